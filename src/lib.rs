@@ -1,0 +1,35 @@
+//! # viscobar
+//!
+//! A reference implementation of the time-stepping scheme of A. Petrov and M. Schatzman
+//! ("On the numerical approximation of a viscoelastic problem with unilateral constraints",
+//! talk, Lisboa 2009) for the Kelvin–Voigt bar on `[0, L]`:
+//!
+//! ```text
+//!   u_tt − u_xx − α u_xxt = l,   s = u_x + α u_xt,
+//!   0 <= u(0) + a_0 ⊥ −s(0) >= 0,   0 <= u(L) + a_L ⊥ s(L) >= 0   (or free, or clamped ends),
+//! ```
+//!
+//! discretised with P1 elements in space and the implicit three-level scheme (VI)_h in time,
+//! each step a bound-constrained quadratic programme solved exactly.
+//!
+//! Modules, one concept each: [`tridiag`] (banded kernels), [`matrices`] (M and R),
+//! [`scene`] (input), [`expr`] (expressions), [`solver`] (the step-solver seam), [`exact`] (the
+//! exact enumeration), [`oracle`] (a dense brute-force reference for tests), [`simulation`] (the
+//! time stepper and energy balance), [`closed_form`] (exact solutions), [`run`] (outputs).
+
+pub mod closed_form;
+pub mod error;
+pub mod exact;
+pub mod expr;
+pub mod matrices;
+pub mod oracle;
+pub mod run;
+pub mod scene;
+pub mod simulation;
+pub mod solver;
+pub mod study;
+pub mod tridiag;
+
+pub use error::{RunError, SceneError};
+pub use scene::Scene;
+pub use simulation::Simulation;

@@ -1,0 +1,330 @@
+//! Running a scene end to end: the step loop, the summary statistics and the output files
+//! (`summary.json`, `history.csv`, `displacement.csv`), written whole or not at all.
+
+use crate::error::RunError;
+use crate::scene::Scene;
+use crate::simulation::{Simulation, StepRecord};
+use serde::Serialize;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// A constrained node counts as in contact when its gap `u + a` is at most this: the exact
+/// solver puts active nodes on the obstacle up to the rounding of `u^n + z` (a few ulps of |u|).
+pub const CONTACT_GAP_TOL: f64 = 1e-12;
+
+/// Summary statistics of a run, as written to `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub scene: String,
+    pub solver: String,
+    pub nodes: usize,
+    pub elements: usize,
+    pub dt: f64,
+    pub steps: usize,
+    pub final_time: f64,
+    pub wall_time_s: f64,
+    pub ns_per_node_step: f64,
+    /// `E^{1/2}`.
+    pub energy_initial: f64,
+    /// `E^{N−1/2}`.
+    pub energy_final: f64,
+    /// Largest one-step increase `E^{n+1/2} − E^{n−1/2}` divided by `E^{1/2}`; only for scenes
+    /// without load (where the scheme cannot gain energy), `null` otherwise.
+    pub max_energy_rise: Option<f64>,
+    pub max_identity_residual: f64,
+    /// Largest `|gap · reaction|` over steps and constrained nodes.
+    pub max_complementarity: f64,
+    /// Largest penetration `max(0, −gap)`.
+    pub max_violation: f64,
+    /// Most negative reaction (0 when none is negative).
+    pub min_reaction: f64,
+    /// `[start, end]` time intervals of contact per constrained end.
+    pub contact_intervals: std::collections::BTreeMap<String, Vec<[f64; 2]>>,
+    pub solver_iterations: Iterations,
+}
+
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Iterations {
+    pub mean: f64,
+    pub max: u32,
+}
+
+/// Accumulates the summary from the step records, in step order.
+#[derive(Clone, Debug)]
+pub struct Tracker {
+    sides: Vec<String>,
+    unforced: bool,
+    energy_initial: f64,
+    energy_prev: f64,
+    energy_final: f64,
+    max_rise: f64,
+    max_residual: f64,
+    max_comp: f64,
+    max_violation: f64,
+    min_reaction: f64,
+    intervals: Vec<Vec<[f64; 2]>>,
+    in_contact: Vec<bool>,
+    iterations_sum: u64,
+    iterations_max: u32,
+    records: usize,
+}
+
+impl Tracker {
+    pub fn new(sim: &Simulation, unforced: bool) -> Self {
+        let sides: Vec<String> = sim
+            .discretisation()
+            .constraints
+            .iter()
+            .map(|c| c.side.name().to_string())
+            .collect();
+        let k = sides.len();
+        let first = sim.first_record();
+        let mut t = Self {
+            sides,
+            unforced,
+            energy_initial: first.energy,
+            energy_prev: first.energy,
+            energy_final: first.energy,
+            max_rise: f64::NEG_INFINITY,
+            max_residual: 0.0,
+            max_comp: 0.0,
+            max_violation: 0.0,
+            min_reaction: 0.0,
+            intervals: vec![Vec::new(); k],
+            in_contact: vec![false; k],
+            iterations_sum: 0,
+            iterations_max: 0,
+            records: 0,
+        };
+        t.observe_contact(&first);
+        t
+    }
+
+    /// Takes the record of the next step.
+    pub fn observe(&mut self, r: &StepRecord) {
+        self.max_rise = self.max_rise.max(r.energy - self.energy_prev);
+        self.energy_prev = r.energy;
+        self.energy_final = r.energy;
+        self.max_residual = self.max_residual.max(r.identity_residual);
+        self.iterations_sum += u64::from(r.iterations);
+        self.iterations_max = self.iterations_max.max(r.iterations);
+        self.records += 1;
+        self.observe_contact(r);
+    }
+
+    fn observe_contact(&mut self, r: &StepRecord) {
+        for j in 0..self.sides.len() {
+            let (gap, reaction) = (r.gap[j], r.reaction[j]);
+            self.max_comp = self.max_comp.max((gap * reaction).abs());
+            self.max_violation = self.max_violation.max(-gap);
+            self.min_reaction = self.min_reaction.min(reaction);
+            let contact = gap <= CONTACT_GAP_TOL;
+            match (contact, self.in_contact[j]) {
+                (true, false) => self.intervals[j].push([r.time, r.time]),
+                (true, true) => self.intervals[j].last_mut().expect("open interval")[1] = r.time,
+                _ => {}
+            }
+            self.in_contact[j] = contact;
+        }
+    }
+
+    pub fn finish(&self, scene_name: &str, sim: &Simulation, wall_time_s: f64) -> Summary {
+        let disc = sim.discretisation();
+        let steps = sim.step_index();
+        Summary {
+            scene: scene_name.to_string(),
+            solver: sim.solver_name().to_string(),
+            nodes: disc.nodes,
+            elements: disc.nodes - 1,
+            dt: disc.dt,
+            steps,
+            final_time: sim.time(),
+            wall_time_s,
+            ns_per_node_step: wall_time_s * 1e9 / (steps as f64 * disc.nodes as f64),
+            energy_initial: self.energy_initial,
+            energy_final: self.energy_final,
+            max_energy_rise: (self.unforced && self.records > 0)
+                .then(|| self.max_rise / self.energy_initial.max(f64::MIN_POSITIVE)),
+            max_identity_residual: self.max_residual,
+            max_complementarity: self.max_comp,
+            max_violation: self.max_violation,
+            min_reaction: self.min_reaction,
+            contact_intervals: self
+                .sides
+                .iter()
+                .cloned()
+                .zip(self.intervals.iter().cloned())
+                .collect(),
+            solver_iterations: Iterations {
+                mean: self.iterations_sum as f64 / self.records.max(1) as f64,
+                max: self.iterations_max,
+            },
+        }
+    }
+}
+
+/// Runs a scene in memory, returning every step record (the start-up step first) and the
+/// summary. For tests and studies; [`run_to_dir`] streams instead.
+pub fn run_in_memory(
+    name: &str,
+    scene: &Scene,
+) -> Result<(Vec<StepRecord>, Summary, Simulation), RunError> {
+    let mut sim = Simulation::new(scene)?;
+    let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
+    let mut records = vec![sim.first_record()];
+    let start = Instant::now();
+    for _ in 1..scene.steps() {
+        let r = sim.step()?;
+        tracker.observe(&r);
+        records.push(r);
+    }
+    let summary = tracker.finish(name, &sim, start.elapsed().as_secs_f64());
+    Ok((records, summary, sim))
+}
+
+/// Runs a scene and writes `summary.json`, `history.csv` and `displacement.csv` into `out`.
+/// The files are written into a temporary folder inside `out` and moved into place only when
+/// the run has succeeded, so a failed run leaves earlier results untouched.
+pub fn run_to_dir(
+    name: &str,
+    scene: &Scene,
+    out: &Path,
+    progress: bool,
+) -> Result<Summary, RunError> {
+    let write_err = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| RunError::Write { path, source }
+    };
+    std::fs::create_dir_all(out).map_err(write_err(out))?;
+    let tmp = out.join(format!(".viscobar-partial-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir_all(&tmp).map_err(write_err(&tmp))?;
+    let result = write_run(name, scene, &tmp, progress);
+    let outcome = result.and_then(|summary| {
+        for file in ["history.csv", "displacement.csv", "summary.json"] {
+            std::fs::rename(tmp.join(file), out.join(file)).map_err(write_err(&out.join(file)))?;
+        }
+        Ok(summary)
+    });
+    let _ = std::fs::remove_dir_all(&tmp);
+    outcome
+}
+
+fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Summary, RunError> {
+    let open = |file: &str| -> Result<(PathBuf, std::io::BufWriter<std::fs::File>), RunError> {
+        let path = dir.join(file);
+        let f = std::fs::File::create(&path).map_err(|source| RunError::Write {
+            path: path.clone(),
+            source,
+        })?;
+        Ok((path, std::io::BufWriter::with_capacity(1 << 20, f)))
+    };
+    let (hist_path, mut hist) = open("history.csv")?;
+    let (disp_path, mut disp) = open("displacement.csv")?;
+    let io = |path: &PathBuf| {
+        let path = path.clone();
+        move |source| RunError::Write { path, source }
+    };
+
+    let start = Instant::now();
+    let mut sim = Simulation::new(scene)?;
+    let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
+    let sides: Vec<&str> = sim
+        .discretisation()
+        .constraints
+        .iter()
+        .map(|c| c.side.name())
+        .collect();
+    let mut header = String::from(
+        "step,t,energy,work,viscous_dissipation,contact_dissipation,identity_residual",
+    );
+    for s in &sides {
+        header.push_str(&format!(",gap_{s},reaction_{s}"));
+    }
+    header.push_str(",iterations");
+    writeln!(hist, "{header}").map_err(io(&hist_path))?;
+    write_history_row(&mut hist, &sim.first_record(), sides.len()).map_err(io(&hist_path))?;
+
+    let nodes = sim.discretisation().nodes;
+    let xs: Vec<f64> = (0..nodes).map(|i| sim.discretisation().x(i)).collect();
+    writeln!(disp, "t,x,u,v").map_err(io(&disp_path))?;
+    {
+        let (u0, v0) = sim.initial_state();
+        write_profile(&mut disp, 0.0, &xs, u0, v0).map_err(io(&disp_path))?;
+    }
+    let mut u = vec![0.0; nodes];
+    let mut v = vec![0.0; nodes];
+    let steps = scene.steps();
+    let every = scene.output.every as usize;
+    let bar = (progress && steps as f64 * nodes as f64 > 2e8).then(|| {
+        let bar = indicatif::ProgressBar::new(steps as u64);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} steps, eta {eta}")
+                .expect("static template"),
+        );
+        bar
+    });
+    let keep = |n: usize| n % every == 0 || n == steps;
+    if keep(1) {
+        sim.displacement_into(&mut u);
+        sim.velocity_into(&mut v);
+        write_profile(&mut disp, sim.time(), &xs, &u, &v).map_err(io(&disp_path))?;
+    }
+    for _ in 1..steps {
+        let r = sim.step()?;
+        tracker.observe(&r);
+        write_history_row(&mut hist, &r, sides.len()).map_err(io(&hist_path))?;
+        if keep(r.step) {
+            sim.displacement_into(&mut u);
+            sim.velocity_into(&mut v);
+            write_profile(&mut disp, sim.time(), &xs, &u, &v).map_err(io(&disp_path))?;
+        }
+        if let Some(b) = &bar {
+            if r.step % 1024 == 0 {
+                b.set_position(r.step as u64);
+            }
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    hist.flush().map_err(io(&hist_path))?;
+    disp.flush().map_err(io(&disp_path))?;
+    let summary = tracker.finish(name, &sim, start.elapsed().as_secs_f64());
+    let json_path = dir.join("summary.json");
+    let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
+    std::fs::write(&json_path, json + "\n").map_err(io(&json_path))?;
+    Ok(summary)
+}
+
+fn write_history_row(w: &mut impl Write, r: &StepRecord, k: usize) -> std::io::Result<()> {
+    write!(
+        w,
+        "{},{},{},{},{},{},{}",
+        r.step,
+        r.time,
+        r.energy,
+        r.work,
+        r.viscous_dissipation,
+        r.contact_dissipation,
+        r.identity_residual
+    )?;
+    for j in 0..k {
+        write!(w, ",{},{}", r.gap[j], r.reaction[j])?;
+    }
+    writeln!(w, ",{}", r.iterations)
+}
+
+fn write_profile(
+    w: &mut impl Write,
+    t: f64,
+    xs: &[f64],
+    u: &[f64],
+    v: &[f64],
+) -> std::io::Result<()> {
+    for i in 0..xs.len() {
+        writeln!(w, "{t},{},{},{}", xs[i], u[i], v[i])?;
+    }
+    Ok(())
+}

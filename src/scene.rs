@@ -1,0 +1,392 @@
+//! Scene files (TOML): the bar, its ends, initial data, load, mesh, time step, solver and output.
+//!
+//! The keys are the public interface; unknown keys are refused so that a typo such as
+//! `viscocity` is an error, not a silently ignored setting.
+
+use crate::error::SceneError;
+use crate::expr::Expression;
+use crate::matrices::MatrixVariant;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// A scene as read from TOML, before validation (see [`Scene::validate`]).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub description: Option<String>,
+    pub bar: Bar,
+    pub left: EndSpec,
+    pub right: EndSpec,
+    #[serde(default)]
+    pub initial: Initial,
+    #[serde(default)]
+    pub load: Load,
+    pub mesh: Mesh,
+    pub time: Time,
+    #[serde(default)]
+    pub solver: SolverSpec,
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bar {
+    pub length: f64,
+    /// Kelvin–Voigt viscosity `alpha >= 0`.
+    #[serde(default)]
+    pub viscosity: f64,
+    #[serde(default)]
+    pub matrices: MatrixVariant,
+}
+
+/// Boundary condition at one end of the bar.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Condition {
+    /// `0 <= u + a ⊥ reaction >= 0` (a lower bound `u >= -a`, at either end, as in the talk).
+    Signorini,
+    /// Zero stress.
+    Free,
+    /// `u = 0`.
+    Clamped,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EndSpec {
+    pub condition: Condition,
+    /// The gap `a` of a Signorini end (constraint `u(end) >= -a`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gap: Option<f64>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Initial {
+    /// `u(x, 0)`, an expression in `x`.
+    #[serde(default = "zero")]
+    pub displacement: String,
+    /// `u_t(x, 0)`, an expression in `x`.
+    #[serde(default = "zero")]
+    pub velocity: String,
+}
+
+impl Default for Initial {
+    fn default() -> Self {
+        Self {
+            displacement: zero(),
+            velocity: zero(),
+        }
+    }
+}
+
+fn zero() -> String {
+    "0".to_string()
+}
+
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Load {
+    /// `l(x, t)`, force per unit length; absent means no load.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<String>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Mesh {
+    /// Number of elements `J + 1`.
+    pub elements: u64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Time {
+    /// `dt > 0`.
+    pub step: f64,
+    /// Final time `T`; the run takes `round(T / dt)` steps (see [`Scene::steps`]).
+    pub end: f64,
+}
+
+/// Which step solver to use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SolverMethod {
+    /// Active-set enumeration on the constrained nodes (exact to round-off).
+    #[default]
+    Exact,
+}
+
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSpec {
+    #[serde(default)]
+    pub method: SolverMethod,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Keep every `every`-th step in `displacement.csv` (the last step is always kept).
+    #[serde(default = "one")]
+    pub every: u64,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        Self { every: 1 }
+    }
+}
+
+fn one() -> u64 {
+    1
+}
+
+/// Largest accepted element count: the run holds about 20 vectors of this length.
+pub const MAX_ELEMENTS: u64 = 50_000_000;
+/// Largest accepted number of time steps.
+pub const MAX_STEPS: u64 = 1_000_000_000;
+
+/// Built-in scenes, embedded from `scenes/*.toml`.
+pub const BUILTIN: &[(&str, &str)] = &[
+    ("modal", include_str!("../scenes/modal.toml")),
+    ("impact", include_str!("../scenes/impact.toml")),
+    (
+        "clamped-impact",
+        include_str!("../scenes/clamped-impact.toml"),
+    ),
+    ("both-ends", include_str!("../scenes/both-ends.toml")),
+    (
+        "both-ends-forced",
+        include_str!("../scenes/both-ends-forced.toml"),
+    ),
+    ("one-end", include_str!("../scenes/one-end.toml")),
+    (
+        "one-end-forced",
+        include_str!("../scenes/one-end-forced.toml"),
+    ),
+];
+
+/// The names of the built-in scenes, in order.
+pub fn builtin_names() -> Vec<&'static str> {
+    BUILTIN.iter().map(|(n, _)| *n).collect()
+}
+
+/// The TOML text of a built-in scene.
+pub fn builtin_text(name: &str) -> Option<&'static str> {
+    BUILTIN.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
+}
+
+/// Reads a scene by built-in name or path, applies `key=value` overrides, and returns its name
+/// (the built-in name or the file stem) and the validated scene.
+pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(String, Scene), SceneError> {
+    let (name, text) = match builtin_text(name_or_path) {
+        Some(t) => (name_or_path.to_string(), t.to_string()),
+        None => {
+            let path = Path::new(name_or_path);
+            if !path.is_file() {
+                return Err(SceneError::UnknownScene {
+                    name: name_or_path.to_string(),
+                    builtins: builtin_names().join(", "),
+                });
+            }
+            let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+                path: path.to_path_buf(),
+                source,
+            })?;
+            let stem = path
+                .file_stem()
+                .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+            (stem, text)
+        }
+    };
+    let scene = Scene::from_toml(&text, overrides)?;
+    Ok((name, scene))
+}
+
+impl Scene {
+    /// Parses TOML text, applies `key=value` overrides (dotted keys, TOML values; a bare word
+    /// is taken as a string) and validates.
+    pub fn from_toml(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
+        let mut table: toml::Table =
+            toml::from_str(text).map_err(|e| SceneError::Syntax(e.to_string()))?;
+        for assignment in overrides {
+            apply_override(&mut table, assignment)?;
+        }
+        let scene: Scene = table
+            .try_into()
+            .map_err(|e: toml::de::Error| SceneError::Syntax(e.to_string()))?;
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// The scene as TOML text.
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).expect("a scene always serialises")
+    }
+
+    /// Checks every field; the error names the field, the value and what is allowed.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        positive("bar.length", self.bar.length)?;
+        if !(self.bar.viscosity.is_finite() && self.bar.viscosity >= 0.0) {
+            return Err(invalid(
+                "bar.viscosity",
+                self.bar.viscosity,
+                "must be a finite number >= 0",
+            ));
+        }
+        for (side, end) in [("left", &self.left), ("right", &self.right)] {
+            match (end.condition, end.gap) {
+                (Condition::Signorini, None) => {
+                    return Err(SceneError::Invalid {
+                        field: format!("{side}.gap"),
+                        value: "missing".into(),
+                        allowed: "a signorini end needs a finite gap >= 0".into(),
+                    });
+                }
+                (Condition::Signorini, Some(a)) if !(a.is_finite() && a >= 0.0) => {
+                    return Err(invalid(
+                        &format!("{side}.gap"),
+                        a,
+                        "must be a finite number >= 0",
+                    ));
+                }
+                (Condition::Free | Condition::Clamped, Some(a)) => {
+                    return Err(invalid(
+                        &format!("{side}.gap"),
+                        a,
+                        "only a signorini end has a gap",
+                    ));
+                }
+                _ => {}
+            }
+        }
+        let elements = self.mesh.elements;
+        let clamped = [&self.left, &self.right]
+            .iter()
+            .filter(|e| e.condition == Condition::Clamped)
+            .count() as u64;
+        if elements < 1 || elements > MAX_ELEMENTS || elements + 1 <= clamped {
+            return Err(SceneError::Invalid {
+                field: "mesh.elements".into(),
+                value: elements.to_string(),
+                allowed: format!(
+                    "must be between {} and {MAX_ELEMENTS} (at least one node must be free to move)",
+                    clamped.max(1)
+                ),
+            });
+        }
+        positive("time.step", self.time.step)?;
+        positive("time.end", self.time.end)?;
+        let steps = self.time.end / self.time.step;
+        if steps.round() < 1.0 || steps > MAX_STEPS as f64 {
+            return Err(SceneError::Invalid {
+                field: "time.end".into(),
+                value: self.time.end.to_string(),
+                allowed: format!("time.end / time.step must lie between 1 and {MAX_STEPS}"),
+            });
+        }
+        if self.output.every < 1 {
+            return Err(invalid(
+                "output.every",
+                self.output.every as f64,
+                "must be >= 1",
+            ));
+        }
+        Expression::parse("initial.displacement", &self.initial.displacement, false)?;
+        Expression::parse("initial.velocity", &self.initial.velocity, false)?;
+        if let Some(d) = &self.load.density {
+            Expression::parse("load.density", d, true)?;
+        }
+        Ok(())
+    }
+
+    /// Number of elements `J + 1`.
+    pub fn elements(&self) -> usize {
+        self.mesh.elements as usize
+    }
+
+    /// `Δx = L / (J + 1)`.
+    pub fn dx(&self) -> f64 {
+        self.bar.length / self.mesh.elements as f64
+    }
+
+    /// Number of time steps: `T / dt` rounded to the nearest integer, so the run ends at
+    /// `steps · dt`, which differs from `T` by at most `dt / 2`.
+    pub fn steps(&self) -> usize {
+        (self.time.end / self.time.step).round() as usize
+    }
+
+    /// The Signorini ends as `(node index in 0..=J+1, gap)`, left first.
+    pub fn signorini_ends(&self) -> Vec<(Side, f64)> {
+        let mut v = Vec::new();
+        for (side, end) in [(Side::Left, &self.left), (Side::Right, &self.right)] {
+            if let (Condition::Signorini, Some(a)) = (end.condition, end.gap) {
+                v.push((side, a));
+            }
+        }
+        v
+    }
+}
+
+/// An end of the bar.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Side {
+    Left,
+    Right,
+}
+
+impl Side {
+    pub fn name(self) -> &'static str {
+        match self {
+            Side::Left => "left",
+            Side::Right => "right",
+        }
+    }
+}
+
+fn invalid(field: &str, value: f64, allowed: &str) -> SceneError {
+    SceneError::Invalid {
+        field: field.to_string(),
+        value: value.to_string(),
+        allowed: allowed.to_string(),
+    }
+}
+
+fn positive(field: &str, value: f64) -> Result<(), SceneError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(field, value, "must be a finite number > 0"))
+    }
+}
+
+fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), SceneError> {
+    let fail = |reason: &str| SceneError::Override {
+        assignment: assignment.to_string(),
+        reason: reason.to_string(),
+    };
+    let (key, raw) = assignment
+        .split_once('=')
+        .ok_or_else(|| fail("expected key=value, e.g. time.step=0.001"))?;
+    let (key, raw) = (key.trim(), raw.trim());
+    let value = match toml::from_str::<toml::Table>(&format!("v = {raw}")) {
+        Ok(mut t) => t.remove("v").expect("parsed key"),
+        Err(_) => toml::Value::String(raw.to_string()),
+    };
+    let parts: Vec<&str> = key.split('.').collect();
+    if parts.len() != 2 || parts.iter().any(|p| p.is_empty()) {
+        return Err(fail("the key must be section.field, e.g. bar.viscosity"));
+    }
+    let section = table
+        .entry(parts[0].to_string())
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    let section = section
+        .as_table_mut()
+        .ok_or_else(|| fail("that section is not a table"))?;
+    section.insert(parts[1].to_string(), value);
+    Ok(())
+}

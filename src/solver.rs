@@ -1,0 +1,45 @@
+//! The seam between the time stepper and the per-step minimisation.
+//!
+//! Every step of the scheme (talk, "Numerical scheme": minimise J over K_h) is, in the increment
+//! `z = u^{n+1} - u^n` that the stepper solves for, the bound-constrained quadratic programme
+//!
+//! ```text
+//!   minimise ½ zᵀ C z − bᵀ z   subject to   z_j >= lo_j  for each constrained node j,
+//! ```
+//!
+//! with `C` symmetric positive definite tridiagonal and constant in time. Its KKT conditions,
+//! which every implementation must meet, are `C z = b + Σ_j r_j e_j`, `z_j >= lo_j`, `r_j >= 0`,
+//! `r_j (z_j − lo_j) = 0`; the multipliers `r_j` are the contact reactions.
+
+/// Outcome statistics of one successful solve.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SolveInfo {
+    /// Iterations (active sets tried, Newton steps, ADMM iterations...), solver-specific.
+    pub iterations: u32,
+}
+
+/// Why a step solver produced no trustworthy answer.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum StepFailure {
+    #[error("non-finite value in the solution (right-hand side or data overflowed)")]
+    NonFinite,
+    #[error("solver status: {0}")]
+    Status(String),
+}
+
+/// A solver for the step problem. Built once per run for a fixed `C` and a fixed list of
+/// constrained nodes; `solve` is called every step and must not allocate.
+pub trait StepSolver {
+    /// Short name used in outputs (`exact`, ...).
+    fn name(&self) -> &'static str;
+
+    /// Given `rhs = b` and `lower = lo` (one entry per constrained node, in the order given at
+    /// construction), writes the minimiser into `z` and the multipliers into `reactions`.
+    fn solve(
+        &mut self,
+        rhs: &[f64],
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<SolveInfo, StepFailure>;
+}

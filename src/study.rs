@@ -1,0 +1,62 @@
+//! Error measurement against closed forms, shared by the tests and the CLI studies.
+
+use crate::closed_form::ClosedForm;
+use crate::error::RunError;
+use crate::scene::Scene;
+use crate::simulation::Simulation;
+
+/// Errors of a run against an exact solution, at the nodes and every time step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ErrorNorms {
+    /// `max_n ‖u_h(t_n) − u(·, t_n)‖_{L2}` with the trapezoidal rule on the nodes.
+    pub l2: f64,
+    /// `max_n max_i |u_i^n − u(x_i, t_n)|`.
+    pub max: f64,
+}
+
+/// Runs `scene` with the exact solver and measures its error against `exact`.
+pub fn error_against(scene: &Scene, exact: &dyn ClosedForm) -> Result<ErrorNorms, RunError> {
+    let mut sim = Simulation::new(scene)?;
+    let disc = sim.discretisation().clone();
+    let xs: Vec<f64> = (0..disc.nodes).map(|i| disc.x(i)).collect();
+    let weights: Vec<f64> = (0..disc.nodes)
+        .map(|i| {
+            if i == 0 || i + 1 == disc.nodes {
+                0.5 * disc.dx
+            } else {
+                disc.dx
+            }
+        })
+        .collect();
+    let mut u = vec![0.0; disc.nodes];
+    let mut norms = ErrorNorms::default();
+    let mut measure = |sim: &Simulation, u: &mut Vec<f64>| {
+        sim.displacement_into(u);
+        let t = sim.time();
+        let mut l2 = 0.0;
+        for i in 0..u.len() {
+            let e = u[i] - exact.displacement(xs[i], t);
+            l2 += weights[i] * e * e;
+            norms.max = norms.max.max(e.abs());
+        }
+        norms.l2 = norms.l2.max(l2.sqrt());
+    };
+    measure(&sim, &mut u);
+    for _ in 1..scene.steps() {
+        sim.step()?;
+        measure(&sim, &mut u);
+    }
+    Ok(norms)
+}
+
+/// Least-squares slope of `log e` against `log h`: the observed order of convergence.
+pub fn observed_order(h: &[f64], e: &[f64]) -> f64 {
+    let n = h.len() as f64;
+    let lx: Vec<f64> = h.iter().map(|v| v.ln()).collect();
+    let ly: Vec<f64> = e.iter().map(|v| v.ln()).collect();
+    let mx = lx.iter().sum::<f64>() / n;
+    let my = ly.iter().sum::<f64>() / n;
+    let sxy: f64 = lx.iter().zip(&ly).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let sxx: f64 = lx.iter().map(|x| (x - mx) * (x - mx)).sum();
+    sxy / sxx
+}
