@@ -185,8 +185,6 @@ pub struct Simulation {
     z: Vec<f64>,
     mz: Vec<f64>,
     rhs: Vec<f64>,
-    /// Scratch: `(½ − α/(2Δt)) w − u^n`.
-    combo: Vec<f64>,
     force: Vec<f64>,
     lower: Vec<f64>,
     reactions: Vec<f64>,
@@ -307,7 +305,6 @@ impl Simulation {
             z: vec![0.0; n],
             mz: vec![0.0; n],
             rhs: vec![0.0; n],
-            combo: vec![0.0; n],
             force: vec![0.0; n],
             lower: vec![0.0; k],
             reactions: vec![0.0; k],
@@ -431,14 +428,21 @@ impl Simulation {
         self.update_force(n)?;
         let has_load = !matches!(self.load, LoadTerm::None);
         let (inv_dt2, c_w) = (self.inv_dt2, self.c_w);
-        for i in 0..self.combo.len() {
-            self.combo[i] = c_w * self.w[i] - self.u[i];
-        }
-        self.disc.stiffness.mul_into(&self.combo, &mut self.rhs);
-        for i in 0..self.rhs.len() {
-            let f = if has_load { self.force[i] } else { 0.0 };
-            self.rhs[i] += f + self.mw[i] * inv_dt2;
-        }
+        let force = if has_load {
+            Some(&self.force[..])
+        } else {
+            None
+        };
+        rhs_into(
+            &self.disc.stiffness,
+            c_w,
+            inv_dt2,
+            &self.u,
+            &self.w,
+            &self.mw,
+            force,
+            &mut self.rhs,
+        );
         for (j, c) in self.disc.constraints.iter().enumerate() {
             self.lower[j] = -c.gap - self.u[self.locals[j]];
         }
@@ -446,25 +450,18 @@ impl Simulation {
             .solver
             .solve(&self.rhs, &self.lower, &mut self.z, &mut self.reactions)
             .map_err(|failure| self.failure(n + 1, failure))?;
-        for (ui, zi) in self.u.iter_mut().zip(&self.z) {
-            *ui += zi;
-        }
-        self.disc.mass.mul_into(&self.z, &mut self.mz);
-        // Energy terms; δ = z + w = u^{n+1} − u^{n−1}. The R-norms use the difference form
-        // (see `SymTridiag::quad`), so rigid motion adds no round-off.
-        let (mut kinetic, mut work) = (0.0, 0.0);
-        for i in 0..self.z.len() {
-            kinetic += self.z[i] * self.mz[i];
-            if has_load {
-                work += self.force[i] * (self.z[i] + self.w[i]);
-            }
-        }
-        let potential = self.disc.stiffness.quad(&self.u);
-        let viscous = if self.disc.alpha > 0.0 {
-            self.disc.stiffness.quad_of_sum(&self.z, &self.w)
-        } else {
-            0.0
-        };
+        let sums = update_and_measure(
+            &self.disc.mass,
+            &self.disc.stiffness,
+            &mut self.u,
+            &self.z,
+            &self.w,
+            &mut self.mz,
+            force,
+            self.disc.alpha > 0.0,
+        );
+        let (kinetic, potential, viscous, work) =
+            (sums.kinetic, sums.potential, sums.viscous, sums.work);
         let dt = self.disc.dt;
         let energy = 0.5 * kinetic * inv_dt2 + 0.25 * (potential + self.potential);
         let viscous = self.disc.alpha / (4.0 * dt) * viscous;
@@ -563,3 +560,101 @@ impl Simulation {
 /// Initial data at a clamped node must vanish up to this (expressions such as `(1-x)/2` at
 /// `x = 1` evaluate to exactly 0, but `sin(pi*x)` at `x = 1` gives 1.2e-16).
 pub const CLAMPED_START_TOL: f64 = 1e-12;
+
+/// `b = F + M w/Δt² + R ((½ − α/(2Δt)) w − u)` in one pass (`M w` is carried over from the
+/// previous step), the stiffness product in difference form.
+#[allow(clippy::too_many_arguments)]
+fn rhs_into(
+    stiffness: &SymTridiag,
+    c_w: f64,
+    inv_dt2: f64,
+    u: &[f64],
+    w: &[f64],
+    mw: &[f64],
+    force: Option<&[f64]>,
+    rhs: &mut [f64],
+) {
+    let n = rhs.len();
+    let y = |i: usize| c_w * w[i] - u[i];
+    let (s, e) = (stiffness.row_sums(), &stiffness.off[..]);
+    if n == 1 {
+        rhs[0] = s[0] * y(0) + mw[0] * inv_dt2 + force.map_or(0.0, |f| f[0]);
+        return;
+    }
+    let mut y_prev = 0.0;
+    let mut y_here = y(0);
+    for i in 0..n {
+        let y_next = if i + 1 < n { y(i + 1) } else { 0.0 };
+        let mut r = s[i] * y_here;
+        if i > 0 {
+            r += e[i - 1] * (y_prev - y_here);
+        }
+        if i + 1 < n {
+            r += e[i] * (y_next - y_here);
+        }
+        rhs[i] = r + mw[i] * inv_dt2 + force.map_or(0.0, |f| f[i]);
+        y_prev = y_here;
+        y_here = y_next;
+    }
+}
+
+/// The sums of the energy balance of one step.
+#[derive(Clone, Copy, Debug, Default)]
+struct StepSums {
+    /// `zᵀ M z`.
+    kinetic: f64,
+    /// `|u^{n+1}|²_R`.
+    potential: f64,
+    /// `|z + w|²_R` (left 0 when `α = 0`).
+    viscous: f64,
+    /// `F·(z + w)`.
+    work: f64,
+}
+
+/// `u += z`, `M z`, and the energy sums, in one pass; the R-norms in difference form so that
+/// rigid motion adds no round-off (see [`SymTridiag::quad`]).
+#[allow(clippy::too_many_arguments)]
+fn update_and_measure(
+    mass: &SymTridiag,
+    stiffness: &SymTridiag,
+    u: &mut [f64],
+    z: &[f64],
+    w: &[f64],
+    mz: &mut [f64],
+    force: Option<&[f64]>,
+    viscous: bool,
+) -> StepSums {
+    let n = u.len();
+    let (sm, em) = (mass.row_sums(), &mass.off[..]);
+    let (sr, er) = (stiffness.row_sums(), &stiffness.off[..]);
+    let mut sums = StepSums::default();
+    for i in 0..n {
+        let zi = z[i];
+        let ui = u[i] + zi;
+        u[i] = ui;
+        let mut m = sm[i] * zi;
+        if i > 0 {
+            m += em[i - 1] * (z[i - 1] - zi);
+        }
+        let di = zi + w[i];
+        sums.potential += sr[i] * ui * ui;
+        if viscous {
+            sums.viscous += sr[i] * di * di;
+        }
+        if i + 1 < n {
+            m += em[i] * (z[i + 1] - zi);
+            let du = (u[i + 1] + z[i + 1]) - ui;
+            sums.potential -= er[i] * du * du;
+            if viscous {
+                let dd = (z[i + 1] + w[i + 1]) - di;
+                sums.viscous -= er[i] * dd * dd;
+            }
+        }
+        mz[i] = m;
+        sums.kinetic += zi * m;
+        if let Some(f) = force {
+            sums.work += f[i] * di;
+        }
+    }
+    sums
+}

@@ -185,21 +185,25 @@ impl Ldlt {
         self.inv_d.len()
     }
 
-    /// Overwrites `b` with `A⁻¹ b`.
+    /// Overwrites `b` with `A⁻¹ b`: a forward sweep with the `D⁻¹` scaling fused in, then a
+    /// backward sweep. Both are chains of dependent multiply-adds (latency-bound).
     pub fn solve_in_place(&self, b: &mut [f64]) {
         let n = self.dim();
         debug_assert_eq!(b.len(), n);
         if n == 0 {
             return;
         }
+        let (l, inv_d) = (&self.l[..n - 1], &self.inv_d[..n]);
+        let mut t = b[0];
+        b[0] = t * inv_d[0];
         for i in 1..n {
-            b[i] -= self.l[i - 1] * b[i - 1];
+            t = b[i] - l[i - 1] * t;
+            b[i] = t * inv_d[i];
         }
-        for (bi, inv) in b.iter_mut().zip(&self.inv_d) {
-            *bi *= inv;
-        }
+        let mut next = b[n - 1];
         for i in (0..n - 1).rev() {
-            b[i] -= self.l[i] * b[i + 1];
+            next = b[i] - l[i] * next;
+            b[i] = next;
         }
     }
 
