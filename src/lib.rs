@@ -29,6 +29,7 @@ pub mod simulation;
 pub mod solver;
 pub mod study;
 pub mod tridiag;
+pub mod verify;
 
 pub use error::{RunError, SceneError};
 pub use scene::Scene;

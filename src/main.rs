@@ -36,6 +36,12 @@ enum Command {
     Scenes,
     /// Print a built-in scene as TOML.
     Show { name: String },
+    /// Recompute the measured figures of VERIFICATION.md and print them as Markdown.
+    Verify {
+        /// Rewrite the generated blocks of this file in place instead of printing.
+        #[arg(long, value_name = "FILE")]
+        update: Option<PathBuf>,
+    },
 }
 
 fn main() {
@@ -65,6 +71,7 @@ fn main() {
                 2
             }
         },
+        Command::Verify { update } => verify(update),
         Command::Run {
             scene: name,
             out,
@@ -104,4 +111,32 @@ fn run(name: &str, out: Option<PathBuf>, set: &[String]) -> Result<(), viscobar:
         out.display()
     );
     Ok(())
+}
+
+fn verify(update: Option<PathBuf>) -> i32 {
+    let sections = match viscobar::verify::sections() {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return e.exit_code();
+        }
+    };
+    let Some(path) = update else {
+        print!("{}", viscobar::verify::render(&sections));
+        return 0;
+    };
+    let result = std::fs::read_to_string(&path)
+        .map_err(|e| format!("cannot read {}: {e}", path.display()))
+        .and_then(|doc| viscobar::verify::update_document(&doc, &sections))
+        .and_then(|doc| {
+            viscobar::run::write_atomically(&path, doc.as_bytes())
+                .map_err(|e| format!("cannot write {}: {e}", path.display()))
+        });
+    match result {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("error: {e}");
+            1
+        }
+    }
 }

@@ -1,6 +1,6 @@
 //! Convergence to the closed-form solutions shipped with the built-in scenes.
 //!
-//! The refinement study behind the bounds is `cargo run --release --example refine` (five
+//! The refinement study behind the bounds is `cargo run --release -- verify` (five
 //! levels, dx and dt halved together): modal order 1.995; impact 0.686; clamped-impact 0.680,
 //! with L2 errors 2.10e-2 and 1.09e-2 at the scenes' own meshes.
 

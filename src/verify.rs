@@ -1,0 +1,203 @@
+//! `viscobar verify`: recomputes the measured figures of VERIFICATION.md and prints them as
+//! Markdown tables, each between `<!-- generated:ID -->` and `<!-- end:ID -->` markers, so the
+//! document is regenerated (`viscobar verify --update VERIFICATION.md`), never hand-edited.
+//! Every figure here is deterministic (no timings), so a test checks the document is current.
+
+use crate::closed_form;
+use crate::error::RunError;
+use crate::matrices::{MatrixVariant, mass, stiffness};
+use crate::run::run_in_memory;
+use crate::scene::{self, Scene};
+use crate::study::{error_against, observed_order, rigid_mode_drift};
+use std::fmt::Write;
+
+/// One generated block of VERIFICATION.md.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Section {
+    pub id: &'static str,
+    pub markdown: String,
+}
+
+/// Levels of the convergence tables (dx and dt halved together from the scene's own mesh).
+pub const CONVERGENCE_LEVELS: u32 = 5;
+/// Size of the rigid-mode round-off study (the independent figure was taken at J = 8192).
+pub const RIGID_ELEMENTS: u64 = 8193;
+pub const RIGID_STEPS: usize = 26_000;
+
+/// All sections, in document order.
+pub fn sections() -> Result<Vec<Section>, RunError> {
+    Ok(vec![
+        matrices_section(),
+        scenes_section()?,
+        convergence_section()?,
+        roundoff_section()?,
+    ])
+}
+
+fn matrices_section() -> Section {
+    let mut md = String::from(
+        "| variant | nodes | 1ᵀM1 / L | max abs(R·1) · Δx | M symmetric | R symmetric |\n|---|---|---|---|---|---|\n",
+    );
+    for variant in [MatrixVariant::Consistent, MatrixVariant::TalkPrinted] {
+        for nodes in [11usize, 101, 1001] {
+            let dx = 1.0 / (nodes - 1) as f64;
+            let m = mass(variant, nodes, dx);
+            let r = stiffness(variant, nodes, dx);
+            let total: f64 = m.mul(&vec![1.0; nodes]).iter().sum();
+            let r1 = r
+                .mul(&vec![1.0; nodes])
+                .iter()
+                .fold(0.0f64, |a, v| a.max(v.abs()));
+            let sym = |a: &crate::tridiag::SymTridiag| {
+                let d = a.to_dense();
+                d == d.transpose()
+            };
+            let _ = writeln!(
+                md,
+                "| {} | {nodes} | {:.6} | {} | {} | {} |",
+                variant_name(variant),
+                total,
+                r1 * dx,
+                sym(&m),
+                sym(&r)
+            );
+        }
+    }
+    Section {
+        id: "matrices",
+        markdown: md,
+    }
+}
+
+fn variant_name(v: MatrixVariant) -> &'static str {
+    match v {
+        MatrixVariant::Consistent => "consistent",
+        MatrixVariant::TalkPrinted => "talk-printed",
+    }
+}
+
+fn scenes_section() -> Result<Section, RunError> {
+    let mut md = String::from(
+        "| scene | solver | nodes | steps | max identity residual | max energy rise / E^{1/2} | max abs(gap·reaction) | max penetration | min reaction | contact episodes |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for name in scene::builtin_names() {
+        let (_, scene) = scene::load(name, &[])?;
+        let (_, s, _) = run_in_memory(name, &scene)?;
+        let episodes: Vec<String> = s
+            .contact_intervals
+            .iter()
+            .map(|(side, v)| format!("{side}: {}", v.len()))
+            .collect();
+        let _ = writeln!(
+            md,
+            "| {name} | {} | {} | {} | {:.1e} | {} | {:.1e} | {:.1e} | {:.1e} | {} |",
+            s.solver,
+            s.nodes,
+            s.steps,
+            s.max_identity_residual,
+            s.max_energy_rise
+                .map_or("(forced)".to_string(), |v| format!("{v:.1e}")),
+            s.max_complementarity,
+            s.max_violation,
+            s.min_reaction,
+            if episodes.is_empty() {
+                "(no contact)".into()
+            } else {
+                episodes.join(", ")
+            }
+        );
+    }
+    Ok(Section {
+        id: "scenes",
+        markdown: md,
+    })
+}
+
+fn refined(base: &Scene, level: u32) -> Scene {
+    let mut s = base.clone();
+    s.mesh.elements = base.mesh.elements << level;
+    s.time.step = base.time.step / f64::from(1u32 << level);
+    s
+}
+
+fn convergence_section() -> Result<Section, RunError> {
+    let mut md = String::from(
+        "| scene | elements | dt | L2 error (max over t) | max-norm error | observed order (L2, all levels) |\n|---|---|---|---|---|---|\n",
+    );
+    for name in ["modal", "impact", "clamped-impact"] {
+        let (_, base) = scene::load(name, &[])?;
+        let exact = closed_form::for_scene(name, &base).expect("built-in closed form");
+        let mut rows = Vec::new();
+        for level in 0..CONVERGENCE_LEVELS {
+            let s = refined(&base, level);
+            let e = error_against(&s, exact.as_ref())?;
+            rows.push((s.mesh.elements, s.time.step, s.dx(), e));
+        }
+        let h: Vec<f64> = rows.iter().map(|r| r.2).collect();
+        let e: Vec<f64> = rows.iter().map(|r| r.3.l2).collect();
+        let order = observed_order(&h, &e);
+        for (i, (el, dt, _, err)) in rows.iter().enumerate() {
+            let _ = writeln!(
+                md,
+                "| {name} | {el} | {dt} | {:.3e} | {:.3e} | {} |",
+                err.l2,
+                err.max,
+                if i == 0 {
+                    format!("{order:.3}")
+                } else {
+                    String::new()
+                }
+            );
+        }
+    }
+    Ok(Section {
+        id: "convergence",
+        markdown: md,
+    })
+}
+
+fn roundoff_section() -> Result<Section, RunError> {
+    let (ours, talk) = rigid_mode_drift(RIGID_ELEMENTS, RIGID_STEPS)?;
+    let md = format!(
+        "| formulation | max_i abs(u_i − t) after {RIGID_STEPS} steps, J = {} |\n|---|---|\n\
+         | increment z = u^(n+1) − u^n (viscobar) | {ours:.2e} |\n| talk form C u^(n+1) = F̃^n | {talk:.2e} |\n",
+        RIGID_ELEMENTS - 1
+    );
+    Ok(Section {
+        id: "roundoff",
+        markdown: md,
+    })
+}
+
+/// The whole output of `viscobar verify`.
+pub fn render(sections: &[Section]) -> String {
+    let mut out = String::new();
+    for s in sections {
+        let _ = write!(
+            out,
+            "<!-- generated:{} -->\n{}<!-- end:{} -->\n\n",
+            s.id, s.markdown, s.id
+        );
+    }
+    out
+}
+
+/// Replaces each generated block of `doc` by the section of the same id. Errors name a
+/// missing marker.
+pub fn update_document(doc: &str, sections: &[Section]) -> Result<String, String> {
+    let mut out = doc.to_string();
+    for s in sections {
+        let open = format!("<!-- generated:{} -->\n", s.id);
+        let close = format!("<!-- end:{} -->", s.id);
+        let a = out
+            .find(&open)
+            .ok_or(format!("VERIFICATION.md has no marker `{}`", open.trim()))?;
+        let b = out[a..]
+            .find(&close)
+            .ok_or(format!("VERIFICATION.md has no marker `{close}`"))?
+            + a;
+        out.replace_range(a + open.len()..b, &s.markdown);
+    }
+    Ok(out)
+}
