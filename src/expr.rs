@@ -4,13 +4,53 @@
 
 use crate::error::SceneError;
 use exmex::prelude::*;
+use exmex::{FloatOpsFactory, MatchLiteral};
+
+/// Numeric literals with an optional exponent (`1e6`, `2.5E-3`): exmex's default matcher reads
+/// `1e6` as `1`, Euler's `e`, `6`. An `e` counts as an exponent only after a mantissa and before
+/// digits, so `2*e` is still Euler's number.
+#[derive(Clone, Debug, Default)]
+pub struct ScientificLiteral;
+
+impl MatchLiteral for ScientificLiteral {
+    fn is_literal(text: &str) -> Option<&str> {
+        let b = text.as_bytes();
+        let digits = |mut i: usize| {
+            while i < b.len() && b[i].is_ascii_digit() {
+                i += 1;
+            }
+            i
+        };
+        let int_end = digits(0);
+        let mut end = int_end;
+        if end < b.len() && b[end] == b'.' {
+            end = digits(end + 1);
+        }
+        if end == 0 || (end == 1 && b[0] == b'.') {
+            return None;
+        }
+        if end < b.len() && (b[end] == b'e' || b[end] == b'E') {
+            let mut k = end + 1;
+            if k < b.len() && (b[k] == b'+' || b[k] == b'-') {
+                k += 1;
+            }
+            let exp_end = digits(k);
+            if exp_end > k {
+                end = exp_end;
+            }
+        }
+        Some(&text[..end])
+    }
+}
+
+type Flat = FlatEx<f64, FloatOpsFactory<f64>, ScientificLiteral>;
 
 /// A parsed expression `f(x, t)`, evaluated with the variables it does not use ignored.
 #[derive(Clone, Debug)]
 pub struct Expression {
     text: String,
     field: String,
-    flat: FlatEx<f64>,
+    flat: Flat,
     /// Position in the argument list of each variable exmex found (alphabetical order).
     slots: Vec<Var>,
 }
@@ -31,7 +71,7 @@ impl Expression {
             text: text.to_string(),
             reason,
         };
-        let flat = exmex::parse::<f64>(text).map_err(|e| bad(e.to_string()))?;
+        let flat = Flat::parse(text).map_err(|e| bad(e.to_string()))?;
         let slots = flat
             .var_names()
             .iter()

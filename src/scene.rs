@@ -145,7 +145,25 @@ fn one() -> u64 {
 }
 
 /// Largest accepted element count: the run holds about 20 vectors of this length.
-pub const MAX_ELEMENTS: u64 = 50_000_000;
+pub const MAX_ELEMENTS: u64 = 100_000_000;
+/// Memory per node of a run: about 40 vectors of f64 (state, products, matrices, factors,
+/// solver columns, output buffers) with a margin for the solver's own work space.
+pub const BYTES_PER_NODE: u64 = 512;
+const GIB: f64 = (1u64 << 30) as f64;
+
+/// `MemAvailable` from /proc/meminfo, or 24 GiB (this project's machines) where unreadable.
+fn available_memory_bytes() -> u64 {
+    std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("MemAvailable:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<u64>().ok())
+        })
+        .map_or(24 << 30, |kb| kb * 1024)
+}
+
 /// Largest accepted number of time steps.
 pub const MAX_STEPS: u64 = 1_000_000_000;
 
@@ -210,14 +228,12 @@ impl Scene {
     /// Parses TOML text, applies `key=value` overrides (dotted keys, TOML values; a bare word
     /// is taken as a string) and validates.
     pub fn from_toml(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
-        let mut table: toml::Table =
-            toml::from_str(text).map_err(|e| SceneError::Syntax(e.to_string()))?;
+        let syntax = |e: toml::de::Error| SceneError::Syntax(e.to_string().trim_end().to_string());
+        let mut table: toml::Table = toml::from_str(text).map_err(syntax)?;
         for assignment in overrides {
             apply_override(&mut table, assignment)?;
         }
-        let scene: Scene = table
-            .try_into()
-            .map_err(|e: toml::de::Error| SceneError::Syntax(e.to_string()))?;
+        let scene: Scene = table.try_into().map_err(syntax)?;
         scene.validate()?;
         Ok(scene)
     }
@@ -278,6 +294,19 @@ impl Scene {
                 ),
             });
         }
+        let needed = self.estimated_bytes();
+        let available = available_memory_bytes();
+        if needed > available {
+            return Err(SceneError::Invalid {
+                field: "mesh.elements".into(),
+                value: elements.to_string(),
+                allowed: format!(
+                    "a run this size needs about {:.1} GiB, more than the {:.1} GiB available",
+                    needed as f64 / GIB,
+                    available as f64 / GIB
+                ),
+            });
+        }
         positive("time.step", self.time.step)?;
         positive("time.end", self.time.end)?;
         let steps = self.time.end / self.time.step;
@@ -301,6 +330,11 @@ impl Scene {
             Expression::parse("load.density", d, true)?;
         }
         Ok(())
+    }
+
+    /// Memory a run of this scene needs, estimated before anything is allocated.
+    pub fn estimated_bytes(&self) -> u64 {
+        (self.mesh.elements + 1).saturating_mul(BYTES_PER_NODE)
     }
 
     /// Number of elements `J + 1`.

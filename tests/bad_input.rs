@@ -1,0 +1,268 @@
+//! Bad input is refused with exit code 2 and a message naming the problem; failures during a
+//! run exit with 1 and name the step; nothing is written for either, and an earlier good result
+//! in the output folder survives a failed rerun.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn viscobar(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_viscobar"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn fresh_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("viscobar-bad-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// (what, scene text edit or --set arguments, text the message must contain)
+enum Edit {
+    Set(&'static [&'static str]),
+    /// Replace the first occurrence of `.0` by `.1` in the impact scene's TOML text.
+    Replace(&'static str, &'static str),
+}
+
+const CASES: &[(&str, Edit, &str)] = &[
+    (
+        "negative step",
+        Edit::Set(&["time.step=-0.01"]),
+        "time.step",
+    ),
+    ("zero step", Edit::Set(&["time.step=0"]), "time.step"),
+    ("nan step", Edit::Set(&["time.step=nan"]), "time.step"),
+    ("infinite step", Edit::Set(&["time.step=inf"]), "time.step"),
+    ("negative end", Edit::Set(&["time.end=-3"]), "time.end"),
+    (
+        "end shorter than a step",
+        Edit::Set(&["time.end=0.001"]),
+        "time.end",
+    ),
+    (
+        "absurd step count",
+        Edit::Set(&["time.step=1e-12"]),
+        "time.end",
+    ),
+    ("zero length", Edit::Set(&["bar.length=0"]), "bar.length"),
+    ("nan length", Edit::Set(&["bar.length=nan"]), "bar.length"),
+    (
+        "negative viscosity",
+        Edit::Set(&["bar.viscosity=-1"]),
+        "bar.viscosity",
+    ),
+    (
+        "infinite viscosity",
+        Edit::Set(&["bar.viscosity=inf"]),
+        "bar.viscosity",
+    ),
+    ("negative gap", Edit::Set(&["left.gap=-0.1"]), "left.gap"),
+    ("nan gap", Edit::Set(&["left.gap=nan"]), "left.gap"),
+    (
+        "gap on a free end",
+        Edit::Set(&["right.gap=0.1"]),
+        "right.gap",
+    ),
+    (
+        "signorini without gap",
+        Edit::Replace("gap = 0.1\n", ""),
+        "left.gap",
+    ),
+    (
+        "zero elements",
+        Edit::Set(&["mesh.elements=0"]),
+        "mesh.elements",
+    ),
+    (
+        "negative elements",
+        Edit::Set(&["mesh.elements=-5"]),
+        "mesh.elements",
+    ),
+    (
+        "fractional elements",
+        Edit::Set(&["mesh.elements=10.5"]),
+        "mesh.elements",
+    ),
+    (
+        "more memory than the machine has",
+        Edit::Set(&["mesh.elements=99000000", "time.step=1"]),
+        "GiB",
+    ),
+    (
+        "gap on a clamped end",
+        Edit::Set(&["left.condition=\"clamped\""]),
+        "only a signorini end has a gap",
+    ),
+    (
+        "typo in a key",
+        Edit::Set(&["bar.viscocity=0.1"]),
+        "viscocity",
+    ),
+    (
+        "unknown section",
+        Edit::Set(&["solvr.method=\"exact\""]),
+        "solvr",
+    ),
+    (
+        "unknown condition",
+        Edit::Set(&["right.condition=\"glued\""]),
+        "glued",
+    ),
+    (
+        "unknown matrices",
+        Edit::Set(&["bar.matrices=\"lumped\""]),
+        "lumped",
+    ),
+    (
+        "unknown solver",
+        Edit::Set(&["solver.method=\"magic\""]),
+        "magic",
+    ),
+    (
+        "wrong type",
+        Edit::Set(&["mesh.elements=\"many\""]),
+        "mesh.elements",
+    ),
+    ("--set without =", Edit::Set(&["time.step"]), "key=value"),
+    (
+        "--set key without section",
+        Edit::Set(&["step=0.1"]),
+        "section.field",
+    ),
+    (
+        "unparsable expression",
+        Edit::Set(&["initial.velocity=\"-1*(\""]),
+        "initial.velocity",
+    ),
+    (
+        "unknown variable",
+        Edit::Set(&["initial.velocity=\"y\""]),
+        "unknown variable `y`",
+    ),
+    (
+        "t in initial data",
+        Edit::Set(&["initial.displacement=\"t\""]),
+        "initial.displacement",
+    ),
+    (
+        "NaN in the load",
+        Edit::Set(&["load.density=\"sqrt(x-0.5)\""]),
+        "x = 0",
+    ),
+    (
+        "infinite load at t = 1",
+        Edit::Set(&["load.density=\"1/(t-1)\""]),
+        "t = 1",
+    ),
+    (
+        "initial state below the obstacle",
+        Edit::Set(&["initial.displacement=\"-0.5\""]),
+        "node 0 (x = 0)",
+    ),
+    (
+        "clamped end not at rest",
+        Edit::Set(&["right.condition=\"clamped\"", "initial.displacement=\"x\""]),
+        "clamped right end",
+    ),
+    (
+        "invalid TOML",
+        Edit::Replace("[mesh]", "[mesh"),
+        "not valid",
+    ),
+    (
+        "zero output stride",
+        Edit::Set(&["output.every=0"]),
+        "output.every",
+    ),
+];
+
+#[test]
+fn bad_scenes_exit_2_and_name_the_problem() {
+    assert!(CASES.len() >= 30);
+    let base = viscobar::scene::builtin_text("impact").unwrap();
+    for (what, edit, needle) in CASES {
+        let dir = fresh_dir("case");
+        let scene = dir.join("impact.toml");
+        let out = dir.join("out");
+        let mut args = vec![
+            "run".to_string(),
+            scene.display().to_string(),
+            "--out".into(),
+            out.display().to_string(),
+        ];
+        let text = match edit {
+            Edit::Set(sets) => {
+                for s in *sets {
+                    args.push("--set".into());
+                    args.push(s.to_string());
+                }
+                base.to_string()
+            }
+            Edit::Replace(a, b) => base.replacen(a, b, 1),
+        };
+        std::fs::write(&scene, text).unwrap();
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = viscobar(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{what}: exit code; stderr: {err}");
+        assert!(
+            err.contains(needle),
+            "{what}: message should contain `{needle}`: {err}"
+        );
+        assert!(!err.contains("panicked"), "{what}: panic: {err}");
+        assert!(
+            !out.join("summary.json").exists(),
+            "{what}: a result was written"
+        );
+    }
+}
+
+#[test]
+fn unknown_scene_name_exits_2() {
+    let o = viscobar(&["run", "no-such-scene"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no-such-scene"));
+}
+
+fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                std::fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+#[test]
+fn a_failed_run_exits_1_names_the_step_and_keeps_the_earlier_result() {
+    let dir = fresh_dir("keep");
+    let out = dir.to_str().unwrap();
+    let ok = viscobar(&["run", "impact", "--out", out, "--set", "time.end=0.5"]);
+    assert!(ok.status.success());
+    let before = snapshot(&dir);
+    // The load overflows f64 at the second step: a run-time failure, not bad input.
+    let failed = viscobar(&[
+        "run",
+        "impact",
+        "--out",
+        out,
+        "--set",
+        "load.density=\"1e300*t*t\"",
+    ]);
+    let err = String::from_utf8_lossy(&failed.stderr);
+    assert_eq!(failed.status.code(), Some(1), "{err}");
+    assert!(err.contains("step 2") && err.contains("exact"), "{err}");
+    assert_eq!(
+        snapshot(&dir),
+        before,
+        "the earlier result must survive, and nothing else appear"
+    );
+}
