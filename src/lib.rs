@@ -17,6 +17,7 @@
 //! exact enumeration), [`oracle`] (a dense brute-force reference for tests), [`simulation`] (the
 //! time stepper and energy balance), [`closed_form`] (exact solutions), [`run`] (outputs).
 
+pub mod active_set;
 pub mod closed_form;
 pub mod error;
 pub mod exact;
