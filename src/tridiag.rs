@@ -140,15 +140,23 @@ pub fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
 }
 
-/// The factorisation `A = L D Lᵀ` of a symmetric positive definite tridiagonal matrix, with `L`
-/// unit lower bidiagonal. Computed once per run; `solve_in_place` costs 3 multiply-adds per node
-/// and never allocates.
+/// A twisted factorisation of a symmetric positive definite tridiagonal matrix ("burn at both
+/// ends"): `L D Lᵀ` from the top for rows `0..m`, `U D Uᵀ` from the bottom for rows `m+1..n`,
+/// joined at the twist row `m = n/2`. Computed once per run. A solve runs the two elimination
+/// chains (top-down and bottom-up) interleaved in one loop, so the processor overlaps two
+/// dependent multiply-subtract chains instead of waiting on one: about half the latency of the
+/// plain `L D Lᵀ` sweep, with the same number of operations and no fused multiply-add (results
+/// do not depend on target-cpu flags).
 #[derive(Clone, Debug)]
 pub struct Ldlt {
-    /// `l[i] = L[i+1][i]`.
+    /// Multipliers: `l[i] = e_i / d_i` for `i < m` (top chain) and `l[i] = e_{i−1} / d_i` for
+    /// `i > m` (bottom chain); unused at `m`.
     l: Vec<f64>,
-    /// `1 / D[i]`.
+    /// `1 / d_i`, with `d_m = γ_m` the twist pivot.
     inv_d: Vec<f64>,
+    /// Off-diagonal of `A`, needed by the outward sweeps.
+    off: Vec<f64>,
+    twist: usize,
 }
 
 /// The matrix was not numerically positive definite: pivot `index` came out as `pivot`.
@@ -162,48 +170,110 @@ pub struct NotPositiveDefinite {
 impl Ldlt {
     pub fn factor(a: &SymTridiag) -> Result<Self, NotPositiveDefinite> {
         let n = a.dim();
-        let mut l = vec![0.0; n.saturating_sub(1)];
+        let twist = n / 2;
+        let mut l = vec![0.0; n];
         let mut inv_d = vec![0.0; n];
-        let mut d_prev = 0.0;
-        for i in 0..n {
-            let d = if i == 0 {
-                a.diag[0]
+        let check = |index: usize, pivot: f64| {
+            if pivot > 0.0 && pivot.is_finite() {
+                Ok(pivot)
             } else {
-                l[i - 1] = a.off[i - 1] / d_prev;
-                a.diag[i] - l[i - 1] * a.off[i - 1]
-            };
-            if !(d > 0.0 && d.is_finite()) {
-                return Err(NotPositiveDefinite { index: i, pivot: d });
+                Err(NotPositiveDefinite { index, pivot })
             }
-            inv_d[i] = 1.0 / d;
-            d_prev = d;
+        };
+        let (d, e) = (&a.diag, &a.off);
+        let mut top = 0.0;
+        for i in 0..twist {
+            let p = if i == 0 {
+                d[0]
+            } else {
+                d[i] - e[i - 1] * l[i - 1]
+            };
+            top = check(i, p)?;
+            inv_d[i] = 1.0 / top;
+            l[i] = e[i] / top;
         }
-        Ok(Self { l, inv_d })
+        let mut bottom = 0.0;
+        for i in (twist + 1..n).rev() {
+            let p = if i == n - 1 {
+                d[i]
+            } else {
+                d[i] - e[i] * l[i + 1]
+            };
+            bottom = check(i, p)?;
+            inv_d[i] = 1.0 / bottom;
+            l[i] = e[i - 1] / bottom;
+        }
+        if n > 0 {
+            let mut g = d[twist];
+            if twist > 0 {
+                g -= e[twist - 1] * l[twist - 1];
+            }
+            if twist + 1 < n {
+                g -= e[twist] * l[twist + 1];
+            }
+            inv_d[twist] = 1.0 / check(twist, g)?;
+        }
+        let _ = (top, bottom);
+        Ok(Self {
+            l,
+            inv_d,
+            off: e.clone(),
+            twist,
+        })
     }
 
     pub fn dim(&self) -> usize {
         self.inv_d.len()
     }
 
-    /// Overwrites `b` with `A⁻¹ b`: a forward sweep with the `D⁻¹` scaling fused in, then a
-    /// backward sweep. Both are chains of dependent multiply-adds (latency-bound).
+    /// Overwrites `b` with `A⁻¹ b`: the two chains eliminate towards the twist row together,
+    /// then substitute outwards together.
     pub fn solve_in_place(&self, b: &mut [f64]) {
         let n = self.dim();
         debug_assert_eq!(b.len(), n);
         if n == 0 {
             return;
         }
-        let (l, inv_d) = (&self.l[..n - 1], &self.inv_d[..n]);
-        let mut t = b[0];
-        b[0] = t * inv_d[0];
-        for i in 1..n {
-            t = b[i] - l[i - 1] * t;
-            b[i] = t * inv_d[i];
+        let m = self.twist;
+        let (l, inv_d, e) = (&self.l[..n], &self.inv_d[..n], &self.off[..]);
+        // Inward: top rows 1..m (each uses the row above), bottom rows n−2..m+1 (the row below).
+        let top_len = m; // rows 0..m
+        let bottom_len = n - 1 - m; // rows m+1..n
+        let common = top_len.min(bottom_len);
+        for k in 1..common {
+            let (i, j) = (k, n - 1 - k);
+            b[i] -= l[i - 1] * b[i - 1];
+            b[j] -= l[j + 1] * b[j + 1];
         }
-        let mut next = b[n - 1];
-        for i in (0..n - 1).rev() {
-            next = b[i] - l[i] * next;
-            b[i] = next;
+        for i in common.max(1)..top_len {
+            b[i] -= l[i - 1] * b[i - 1];
+        }
+        for k in common.max(1)..bottom_len {
+            let j = n - 1 - k;
+            b[j] -= l[j + 1] * b[j + 1];
+        }
+        // Twist row.
+        let mut xm = b[m];
+        if m > 0 {
+            xm -= l[m - 1] * b[m - 1];
+        }
+        if m + 1 < n {
+            xm -= l[m + 1] * b[m + 1];
+        }
+        b[m] = xm * inv_d[m];
+        // Outward: x_i = (y_i − e_i x_{i+1}) / d_i above, (y_j − e_{j−1} x_{j−1}) / d_j below.
+        for k in 1..=common {
+            let (i, j) = (m - k, m + k);
+            b[i] = (b[i] - e[i] * b[i + 1]) * inv_d[i];
+            b[j] = (b[j] - e[j - 1] * b[j - 1]) * inv_d[j];
+        }
+        for k in common + 1..=top_len {
+            let i = m - k;
+            b[i] = (b[i] - e[i] * b[i + 1]) * inv_d[i];
+        }
+        for k in common + 1..=bottom_len {
+            let j = m + k;
+            b[j] = (b[j] - e[j - 1] * b[j - 1]) * inv_d[j];
         }
     }
 
