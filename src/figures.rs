@@ -84,7 +84,7 @@ impl Sampling {
     pub fn exact(scene: &Scene, x_points: usize, t_points: usize) -> Option<Self> {
         let (elements, steps) = (scene.elements(), scene.steps());
         let (xi, ti) = (x_points.checked_sub(1)?, t_points.checked_sub(1)?);
-        (xi > 0 && ti > 0 && elements % xi == 0 && steps % ti == 0).then_some(Self {
+        (xi > 0 && ti > 0 && elements % xi == 0 && steps % ti == 0).then(|| Self {
             x_stride: elements / xi,
             t_stride: steps / ti,
         })
@@ -782,5 +782,52 @@ fn tick(v: f64, decimals: usize) -> String {
     }
 }
 
-/// Colour of the contact set.
-const CONTACT_COLOUR: RGBColor = RGBColor(40, 40, 40);
+/// Colour of the contact set: the dark end of viridis (not a grey, so never text).
+const CONTACT_COLOUR: RGBColor = RGBColor(68, 1, 84);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Pixels of `colour` in a drawing of the contact set of `h`.
+    fn contact_pixels(h: &ContactHistory) -> usize {
+        const SIZE: (u32, u32) = (400, 300);
+        let mut buf = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area();
+            root.fill(&WHITE).unwrap();
+            draw_contact_set(&root, h, 1.0, 1.0).unwrap();
+            root.present().unwrap();
+        }
+        let c = CONTACT_COLOUR;
+        buf.chunks(3).filter(|p| *p == [c.0, c.1, c.2]).count()
+    }
+
+    /// The hook for distributed obstacles: with more constraints than the reaction panel can
+    /// show, the contact set is drawn, and it is coloured exactly where a node touched.
+    #[test]
+    fn many_constraints_draw_the_contact_set_where_nodes_touch() {
+        register_font().unwrap();
+        let names = (0..5).map(|i| format!("node {i}")).collect();
+        let xs = (0..5).map(|i| f64::from(i) * 0.25).collect();
+        let mut touching = ContactHistory::new(names, xs);
+        let mut apart = touching.clone();
+        for (bin, t) in [0.25, 0.5, 0.75, 1.0].into_iter().enumerate() {
+            let mut gaps = [1.0; 5];
+            apart.observe(t, &gaps, &[0.0; 5], true);
+            if bin == 2 {
+                gaps[3] = 0.0; // node 3 (x = 0.75) touches in the third bin
+            }
+            touching.observe(t, &gaps, &[0.0; 5], true);
+        }
+        assert_eq!(
+            ContactPanel::for_history(&touching),
+            ContactPanel::ContactSet
+        );
+        assert!(touching.in_contact(2, 3) && !touching.in_contact(1, 3));
+        assert_eq!(contact_pixels(&apart), 0);
+        // One of 5 columns by one of 4 rows of the plot area (about 320 x 220 pixels).
+        let n = contact_pixels(&touching);
+        assert!((2000..6000).contains(&n), "{n} contact pixels");
+    }
+}
