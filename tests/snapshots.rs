@@ -8,16 +8,16 @@
 //! recorded by those steps, the contact intervals per Signorini end and the solver iteration
 //! statistics.
 //!
-//! Rounding: every quantity is rounded to [`SIGNIFICANT_DIGITS`] significant digits *of its
-//! largest magnitude* (for `u`, a quantum of about 1e-8 · max|u|). That is safe both ways: the
-//! round-off of these runs is about 1e-13 relative (an ulp per operation over 2400 steps of
-//! well-conditioned tridiagonal solves; `libm`'s `sin`/`cos` may differ by an ulp between
-//! machines), five orders below the quantum, so last-bit differences do not churn the
-//! snapshots; and the discretisation error of these meshes (h = π/400, Δt = 0.005) is about 1e-3..1e-2, five orders above it, so any
-//! change that could matter numerically shows. Rounding each value to its own digits would not
-//! be safe: `u(π/4, 0) = 0.3 cos(π/2)` is 2e-17 of pure round-off. A value within 1e-13 of a
-//! rounding boundary can still flip its last digit (chance 2e-13/1e-8 per value, about 1e-2 for
-//! the ~460 values here per change of machine or compiler); that shows as a one-digit diff.
+//! Rounding: every quantity is rounded to [`SIGNIFICANT_DIGITS`] significant digits *of its largest
+//! magnitude* (for `u`, a quantum of about 1e-8 · max|u|). That is safe both ways: the round-off of
+//! these runs is about 1e-13 relative (an ulp per operation over 2400 steps of well-conditioned
+//! tridiagonal solves; `libm`'s `sin`/`cos` may differ by an ulp between machines), five orders
+//! below the quantum, so last-bit differences do not churn the snapshots; and the discretisation
+//! error of these meshes (h = π/400, Δt = 0.005) is about 1e-3..1e-2, five orders above it, so any
+//! change that could matter numerically shows. Rounding each value to its own digits would not be
+//! safe: `u(π/4, 0) = 0.3 cos(π/2)` is 2e-17 of pure round-off. A value within 1e-13 of a rounding
+//! boundary can still flip its last digit (chance 2e-13/1e-8 per value, about 1e-2 for the ~460
+//! values here per change of machine or compiler); that shows as a one-digit diff.
 
 use insta::with_settings;
 use serde::Serialize;
