@@ -256,6 +256,8 @@ pub fn sample_run(name: &str, scene: &Scene, sampling: Sampling) -> Result<Sampl
     let mut observe = |sim: &Simulation, r: &StepRecord, u: &mut Vec<f64>, energy: &mut Vec<_>| {
         let k = contact.constraints();
         let new_bin = r.step == steps_sampled[next - 1] + 1; // the previous bin closed
+        // The only read of per-constraint contact data: the distributed scenes change this line
+        // if they change how a step record holds it.
         contact.observe(r.time, &r.gap[..k], &r.reaction[..k], new_bin);
         if steps_sampled.get(next) == Some(&r.step) {
             sim.displacement_into(&mut full);
