@@ -22,6 +22,7 @@ pub mod closed_form;
 pub mod error;
 pub mod exact;
 pub mod expr;
+pub mod figures;
 pub mod matrices;
 pub mod oracle;
 pub mod run;

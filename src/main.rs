@@ -32,6 +32,16 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
     },
+    /// Run the talk's scenes and draw their figures (PNG and SVG): one per scene (colour map of
+    /// u(x, t) and contact history) and one per talk figure (l = 0 beside forced).
+    Figures {
+        /// Output folder.
+        #[arg(long, default_value = viscobar::figures::DEFAULT_OUT)]
+        out: PathBuf,
+        /// Step solver (overrides [solver] method of every scene).
+        #[arg(long)]
+        solver: Option<String>,
+    },
     /// List the built-in scenes.
     Scenes,
     /// Print a built-in scene as TOML.
@@ -83,6 +93,24 @@ fn main() {
             }
             match run(&name, out, &set) {
                 Ok(()) => 0,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    e.exit_code()
+                }
+            }
+        }
+        Command::Figures { out, solver } => {
+            let set: Vec<String> = solver
+                .iter()
+                .map(|s| format!("solver.method=\"{s}\""))
+                .collect();
+            match viscobar::figures::write_talk_figures(&out, &set) {
+                Ok(files) => {
+                    for f in &files {
+                        println!("wrote {}", f.display());
+                    }
+                    0
+                }
                 Err(e) => {
                     eprintln!("error: {e}");
                     e.exit_code()

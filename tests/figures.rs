@@ -1,0 +1,281 @@
+//! `viscobar figures`: the sampled data the figures are drawn from are the run's own mesh values,
+//! the command writes every talk figure as PNG and SVG, byte-for-byte reproducibly, and refuses
+//! bad input without writing anything.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use viscobar::Simulation;
+use viscobar::figures::{self, Sampling, TALK_FIGURES};
+
+fn viscobar(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_viscobar"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("viscobar-figures-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// Strides that do not divide the mesh, so the last node and the last step are added.
+#[test]
+fn sampled_run_holds_the_runs_mesh_values_and_peak_reactions() {
+    let scene = common::builtin("both-ends", &["time.end=2.0"]); // contact from t = 1.055
+    let sampling = Sampling {
+        x_stride: 7,
+        t_stride: 30,
+    };
+    let run = figures::sample_run("both-ends", &scene, sampling).unwrap();
+    let nodes: Vec<usize> = (0..=399).step_by(7).chain([400]).collect();
+    let steps: Vec<usize> = (0..=390).step_by(30).chain([400]).collect();
+    assert_eq!(run.nodes, nodes);
+    assert_eq!(run.steps_sampled, steps);
+    assert_eq!(run.energy.len(), steps.len());
+    assert_eq!(
+        run.contact.times.len(),
+        steps.len() - 1,
+        "one bin per interval"
+    );
+
+    let mut sim = Simulation::new(&scene).unwrap();
+    assert_eq!(
+        run.u_row(0),
+        &nodes
+            .iter()
+            .map(|&i| sim.initial_state().0[i])
+            .collect::<Vec<_>>()[..]
+    );
+    let mut records = vec![sim.first_record()];
+    while records.len() < scene.steps() {
+        records.push(sim.step().unwrap());
+        let n = records.len();
+        if let Some(k) = steps.iter().position(|&s| s == n) {
+            let u = sim.displacement();
+            let expected: Vec<f64> = nodes.iter().map(|&i| u[i]).collect();
+            assert_eq!(run.u_row(k), &expected[..], "u after step {n}");
+            assert_eq!(
+                run.energy[k],
+                Some(records[n - 1].energy),
+                "energy at step {n}"
+            );
+        }
+    }
+    assert_eq!(run.energy[0], None);
+    let mut peak = 0.0f64;
+    for (b, w) in steps.windows(2).enumerate() {
+        let bin = &records[w[0]..w[1]]; // steps w[0]+1 ..= w[1]
+        assert_eq!(run.contact.times[b], bin.last().unwrap().time);
+        for j in 0..2 {
+            let r = bin.iter().map(|r| r.reaction[j]).fold(f64::MIN, f64::max);
+            let g = bin.iter().map(|r| r.gap[j]).fold(f64::MAX, f64::min);
+            assert_eq!(
+                run.contact.reaction[2 * b + j],
+                r,
+                "peak reaction, bin {b}, end {j}"
+            );
+            assert_eq!(run.contact.gap[2 * b + j], g, "least gap, bin {b}, end {j}");
+            peak = peak.max(r);
+        }
+    }
+    assert!(
+        peak > 0.0,
+        "the window must contain contact, or the test checks nothing"
+    );
+    let (_, summary, _) = viscobar::run::run_in_memory("both-ends", &scene).unwrap();
+    assert_eq!(run.summary.contact_intervals, summary.contact_intervals);
+}
+
+#[test]
+fn exact_sampling_exists_only_when_the_grid_is_made_of_mesh_points() {
+    let scene = common::builtin("one-end", &[]); // 400 elements, 2400 steps
+    assert_eq!(
+        Sampling::exact(&scene, 9, 11),
+        Some(Sampling {
+            x_stride: 50,
+            t_stride: 240
+        })
+    );
+    assert_eq!(
+        Sampling::exact(&scene, 8, 11),
+        None,
+        "7 does not divide 400"
+    );
+    assert_eq!(
+        Sampling::exact(&scene, 9, 8),
+        None,
+        "7 does not divide 2400"
+    );
+    assert_eq!(
+        Sampling::exact(&scene, 1, 11),
+        None,
+        "one point has no spacing"
+    );
+}
+
+/// The width and height in a PNG's IHDR chunk.
+fn png_size(bytes: &[u8]) -> (u32, u32) {
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
+    assert_eq!(&bytes[12..16], b"IHDR");
+    let be = |b: &[u8]| u32::from_be_bytes(b.try_into().unwrap());
+    (be(&bytes[16..20]), be(&bytes[20..24]))
+}
+
+fn expected_files() -> Vec<(String, (u32, u32))> {
+    let mut files = Vec::new();
+    for scene in figures::talk_scenes() {
+        for ext in ["png", "svg"] {
+            files.push((format!("{scene}.{ext}"), figures::SCENE_SIZE));
+        }
+    }
+    for (stem, _, _) in TALK_FIGURES {
+        for ext in ["png", "svg"] {
+            files.push((format!("{stem}.{ext}"), figures::PAIR_SIZE));
+        }
+    }
+    files
+}
+
+fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn figures_command_writes_every_talk_figure_reproducibly() {
+    let (a, b) = (tmpdir("a"), tmpdir("b"));
+    for dir in [&a, &b] {
+        let o = viscobar(&["figures", "--out", dir.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let expected = expected_files();
+    let mut names: Vec<String> = expected.iter().map(|(n, _)| n.clone()).collect();
+    names.sort();
+    assert_eq!(
+        listing(&a),
+        names,
+        "exactly the figures, no temporary files left"
+    );
+    for (name, size) in &expected {
+        let bytes = std::fs::read(a.join(name)).unwrap();
+        if name.ends_with(".png") {
+            assert_eq!(png_size(&bytes), *size, "{name}");
+            assert_eq!(
+                bytes,
+                std::fs::read(b.join(name)).unwrap(),
+                "{name} differs between runs"
+            );
+            continue;
+        }
+        let svg = String::from_utf8(bytes).unwrap();
+        assert!(svg.starts_with("<svg"), "{name}");
+        assert!(
+            svg.contains(&format!("width=\"{}\" height=\"{}\"", size.0, size.1)),
+            "{name}: size"
+        );
+        let maps = svg.matches("\"data:image/png;base64,").count();
+        let panels = if name.starts_with("figure-") { 2 } else { 1 };
+        assert_eq!(maps, panels, "{name}: one embedded image per colour map");
+        assert!(!svg.contains("\"data:png;"), "{name}: invalid MIME type");
+        // Titles name the scene, alpha, J, dt and the solver (all talk scenes: alpha = 0.1,
+        // 400 elements, dt = 0.005).
+        for needle in ["α = 0.1", "J = 399", "Δt = 0.005", "solver: exact"] {
+            assert!(svg.contains(needle), "{name}: title lacks `{needle}`");
+        }
+        for axis in [">\nx\n<", ">\nt\n<", ">\nu\n<"] {
+            assert!(svg.contains(axis), "{name}: axis label {axis:?}");
+        }
+    }
+    for scene in figures::talk_scenes() {
+        let svg = std::fs::read_to_string(a.join(format!("{scene}.svg"))).unwrap();
+        assert!(
+            svg.contains(&format!("\n{scene}  (l = ")),
+            "{scene}: title names the scene"
+        );
+    }
+    for dir in [a, b] {
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}
+
+#[test]
+fn figures_command_refuses_bad_input_with_2_and_write_failures_with_1() {
+    let out = tmpdir("bad");
+    let o = viscobar(&[
+        "figures",
+        "--out",
+        out.to_str().unwrap(),
+        "--solver",
+        "nope",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("nope") && err.contains("solver.method"),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing written on bad input");
+
+    let file = tmpdir("file");
+    std::fs::write(&file, "not a folder").unwrap();
+    let o = viscobar(&["figures", "--out", file.join("sub").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot write"));
+    let _ = std::fs::remove_file(file);
+}
+
+/// The README shows `docs/figures/*.png`, regenerated by `figures --out docs/figures`: the
+/// committed PNGs are exactly the ones the command writes (names; the pixels are not pinned).
+#[test]
+fn docs_figures_are_the_pngs_the_command_writes() {
+    let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/figures");
+    let committed: Vec<String> = listing(&docs)
+        .into_iter()
+        .filter(|n| n.ends_with(".png"))
+        .collect();
+    let mut written: Vec<String> = expected_files()
+        .into_iter()
+        .map(|(n, _)| n)
+        .filter(|n| n.ends_with(".png"))
+        .collect();
+    written.sort();
+    assert_eq!(committed, written);
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    assert!(readme.contains("`cargo run --release -- figures --out docs/figures`"));
+    for scene in figures::talk_scenes() {
+        let link = format!("(docs/figures/{scene}.png)");
+        assert!(readme.contains(&link), "README does not show {scene}");
+    }
+}
+
+/// plotters' `ttf` feature pulls font-kit and the system font libraries; the figures must not
+/// need them (the font is embedded through `ab_glyph`).
+#[test]
+fn no_system_font_library_is_in_the_dependency_graph() {
+    let lock = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.lock")).unwrap();
+    assert!(
+        lock.contains("name = \"ab_glyph\""),
+        "text goes through ab_glyph"
+    );
+    for name in [
+        "font-kit",
+        "freetype",
+        "freetype-sys",
+        "yeslogic-fontconfig-sys",
+        "servo-fontconfig",
+    ] {
+        assert!(
+            !lock.contains(&format!("name = \"{name}\"")),
+            "{name} is in Cargo.lock"
+        );
+    }
+}
