@@ -21,6 +21,7 @@
 
 pub mod audit;
 pub mod closed_form;
+pub mod compare;
 pub mod error;
 pub mod exact;
 pub mod expr;
