@@ -275,6 +275,8 @@ impl KktAudit {
             ),
         ];
         for (what, value, tolerance) in checks {
+            // Negated so that a NaN residual fails.
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
             if !(value <= tolerance) {
                 return Err(StepFailure::AuditFailed {
                     what,

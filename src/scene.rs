@@ -220,14 +220,12 @@ impl SolverSpec {
             });
         }
         for (name, v) in [("eps_abs", self.eps_abs), ("eps_rel", self.eps_rel)] {
-            if let Some(v) = v {
-                if !(v.is_finite() && v >= 0.0) {
-                    return Err(invalid(
-                        &format!("solver.{name}"),
-                        v,
-                        "must be a finite number >= 0",
-                    ));
-                }
+            if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
+                return Err(invalid(
+                    &format!("solver.{name}"),
+                    v,
+                    "must be a finite number >= 0",
+                ));
             }
         }
         let (abs, rel) = (

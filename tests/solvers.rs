@@ -248,18 +248,17 @@ impl StepSolver for Recorder {
     }
 }
 
-/// The step matrix, the constrained nodes, and the data and exact answer of the start-up
-/// step (identical for every solver: it depends on the initial data only).
-fn first_step(
-    scene: &Scene,
-) -> (
-    SymTridiag,
-    Vec<usize>,
-    Vec<f64>,
-    Vec<f64>,
-    Vec<f64>,
-    Vec<f64>,
-) {
+/// The start-up step of a scene: its matrix, constrained nodes, data and exact reactions
+/// (identical for every solver: the step depends on the initial data only).
+struct FirstStep {
+    c: SymTridiag,
+    nodes: Vec<usize>,
+    b: Vec<f64>,
+    lo: Vec<f64>,
+    r_exact: Vec<f64>,
+}
+
+fn first_step(scene: &Scene) -> FirstStep {
     let disc = Discretisation::new(scene);
     let c = disc.step_matrix.clone();
     let nodes = disc.constrained_locals();
@@ -269,8 +268,14 @@ fn first_step(
         log: log.clone(),
     };
     Simulation::with_solver(scene, disc, Box::new(rec)).unwrap();
-    let (b, lo, z, r) = log.borrow()[0].clone();
-    (c, nodes, b, lo, z, r)
+    let (b, lo, _, r_exact) = log.borrow()[0].clone();
+    FirstStep {
+        c,
+        nodes,
+        b,
+        lo,
+        r_exact,
+    }
 }
 
 /// What OSQP itself says about one step problem, called through the `osqp` crate directly
@@ -382,8 +387,8 @@ fn step_failure(
 #[test]
 fn osqp_success_that_misses_its_own_tolerance_is_an_error() {
     let exact_scene = stiff_impact(1000.0, &[]);
-    let (c, nodes, b, lo, _, r_exact) = first_step(&exact_scene);
-    let raw = raw_osqp(&c, &nodes, &b, &lo, OsqpSettings::default());
+    let f = first_step(&exact_scene);
+    let raw = raw_osqp(&f.c, &f.nodes, &f.b, &f.lo, OsqpSettings::default());
     assert!(raw.solved, "OSQP reports solved");
     assert!(
         raw.dual_residual > 10.0 * raw.dual_tolerance,
@@ -391,7 +396,7 @@ fn osqp_success_that_misses_its_own_tolerance_is_an_error() {
         raw.dual_residual,
         raw.dual_tolerance
     );
-    let reaction_error = (raw.reaction[0] - r_exact[0]).abs() / r_exact[0];
+    let reaction_error = (raw.reaction[0] - f.r_exact[0]).abs() / f.r_exact[0];
     assert!(reaction_error > 1e-6, "reaction error {reaction_error:e}");
 
     let scene = stiff_impact(1000.0, &["solver.method=\"osqp\""]);
@@ -422,16 +427,16 @@ fn osqp_loose_answer_far_from_exact_is_an_error() {
         "solver.polish=false",
     ];
     let exact_scene = stiff_impact(100.0, &[]);
-    let (c, nodes, b, lo, _, r_exact) = first_step(&exact_scene);
+    let f = first_step(&exact_scene);
     let settings = OsqpSettings {
         eps_abs: 1e-3,
         eps_rel: 1e-3,
         polish: false,
         ..OsqpSettings::default()
     };
-    let raw = raw_osqp(&c, &nodes, &b, &lo, settings);
+    let raw = raw_osqp(&f.c, &f.nodes, &f.b, &f.lo, settings);
     assert!(raw.solved && raw.dual_residual <= raw.dual_tolerance);
-    let reaction_error = (raw.reaction[0] - r_exact[0]).abs() / r_exact[0];
+    let reaction_error = (raw.reaction[0] - f.r_exact[0]).abs() / f.r_exact[0];
     assert!(reaction_error > 1e-2, "reaction error {reaction_error:e}");
 
     let mut o = vec!["solver.method=\"osqp\""];
@@ -644,7 +649,7 @@ fn solver_settings_of_another_method_or_out_of_range_are_refused() {
     ];
     for (overrides, needle) in refused {
         let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-        let err = viscobar::scene::load("impact", &o).err().expect("refused");
+        let err = viscobar::scene::load("impact", &o).expect_err("refused");
         assert!(err.to_string().contains(needle), "{overrides:?}: {err}");
     }
     for ok in [
