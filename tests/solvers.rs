@@ -714,3 +714,28 @@ fn cli_runs_osqp_and_penalty_and_reports_their_audit() {
     assert_eq!(o.status.code(), Some(2));
     let _ = std::fs::remove_dir_all(&base);
 }
+
+#[test]
+fn cli_warns_about_accepted_inaccurate_steps() {
+    let out = std::env::temp_dir().join(format!("viscobar-cli-inacc-{}", std::process::id()));
+    let o = viscobar(&[
+        "run",
+        "impact",
+        "--solver",
+        "osqp",
+        "--set",
+        "solver.eps_abs=1e-8",
+        "--set",
+        "solver.eps_rel=1e-8",
+        "--set",
+        "solver.max_iter=75",
+        "--set",
+        "solver.accept_inaccurate=true",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("warning: 1 steps accepted"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&out);
+}
