@@ -10,10 +10,10 @@
 //! solver's own residuals. A solver that reports success with an answer failing the audit
 //! returns [`StepFailure::AuditFailed`] instead of a result.
 //!
-//! Scales. OSQP (Stellato et al. 2020, §3.4) stops when, in ∞-norms on the unscaled problem,
-//! the primal residual is below `eps_abs + eps_rel·max(‖Az‖, ‖proj‖)` and the dual residual
-//! `‖Cz − b − Σ r_j e_j‖` below `eps_abs + eps_rel·max(‖b‖, ‖r‖, ‖Cz‖)`. The audit applies
-//! the same formulas (times [`AUDIT_MARGIN`]) to
+//! Scales. OSQP (Stellato et al. 2020, termination criteria; auxil.c) stops when, in ∞-norms
+//! on the unscaled problem, the primal residual is below `eps_abs + eps_rel·max(‖Az‖, ‖proj‖)`
+//! and the dual residual `‖Cz − b − Σ r_j e_j‖` below `eps_abs + eps_rel·max(‖b‖, ‖r‖, ‖Cz‖)`.
+//! The audit applies the same formulas (times [`AUDIT_MARGIN`]) to
 //!
 //! - primal feasibility `max_j (lo_j − z_j)⁺`, in displacement, scale `max_j max(|z_j|, |lo_j|)`;
 //! - multiplier sign `max_j (−r_j)⁺` and stationarity `‖Cz − b − Σ r_j e_j‖_∞`, in force,
@@ -299,9 +299,9 @@ fn ratio(value: f64, tolerance: f64) -> f64 {
     }
 }
 
-/// Hager's estimate (1984; Higham, *Accuracy and Stability*, Alg. 15.4) of `‖C⁻¹‖_1`, which
-/// equals `‖C⁻¹‖_∞` for symmetric `C`: a lower bound, exact or within a small factor in
-/// practice; at most five pairs of O(n) solves, once per run.
+/// Hager's estimate (1984; Higham, *Accuracy and Stability of Numerical Algorithms*, ch. 15)
+/// of `‖C⁻¹‖_1`, which equals `‖C⁻¹‖_∞` for symmetric `C`: a lower bound, exact or within a
+/// small factor in practice; at most five pairs of O(n) solves, once per run.
 fn inverse_norm_estimate(factor: &Ldlt) -> f64 {
     let n = factor.dim();
     if n == 0 {

@@ -335,7 +335,7 @@ fn raw_osqp(c: &SymTridiag, nodes: &[usize], b: &[f64], lo: &[f64], s: OsqpSetti
     };
     let x = sol.x();
     let reaction: Vec<f64> = sol.y().iter().map(|y| -y).collect();
-    // OSQP's own criterion: eps_abs + eps_rel max(‖q‖, ‖Aᵀy‖, ‖Px‖) (Stellato et al. §3.4).
+    // OSQP's own criterion: eps_abs + eps_rel max(‖q‖, ‖Aᵀy‖, ‖Px‖) (Stellato et al. 2020; auxil.c).
     let cx = c.mul(x);
     let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let scale = norm(&cx).max(norm(b)).max(norm(&reaction));
