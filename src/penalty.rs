@@ -30,6 +30,7 @@
 //! solver, so the choice is deterministic. `iterations` is the number of subsets tried.
 
 use crate::audit::{KktAudit, Law};
+use crate::error::{RunError, SceneError};
 use crate::solver::{SolveInfo, SolverReport, StepFailure, StepSolver};
 use crate::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
 
@@ -40,6 +41,28 @@ struct Column {
     values: Vec<f64>,
     /// Entries outside are below `f64::MIN_POSITIVE` in magnitude and dropped.
     support: std::ops::Range<usize>,
+}
+
+/// Why the penalty solver could not be set up.
+#[derive(Debug, thiserror::Error)]
+pub enum PenaltySetupError {
+    #[error(transparent)]
+    Matrix(#[from] NotPositiveDefinite),
+    #[error("epsilon = {0} must be a finite number > 0")]
+    Epsilon(f64),
+}
+
+impl From<PenaltySetupError> for RunError {
+    fn from(e: PenaltySetupError) -> Self {
+        match e {
+            PenaltySetupError::Matrix(m) => RunError::Matrix(m),
+            PenaltySetupError::Epsilon(v) => RunError::Scene(SceneError::Invalid {
+                field: "solver.epsilon".into(),
+                value: v.to_string(),
+                allowed: "must be a finite number > 0".into(),
+            }),
+        }
+    }
 }
 
 /// Normal compliance with parameter `ε`, solved exactly per step, audited every step.
@@ -55,15 +78,14 @@ pub struct PenaltySolver {
 
 impl PenaltySolver {
     /// Factorises `C`, precomputes `C⁻¹ e_j` for each constrained node (at most two).
-    pub fn new(c: &SymTridiag, nodes: &[usize], epsilon: f64) -> Result<Self, NotPositiveDefinite> {
+    pub fn new(c: &SymTridiag, nodes: &[usize], epsilon: f64) -> Result<Self, PenaltySetupError> {
         assert!(
             nodes.len() <= 2,
             "the end-node enumeration handles at most two bounds"
         );
-        assert!(
-            epsilon.is_finite() && epsilon > 0.0,
-            "epsilon is validated by the scene"
-        );
+        if !(epsilon.is_finite() && epsilon > 0.0) {
+            return Err(PenaltySetupError::Epsilon(epsilon));
+        }
         let factor = Ldlt::factor(c)?;
         let columns: Vec<Column> = nodes
             .iter()

@@ -335,7 +335,7 @@ fn raw_osqp(c: &SymTridiag, nodes: &[usize], b: &[f64], lo: &[f64], s: OsqpSetti
     };
     let x = sol.x();
     let reaction: Vec<f64> = sol.y().iter().map(|y| -y).collect();
-    // OSQP's own criterion: eps_abs + eps_rel max(‖q‖, ‖Aᵀy‖, ‖Px‖) (Stellato et al. 2020; auxil.c).
+    // OSQP's own criterion, eps_abs + eps_rel max(‖q‖, ‖Aᵀy‖, ‖Px‖) (auxil.c).
     let cx = c.mul(x);
     let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let scale = norm(&cx).max(norm(b)).max(norm(&reaction));
@@ -738,4 +738,18 @@ fn cli_warns_about_accepted_inaccurate_steps() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stderr.contains("warning: 1 steps accepted"), "{stderr}");
     let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn penalty_solver_refuses_a_bad_epsilon_without_panicking() {
+    let c = SymTridiag::new(vec![2.0, 2.0], vec![-1.0]);
+    for eps in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(viscobar::penalty::PenaltySolver::new(&c, &[0], eps).is_err());
+    }
+    // A scene built in code, never validated, gets an error naming the field.
+    let mut scene = common::builtin("impact", &["solver.method=\"penalty\""]);
+    scene.solver.epsilon = Some(-1.0);
+    let err = Simulation::new(&scene).err().expect("refused");
+    assert!(err.to_string().contains("solver.epsilon"), "{err}");
+    assert_eq!(err.exit_code(), 2);
 }
