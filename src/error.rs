@@ -66,6 +66,8 @@ pub enum RunError {
     },
     #[error("the step matrix C is not positive definite ({0}); check dt, viscosity and matrices")]
     Matrix(#[from] crate::tridiag::NotPositiveDefinite),
+    #[error("solver `{solver}` cannot be set up: {reason}")]
+    SolverSetup { solver: String, reason: String },
     #[error("cannot write {path}: {source}")]
     Write {
         path: PathBuf,

@@ -14,17 +14,23 @@
 //!
 //! Modules, one concept each: [`tridiag`] (banded kernels), [`matrices`] (M and R),
 //! [`scene`] (input), [`expr`] (expressions), [`solver`] (the step-solver seam), [`exact`] (the
-//! exact enumeration), [`oracle`] (a dense brute-force reference for tests), [`simulation`] (the
-//! time stepper and energy balance), [`closed_form`] (exact solutions), [`run`] (outputs).
+//! exact enumeration), [`osqp_solver`] (OSQP, Stellato et al. 2020) and [`penalty`] (the talk's
+//! penalised problem (PP)), [`audit`] (the independent optimality check of their answers),
+//! [`oracle`] (a dense brute-force reference for tests), [`simulation`] (the time stepper and
+//! energy balance), [`closed_form`] (exact solutions), [`run`] (outputs).
 
 pub mod active_set;
+pub mod audit;
 pub mod closed_form;
+pub mod compare;
 pub mod error;
 pub mod exact;
 pub mod expr;
 pub mod figures;
 pub mod matrices;
 pub mod oracle;
+pub mod osqp_solver;
+pub mod penalty;
 pub mod run;
 pub mod scene;
 pub mod simulation;

@@ -138,6 +138,12 @@ fn run(name: &str, out: Option<PathBuf>, set: &[String]) -> Result<(), viscobar:
         summary.max_identity_residual,
         out.display()
     );
+    if let Some(n) = summary.inaccurate_steps.filter(|n| *n > 0) {
+        eprintln!(
+            "warning: {n} steps accepted although OSQP reported `solved inaccurate` \
+             (solver.accept_inaccurate = true); see inaccurate_steps and audit in summary.json"
+        );
+    }
     Ok(())
 }
 

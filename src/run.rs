@@ -42,6 +42,13 @@ pub struct Summary {
     /// `[start, end]` time intervals of contact per constrained end.
     pub contact_intervals: std::collections::BTreeMap<String, Vec<[f64; 2]>>,
     pub solver_iterations: Iterations,
+    /// Worst optimality residuals of the solver's answers, for solvers that audit them
+    /// (`osqp`, `penalty`; see `viscobar::audit`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub audit: Option<crate::audit::AuditReport>,
+    /// Steps where OSQP's "solved inaccurate" was accepted (`accept_inaccurate`; osqp only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inaccurate_steps: Option<u64>,
 }
 
 #[derive(Clone, Copy, Debug, Default, Serialize)]
@@ -132,6 +139,7 @@ impl Tracker {
     pub fn finish(&self, scene_name: &str, sim: &Simulation, wall_time_s: f64) -> Summary {
         let disc = sim.discretisation();
         let steps = sim.step_index();
+        let report = sim.solver_report();
         Summary {
             scene: scene_name.to_string(),
             solver: sim.solver_name().to_string(),
@@ -160,6 +168,8 @@ impl Tracker {
                 mean: self.iterations_sum as f64 / self.records.max(1) as f64,
                 max: self.iterations_max,
             },
+            inaccurate_steps: report.as_ref().and_then(|r| r.inaccurate_steps),
+            audit: report.map(|r| r.audit),
         }
     }
 }

@@ -117,13 +117,143 @@ pub enum SolverMethod {
     /// Active-set enumeration on the constrained nodes (exact to round-off).
     #[default]
     Exact,
+    /// OSQP (ADMM, Stellato et al. 2020), every answer audited against the KKT conditions.
+    Osqp,
+    /// The talk's penalised problem (PP): normal compliance `(u + a)⁻/ε` instead of contact.
+    Penalty,
 }
 
+impl SolverMethod {
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverMethod::Exact => "exact",
+            SolverMethod::Osqp => "osqp",
+            SolverMethod::Penalty => "penalty",
+        }
+    }
+}
+
+/// The `[solver]` table. Every setting but `method` belongs to one method; naming it with
+/// another method is refused (see [`Scene::validate`]), so a setting is never silently ignored.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolverSpec {
     #[serde(default)]
     pub method: SolverMethod,
+    /// OSQP absolute tolerance (default [`OSQP_DEFAULT_EPS`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eps_abs: Option<f64>,
+    /// OSQP relative tolerance (default [`OSQP_DEFAULT_EPS`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eps_rel: Option<f64>,
+    /// OSQP solution polishing (default true).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polish: Option<bool>,
+    /// OSQP iteration limit per step (default [`OSQP_DEFAULT_MAX_ITER`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_iter: Option<u32>,
+    /// OSQP iterations between step-size (rho) adaptations (default
+    /// [`OSQP_DEFAULT_ADAPTIVE_RHO_INTERVAL`]); fixed so that runs are bit-identical.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adaptive_rho_interval: Option<u32>,
+    /// Accept OSQP's "solved inaccurate" (default false), counted in `summary.json`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accept_inaccurate: Option<bool>,
+    /// Penalty parameter ε of (PP) (default [`PENALTY_DEFAULT_EPSILON`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub epsilon: Option<f64>,
+}
+
+/// OSQP's `eps_abs` and `eps_rel` unless set: tight enough that, polished, the answer agrees
+/// with the exact solver to round-off on the talk's scenes (docs/solvers-verification.md).
+pub const OSQP_DEFAULT_EPS: f64 = 1e-10;
+/// OSQP's iteration limit unless set: far above what the talk's scenes need per step.
+pub const OSQP_DEFAULT_MAX_ITER: u32 = 100_000;
+/// Rho adaptation every 25 iterations unless set: OSQP 0.6's default (0 = tied to the setup
+/// time) makes the iteration, hence the bits of the answer, depend on the machine's load.
+pub const OSQP_DEFAULT_ADAPTIVE_RHO_INTERVAL: u32 = 25;
+/// ε of the penalised problem unless set: penetration ≈ ε × reaction, so about 1e-6 for the
+/// talk's reactions of order 1.
+pub const PENALTY_DEFAULT_EPSILON: f64 = 1e-6;
+
+impl SolverSpec {
+    /// The settings that are set and belong to `method`s other than `self.method`, by name.
+    fn foreign_settings(&self) -> Vec<(&'static str, SolverMethod)> {
+        let osqp = [
+            ("eps_abs", self.eps_abs.is_some()),
+            ("eps_rel", self.eps_rel.is_some()),
+            ("polish", self.polish.is_some()),
+            ("max_iter", self.max_iter.is_some()),
+            (
+                "adaptive_rho_interval",
+                self.adaptive_rho_interval.is_some(),
+            ),
+            ("accept_inaccurate", self.accept_inaccurate.is_some()),
+        ];
+        let penalty = [("epsilon", self.epsilon.is_some())];
+        let mut out = Vec::new();
+        for (owner, list) in [
+            (SolverMethod::Osqp, &osqp[..]),
+            (SolverMethod::Penalty, &penalty[..]),
+        ] {
+            if owner != self.method {
+                out.extend(
+                    list.iter()
+                        .filter(|(_, set)| *set)
+                        .map(|(n, _)| (*n, owner)),
+                );
+            }
+        }
+        out
+    }
+
+    fn validate(&self) -> Result<(), SceneError> {
+        if let Some((name, owner)) = self.foreign_settings().first() {
+            return Err(SceneError::Invalid {
+                field: format!("solver.{name}"),
+                value: "set".into(),
+                allowed: format!(
+                    "applies only to method \"{}\", not to \"{}\"",
+                    owner.name(),
+                    self.method.name()
+                ),
+            });
+        }
+        for (name, v) in [("eps_abs", self.eps_abs), ("eps_rel", self.eps_rel)] {
+            if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
+                return Err(invalid(
+                    &format!("solver.{name}"),
+                    v,
+                    "must be a finite number >= 0",
+                ));
+            }
+        }
+        let (abs, rel) = (
+            self.eps_abs.unwrap_or(OSQP_DEFAULT_EPS),
+            self.eps_rel.unwrap_or(OSQP_DEFAULT_EPS),
+        );
+        if self.method == SolverMethod::Osqp && abs == 0.0 && rel == 0.0 {
+            return Err(invalid(
+                "solver.eps_abs",
+                abs,
+                "eps_abs and eps_rel cannot both be 0 (OSQP would never stop)",
+            ));
+        }
+        if let Some(0) = self.max_iter {
+            return Err(invalid("solver.max_iter", 0.0, "must be >= 1"));
+        }
+        if let Some(0) = self.adaptive_rho_interval {
+            return Err(invalid(
+                "solver.adaptive_rho_interval",
+                0.0,
+                "must be >= 1 (0 selects OSQP's time-based interval, which makes runs differ)",
+            ));
+        }
+        if let Some(e) = self.epsilon {
+            positive("solver.epsilon", e)?;
+        }
+        Ok(())
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -317,6 +447,7 @@ impl Scene {
                 allowed: format!("time.end / time.step must lie between 1 and {MAX_STEPS}"),
             });
         }
+        self.solver.validate()?;
         if self.output.every < 1 {
             return Err(invalid(
                 "output.every",

@@ -24,8 +24,10 @@ use crate::error::{RunError, SceneError};
 use crate::exact::ExactSolver;
 use crate::expr::Expression;
 use crate::matrices;
-use crate::scene::{Condition, Scene, Side, SolverMethod};
-use crate::solver::{SolveInfo, StepSolver};
+use crate::osqp_solver::{OsqpSettings, OsqpSolver};
+use crate::penalty::PenaltySolver;
+use crate::scene::{Condition, PENALTY_DEFAULT_EPSILON, Scene, Side, SolverMethod};
+use crate::solver::{SolveInfo, SolverReport, StepSolver};
 use crate::tridiag::{Ldlt, SymTridiag, dot};
 
 /// A Signorini node: `u[node] >= -gap`.
@@ -124,6 +126,16 @@ pub fn make_solver(scene: &Scene, disc: &Discretisation) -> Result<Box<dyn StepS
     let nodes = disc.constrained_locals();
     match scene.solver.method {
         SolverMethod::Exact => Ok(Box::new(ExactSolver::new(&disc.step_matrix, &nodes)?)),
+        SolverMethod::Osqp => Ok(Box::new(OsqpSolver::new(
+            &disc.step_matrix,
+            &nodes,
+            OsqpSettings::from_spec(&scene.solver),
+        )?)),
+        SolverMethod::Penalty => Ok(Box::new(PenaltySolver::new(
+            &disc.step_matrix,
+            &nodes,
+            scene.solver.epsilon.unwrap_or(PENALTY_DEFAULT_EPSILON),
+        )?)),
     }
 }
 
@@ -519,6 +531,11 @@ impl Simulation {
 
     pub fn solver_name(&self) -> &'static str {
         self.solver.name()
+    }
+
+    /// The step solver's own statistics (audit residuals...), if it keeps any.
+    pub fn solver_report(&self) -> Option<SolverReport> {
+        self.solver.report()
     }
 
     /// Index `n` of the current state `u^n`.

@@ -18,6 +18,17 @@ pub struct SolveInfo {
     pub iterations: u32,
 }
 
+/// Run-level statistics a solver keeps about its own answers, for `summary.json`. Solvers that
+/// audit their answers (see [`crate::audit`]) report the worst residuals seen.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct SolverReport {
+    /// Worst optimality residuals over all steps, each with its ratio to its tolerance.
+    pub audit: crate::audit::AuditReport,
+    /// Steps accepted although OSQP reported "solved inaccurate" (`accept_inaccurate = true`);
+    /// `None` for solvers without that notion.
+    pub inaccurate_steps: Option<u64>,
+}
+
 /// Why a step solver produced no trustworthy answer.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum StepFailure {
@@ -25,6 +36,14 @@ pub enum StepFailure {
     NonFinite,
     #[error("solver status: {0}")]
     Status(String),
+    /// The solver reported success but its answer fails an optimality condition checked
+    /// independently by [`crate::audit::KktAudit`].
+    #[error("audit failed: {what} = {value:e} exceeds its tolerance {tolerance:e}")]
+    AuditFailed {
+        what: &'static str,
+        value: f64,
+        tolerance: f64,
+    },
 }
 
 /// A solver for the step problem. Built once per run for a fixed `C` and a fixed list of
@@ -42,4 +61,9 @@ pub trait StepSolver {
         z: &mut [f64],
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure>;
+
+    /// Statistics over all solves so far; `None` for solvers that keep none.
+    fn report(&self) -> Option<SolverReport> {
+        None
+    }
 }

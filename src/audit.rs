@@ -1,0 +1,333 @@
+//! An independent check of every step answer against the optimality conditions of the step
+//! problem (see [`crate::solver`]):
+//!
+//! ```text
+//!   C z = b + Σ_j r_j e_j,   z_j >= lo_j,   r_j >= 0,   r_j (z_j − lo_j) = 0        (Signorini)
+//!   C z = b + Σ_j r_j e_j,   ε r_j = max(0, lo_j − z_j)                          (penalty (PP))
+//! ```
+//!
+//! recomputed from the solver's `z` and `r` with this crate's own kernels, never from a
+//! solver's own residuals. A solver that reports success with an answer failing the audit
+//! returns [`StepFailure::AuditFailed`] instead of a result.
+//!
+//! Scales. OSQP (Stellato et al. 2020, termination criteria; auxil.c) stops when, in ∞-norms
+//! on the unscaled problem, the primal residual is below `eps_abs + eps_rel·max(‖Az‖, ‖proj‖)`
+//! and the dual residual `‖Cz − b − Σ r_j e_j‖` below `eps_abs + eps_rel·max(‖b‖, ‖r‖, ‖Cz‖)`.
+//! The audit applies the same formulas (times [`AUDIT_MARGIN`]) to
+//!
+//! - primal feasibility `max_j (lo_j − z_j)⁺`, in displacement, scale `max_j max(|z_j|, |lo_j|)`;
+//! - multiplier sign `max_j (−r_j)⁺` and stationarity `‖Cz − b − Σ r_j e_j‖_∞`, in force,
+//!   scale `max(‖b‖_∞, ‖Cz‖_∞, max_j |r_j|)`;
+//! - complementarity `|r_j (z_j − lo_j)| <= tol_z |r_j| + tol_f |z_j − lo_j|`: either the gap is
+//!   zero to the primal tolerance or the reaction to the dual one;
+//!
+//! and adds one check OSQP does not make: the stationarity residual mapped to displacement,
+//! `‖C⁻¹(Cz − b − Σ r_j e_j)‖_∞`, the change of `z` that would make stationarity exact, with
+//! scale `‖z‖_∞`. A residual within OSQP's tolerance can hide an error in `z` up to `κ(C)` times
+//! larger; this check refuses such answers (the failure case in docs/solvers-verification.md).
+//!
+//! Each tolerance also has a round-off floor: the residual that an answer exact to the last bit
+//! still shows when recomputed in floating point (see [`ROUNDOFF_ULPS`]); with `eps = 0` (the
+//! penalty solver, which solves its problem directly) only the floors remain.
+
+use crate::solver::StepFailure;
+use crate::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
+use serde::Serialize;
+
+/// Margin over OSQP's own stopping test: OSQP evaluates its residuals on its scaled copy of the
+/// data and may accept a polished answer that trades a little of one residual for the other
+/// (polish.c), so the same formula recomputed here can come out a few times larger; ten times
+/// still refuses anything that misses OSQP's own criterion by more than a decade.
+pub const AUDIT_MARGIN: f64 = 10.0;
+
+/// OSQP's "solved inaccurate" means its criterion held with both `eps` multiplied by 10
+/// (auxil.c, `check_termination(.., approximate)`); accepted steps are audited accordingly.
+pub const INACCURATE_FACTOR: f64 = 10.0;
+
+/// Round-off floor, in units of `ε·(magnitude of the terms)`: a row of `C z` is three products
+/// and two additions, then `− b_i − r_i` two more, so an exactly rounded answer leaves up to
+/// about 6 ulps of `|C||z| + |b| + |r|`, and a backward-stable tridiagonal solve about 4 more
+/// (`|L||D||Lᵀ| = |C|` for SPD tridiagonal matrices); 32 gives a margin of three.
+pub const ROUNDOFF_ULPS: f64 = 32.0;
+
+/// The contact law an answer must satisfy.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Law {
+    /// Signorini complementarity, to OSQP-style tolerances `eps_abs`, `eps_rel` as given to
+    /// the solver (the audit multiplies them by [`AUDIT_MARGIN`]).
+    Signorini { eps_abs: f64, eps_rel: f64 },
+    /// Normal compliance `ε r_j = max(0, lo_j − z_j)`, solved directly: round-off floors only.
+    Penalty { epsilon: f64 },
+}
+
+/// The worst value of one audited quantity over a run, and its worst ratio to its tolerance
+/// (the audit fails when the ratio exceeds 1).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Worst {
+    pub max: f64,
+    pub max_over_tolerance: f64,
+}
+
+impl Worst {
+    fn observe(&mut self, value: f64, tolerance: f64) {
+        self.max = self.max.max(value);
+        let ratio = if tolerance > 0.0 {
+            value / tolerance
+        } else if value > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        };
+        self.max_over_tolerance = self.max_over_tolerance.max(ratio);
+    }
+}
+
+/// The worst audit residuals of a run (`summary.json`, field `audit`). Checks that do not apply
+/// to the law are absent: primal feasibility and complementarity for the penalty law, the
+/// penalty law for Signorini.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct AuditReport {
+    /// Steps audited.
+    pub steps: u64,
+    /// `max_j (lo_j − z_j)⁺`, displacement.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub primal_violation: Option<Worst>,
+    /// `max_j (−r_j)⁺`, force.
+    pub negative_reaction: Worst,
+    /// `max_j |r_j (z_j − lo_j)|`, force × displacement.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub complementarity: Option<Worst>,
+    /// `max_j |ε r_j − max(0, lo_j − z_j)|`, displacement.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub penalty_law: Option<Worst>,
+    /// `‖Cz − b − Σ r_j e_j‖_∞`, force.
+    pub stationarity: Worst,
+    /// `‖C⁻¹(Cz − b − Σ r_j e_j)‖_∞`, displacement.
+    pub stationarity_displacement: Worst,
+}
+
+/// The audit of one run: the matrix, its factorisation, scratch space and the worst residuals.
+/// [`KktAudit::check`] allocates nothing.
+#[derive(Clone, Debug)]
+pub struct KktAudit {
+    c: SymTridiag,
+    factor: Ldlt,
+    nodes: Vec<usize>,
+    /// `‖C‖_∞` and an estimate of `‖C⁻¹‖_∞`, for the round-off floors.
+    c_norm: f64,
+    inv_norm: f64,
+    /// `|(C⁻¹)_{jk}|` on the constrained nodes, row-major: solvers that form
+    /// `z_j = z⁰_j + Σ_k (C⁻¹)_{jk} r_k` round `z_j` to ulps of `|z⁰_j|`, which is at most
+    /// `|z_j| + Σ_k |(C⁻¹)_{jk} r_k|`.
+    schur_abs: Vec<f64>,
+    residual: Vec<f64>,
+    report: AuditReport,
+}
+
+impl KktAudit {
+    /// Set-up for matrix `c` and constrained nodes `nodes`; `penalty` selects which checks the
+    /// report lists.
+    pub fn new(
+        c: &SymTridiag,
+        nodes: &[usize],
+        penalty: bool,
+    ) -> Result<Self, NotPositiveDefinite> {
+        let factor = Ldlt::factor(c)?;
+        let n = c.dim();
+        let c_norm = (0..n)
+            .map(|i| {
+                let left = if i > 0 { c.off[i - 1].abs() } else { 0.0 };
+                let right = if i + 1 < n { c.off[i].abs() } else { 0.0 };
+                left + c.diag[i].abs() + right
+            })
+            .fold(0.0, f64::max);
+        let inv_norm = inverse_norm_estimate(&factor);
+        let k = nodes.len();
+        let mut schur_abs = vec![0.0; k * k];
+        for (a, &na) in nodes.iter().enumerate() {
+            let col = factor.column_of_inverse(na);
+            for (b, &nb) in nodes.iter().enumerate() {
+                schur_abs[b * k + a] = col[nb].abs();
+            }
+        }
+        let report = AuditReport {
+            primal_violation: (!penalty).then(Worst::default),
+            complementarity: (!penalty).then(Worst::default),
+            penalty_law: penalty.then(Worst::default),
+            ..Default::default()
+        };
+        Ok(Self {
+            c: c.clone(),
+            factor,
+            nodes: nodes.to_vec(),
+            c_norm,
+            inv_norm,
+            schur_abs,
+            residual: vec![0.0; n],
+            report,
+        })
+    }
+
+    /// The worst residuals so far.
+    pub fn report(&self) -> &AuditReport {
+        &self.report
+    }
+
+    /// Checks one answer `(z, r)` of the step problem with data `(b, lo)` against `law`,
+    /// records its residuals, and returns the first failed check.
+    pub fn check(
+        &mut self,
+        law: Law,
+        b: &[f64],
+        lower: &[f64],
+        z: &[f64],
+        r: &[f64],
+    ) -> Result<(), StepFailure> {
+        let k = self.nodes.len();
+        if !(z.iter().all(|v| v.is_finite()) && r[..k].iter().all(|v| v.is_finite())) {
+            return Err(StepFailure::NonFinite);
+        }
+        let (eps_abs, eps_rel) = match law {
+            Law::Signorini { eps_abs, eps_rel } => (AUDIT_MARGIN * eps_abs, AUDIT_MARGIN * eps_rel),
+            Law::Penalty { .. } => (0.0, 0.0),
+        };
+        let ulp = ROUNDOFF_ULPS * f64::EPSILON;
+        // Stationarity residual, with the norms of its terms.
+        self.c.mul_into(z, &mut self.residual);
+        let (mut cz_norm, mut b_norm, mut z_norm) = (0.0f64, 0.0f64, 0.0f64);
+        for i in 0..z.len() {
+            cz_norm = cz_norm.max(self.residual[i].abs());
+            b_norm = b_norm.max(b[i].abs());
+            z_norm = z_norm.max(z[i].abs());
+            self.residual[i] -= b[i];
+        }
+        let mut r_norm = 0.0f64;
+        for (j, &node) in self.nodes.iter().enumerate() {
+            self.residual[node] -= r[j];
+            r_norm = r_norm.max(r[j].abs());
+        }
+        let res_norm = self.residual.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let floor_f = ulp * (self.c_norm * z_norm + b_norm + r_norm);
+        let tol_f = eps_abs + eps_rel * cz_norm.max(b_norm).max(r_norm) + floor_f;
+        self.factor.solve_in_place(&mut self.residual);
+        let dz_norm = self.residual.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let tol_dz = eps_abs + eps_rel * z_norm + self.inv_norm * floor_f;
+
+        let mut p_scale = 0.0f64;
+        for (j, &node) in self.nodes.iter().enumerate() {
+            p_scale = p_scale.max(z[node].abs()).max(lower[j].abs());
+        }
+        let tol_z = eps_abs + eps_rel * p_scale + ulp * p_scale;
+        let (mut primal, mut negative, mut comp, mut comp_tol, mut law_res, mut law_tol) =
+            (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        for (j, &node) in self.nodes.iter().enumerate() {
+            let gap = z[node] - lower[j];
+            negative = negative.max(-r[j]);
+            match law {
+                Law::Signorini { .. } => {
+                    primal = primal.max(-gap);
+                    let c = (r[j] * gap).abs();
+                    let t = tol_z * r[j].abs() + tol_f * gap.abs();
+                    // Keep the pair with the worst ratio, so that value and tolerance match.
+                    if ratio(c, t) >= ratio(comp, comp_tol) {
+                        comp = c;
+                        comp_tol = t;
+                    }
+                }
+                Law::Penalty { epsilon } => {
+                    let v = (epsilon * r[j] - (-gap).max(0.0)).abs();
+                    // `gap` is rounded to ulps of |z⁰_j| + |lo_j|, `ε r_j` to ulps of itself.
+                    let coupled: f64 = (0..k).map(|i| self.schur_abs[j * k + i] * r[i].abs()).sum();
+                    let t =
+                        ulp * (z[node].abs() + coupled + lower[j].abs() + (epsilon * r[j]).abs());
+                    if ratio(v, t) >= ratio(law_res, law_tol) {
+                        law_res = v;
+                        law_tol = t;
+                    }
+                }
+            }
+        }
+
+        let rep = &mut self.report;
+        rep.steps += 1;
+        rep.stationarity.observe(res_norm, tol_f);
+        rep.stationarity_displacement.observe(dz_norm, tol_dz);
+        rep.negative_reaction.observe(negative, tol_f);
+        if let Some(w) = rep.primal_violation.as_mut() {
+            w.observe(primal, tol_z);
+        }
+        if let Some(w) = rep.complementarity.as_mut() {
+            w.observe(comp, comp_tol);
+        }
+        if let Some(w) = rep.penalty_law.as_mut() {
+            w.observe(law_res, law_tol);
+        }
+        let checks = [
+            ("primal violation (lo_j - z_j)+", primal, tol_z),
+            ("negative reaction (-r_j)+", negative, tol_f),
+            ("complementarity |r_j (z_j - lo_j)|", comp, comp_tol),
+            ("penalty law |eps r_j - (lo_j - z_j)+|", law_res, law_tol),
+            ("stationarity |Cz - b - r|", res_norm, tol_f),
+            (
+                "stationarity in displacement |C^-1 (Cz - b - r)|",
+                dz_norm,
+                tol_dz,
+            ),
+        ];
+        for (what, value, tolerance) in checks {
+            // Negated so that a NaN residual fails.
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
+            if !(value <= tolerance) {
+                return Err(StepFailure::AuditFailed {
+                    what,
+                    value,
+                    tolerance,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+fn ratio(value: f64, tolerance: f64) -> f64 {
+    if tolerance > 0.0 {
+        value / tolerance
+    } else if value > 0.0 {
+        f64::INFINITY
+    } else {
+        0.0
+    }
+}
+
+/// Hager's estimate (1984; Higham, *Accuracy and Stability of Numerical Algorithms*, ch. 15)
+/// of `‖C⁻¹‖_1`, which equals `‖C⁻¹‖_∞` for symmetric `C`: a lower bound, exact or within a
+/// small factor in practice; at most five pairs of O(n) solves, once per run.
+fn inverse_norm_estimate(factor: &Ldlt) -> f64 {
+    let n = factor.dim();
+    if n == 0 {
+        return 0.0;
+    }
+    let mut x = vec![1.0 / n as f64; n];
+    let mut y = vec![0.0; n];
+    let mut w = vec![0.0; n];
+    let mut estimate = 0.0;
+    for _ in 0..5 {
+        y.copy_from_slice(&x);
+        factor.solve_in_place(&mut y);
+        estimate = y.iter().map(|v| v.abs()).sum::<f64>();
+        for (wi, yi) in w.iter_mut().zip(&y) {
+            *wi = if *yi >= 0.0 { 1.0 } else { -1.0 };
+        }
+        factor.solve_in_place(&mut w);
+        let (j, wmax) = w.iter().enumerate().fold((0, 0.0f64), |(jm, m), (i, v)| {
+            if v.abs() > m { (i, v.abs()) } else { (jm, m) }
+        });
+        let wx: f64 = w.iter().zip(&x).map(|(a, b)| a * b).sum();
+        if wmax <= wx {
+            break;
+        }
+        x.fill(0.0);
+        x[j] = 1.0;
+    }
+    estimate
+}

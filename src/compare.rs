@@ -1,0 +1,82 @@
+//! Two runs of the same discretisation side by side, e.g. one scene with two step solvers:
+//! the largest difference of the displacements over all nodes and steps.
+
+use crate::error::{RunError, SceneError};
+use crate::run::{Summary, Tracker};
+use crate::scene::Scene;
+use crate::simulation::{Simulation, StepRecord};
+
+/// How far run `b` is from run `a`, over every step `u^1 … u^N` and every node.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Agreement {
+    /// Number of states compared (`N`).
+    pub steps: usize,
+    /// `max_{n,i} |u_b − u_a|`.
+    pub max_difference: f64,
+    /// The step `n` where it occurs.
+    pub worst_step: usize,
+    /// `max_{n,i} |u_a|`, the scale of the displacements.
+    pub max_displacement: f64,
+}
+
+/// The comparison, and run `b`'s step records (start-up step first) and summary.
+#[derive(Clone, Debug)]
+pub struct Comparison {
+    pub agreement: Agreement,
+    pub records: Vec<StepRecord>,
+    pub summary: Summary,
+}
+
+/// Runs `a` and `b` step by step and compares `u^n` after every step. Both scenes must have
+/// the same mesh and time grid (they differ only in the solver, typically). `name` labels
+/// `b`'s summary.
+pub fn compare(name: &str, a: &Scene, b: &Scene) -> Result<Comparison, RunError> {
+    if a.mesh.elements != b.mesh.elements
+        || a.time.step != b.time.step
+        || a.steps() != b.steps()
+        || a.bar.length != b.bar.length
+    {
+        return Err(SceneError::Invalid {
+            field: "mesh/time".into(),
+            value: "differ".into(),
+            allowed: "the two scenes compared must share mesh, length and time grid".into(),
+        }
+        .into());
+    }
+    let mut sa = Simulation::new(a)?;
+    let mut sb = Simulation::new(b)?;
+    let mut tracker = Tracker::new(&sb, b.load.density.is_none());
+    let mut records = vec![sb.first_record()];
+    let start = std::time::Instant::now();
+    let nodes = sa.discretisation().nodes;
+    let (mut ua, mut ub) = (vec![0.0; nodes], vec![0.0; nodes]);
+    let mut out = Agreement::default();
+    let mut measure = |sa: &Simulation, sb: &Simulation, out: &mut Agreement| {
+        sa.displacement_into(&mut ua);
+        sb.displacement_into(&mut ub);
+        let diff = ua
+            .iter()
+            .zip(&ub)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        if diff > out.max_difference {
+            out.max_difference = diff;
+            out.worst_step = sa.step_index();
+        }
+        out.max_displacement = ua.iter().fold(out.max_displacement, |m, x| m.max(x.abs()));
+        out.steps = sa.step_index();
+    };
+    measure(&sa, &sb, &mut out);
+    for _ in 1..a.steps() {
+        sa.step()?;
+        let r = sb.step()?;
+        tracker.observe(&r);
+        records.push(r);
+        measure(&sa, &sb, &mut out);
+    }
+    let summary = tracker.finish(name, &sb, start.elapsed().as_secs_f64());
+    Ok(Comparison {
+        agreement: out,
+        records,
+        summary,
+    })
+}

@@ -1,0 +1,306 @@
+//! The OSQP step solver: the step problem handed to OSQP (B. Stellato, G. Banjac, P. Goulart,
+//! A. Bemporad, S. Boyd, "OSQP: an operator splitting solver for quadratic programs", Math.
+//! Prog. Comp. 12, 2020), through the `osqp` crate 0.6.3 (OSQP 0.6 with its bundled QDLDL).
+//!
+//! QP form: `minimise ½ zᵀPz + qᵀz  s.t.  l <= Az <= u` with `P = C` (upper triangle, built
+//! directly in CSC from the tridiagonal), `q = −b`, `A` the rows selecting the constrained
+//! nodes, `l = lo` (it moves every step: `lo = −a − u^n`) and `u = `[`OSQP_INFTY`]. OSQP is set
+//! up once per run; each step updates `q` and `l` and warm-starts from the previous step's
+//! answer, which is close since the increment varies smoothly in time. With no constrained node
+//! `A` is `0 × n`: OSQP accepts it (checked in tests) and solves the unconstrained problem by
+//! its ADMM iteration like any other, so the `osqp` method still uses OSQP there.
+//!
+//! OSQP's dual `y` is negative at an active lower bound, so the reaction is `r = −y`.
+//!
+//! Every answer OSQP reports as solved is audited ([`crate::audit`]); a status other than
+//! "solved" (or "solved inaccurate" with `accept_inaccurate`) or a failed audit is an error.
+//!
+//! Determinism: OSQP runs single-threaded, and the rho adaptation interval is fixed (OSQP's
+//! default adapts after a fraction of the set-up *time*), so a run gives the same bits every
+//! time on a given machine and build.
+
+use crate::audit::{INACCURATE_FACTOR, KktAudit, Law};
+use crate::error::RunError;
+use crate::scene::{
+    OSQP_DEFAULT_ADAPTIVE_RHO_INTERVAL, OSQP_DEFAULT_EPS, OSQP_DEFAULT_MAX_ITER, SolverSpec,
+};
+use crate::solver::{SolveInfo, SolverReport, StepFailure, StepSolver};
+use crate::tridiag::{NotPositiveDefinite, SymTridiag};
+use osqp::{CscMatrix, Problem, Settings, Status};
+use std::borrow::Cow;
+
+/// OSQP's infinity (`OSQP_INFTY` in constants.h): bounds at or beyond it count as absent.
+/// `f64::INFINITY` must not be used: it breaks OSQP's infeasibility tests.
+pub const OSQP_INFTY: f64 = 1e30;
+
+/// The OSQP settings a scene can choose (see [`SolverSpec`] for the defaults).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OsqpSettings {
+    pub eps_abs: f64,
+    pub eps_rel: f64,
+    pub polish: bool,
+    pub max_iter: u32,
+    pub adaptive_rho_interval: u32,
+    pub accept_inaccurate: bool,
+}
+
+impl Default for OsqpSettings {
+    fn default() -> Self {
+        Self {
+            eps_abs: OSQP_DEFAULT_EPS,
+            eps_rel: OSQP_DEFAULT_EPS,
+            polish: true,
+            max_iter: OSQP_DEFAULT_MAX_ITER,
+            adaptive_rho_interval: OSQP_DEFAULT_ADAPTIVE_RHO_INTERVAL,
+            accept_inaccurate: false,
+        }
+    }
+}
+
+impl OsqpSettings {
+    /// The scene's settings, defaults for those not given.
+    pub fn from_spec(spec: &SolverSpec) -> Self {
+        let d = Self::default();
+        Self {
+            eps_abs: spec.eps_abs.unwrap_or(d.eps_abs),
+            eps_rel: spec.eps_rel.unwrap_or(d.eps_rel),
+            polish: spec.polish.unwrap_or(d.polish),
+            max_iter: spec.max_iter.unwrap_or(d.max_iter),
+            adaptive_rho_interval: spec
+                .adaptive_rho_interval
+                .unwrap_or(d.adaptive_rho_interval),
+            accept_inaccurate: spec.accept_inaccurate.unwrap_or(d.accept_inaccurate),
+        }
+    }
+
+    fn to_osqp(self) -> Settings {
+        Settings::default()
+            .verbose(false)
+            .eps_abs(self.eps_abs)
+            .eps_rel(self.eps_rel)
+            .max_iter(self.max_iter)
+            .polish(self.polish)
+            .warm_start(true)
+            .adaptive_rho_interval(Some(self.adaptive_rho_interval))
+    }
+}
+
+/// Why OSQP could not be set up.
+#[derive(Debug, thiserror::Error)]
+pub enum OsqpSetupError {
+    #[error(transparent)]
+    Matrix(#[from] NotPositiveDefinite),
+    #[error("{0}")]
+    Osqp(String),
+}
+
+impl From<OsqpSetupError> for RunError {
+    fn from(e: OsqpSetupError) -> Self {
+        match e {
+            OsqpSetupError::Matrix(m) => RunError::Matrix(m),
+            OsqpSetupError::Osqp(reason) => RunError::SolverSetup {
+                solver: "osqp".into(),
+                reason,
+            },
+        }
+    }
+}
+
+/// OSQP on the step problem, set up once per run, audited every step.
+pub struct OsqpSolver {
+    problem: Problem,
+    settings: OsqpSettings,
+    k: usize,
+    /// `q = −b`, and the previous answer for the warm start.
+    q: Vec<f64>,
+    x_prev: Vec<f64>,
+    y_prev: Vec<f64>,
+    audit: KktAudit,
+    inaccurate_steps: u64,
+}
+
+impl std::fmt::Debug for OsqpSolver {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("OsqpSolver")
+            .field("settings", &self.settings)
+            .field("constraints", &self.k)
+            .finish_non_exhaustive()
+    }
+}
+
+/// `C`'s upper triangle in CSC: column `j` holds `C[j−1][j]` (for `j > 0`) and `C[j][j]`.
+fn upper_csc(c: &SymTridiag) -> CscMatrix<'static> {
+    let n = c.dim();
+    let mut indptr = Vec::with_capacity(n + 1);
+    let mut indices = Vec::with_capacity(2 * n);
+    let mut data = Vec::with_capacity(2 * n);
+    indptr.push(0);
+    for j in 0..n {
+        if j > 0 {
+            indices.push(j - 1);
+            data.push(c.off[j - 1]);
+        }
+        indices.push(j);
+        data.push(c.diag[j]);
+        indptr.push(indices.len());
+    }
+    CscMatrix {
+        nrows: n,
+        ncols: n,
+        indptr: Cow::Owned(indptr),
+        indices: Cow::Owned(indices),
+        data: Cow::Owned(data),
+    }
+}
+
+/// The `k × n` selection `A e_{nodes[j]} = e_j`, in CSC (rows ascending within a column).
+fn selection_csc(n: usize, nodes: &[usize]) -> CscMatrix<'static> {
+    let mut indptr = Vec::with_capacity(n + 1);
+    let mut indices = Vec::new();
+    indptr.push(0);
+    for col in 0..n {
+        indices.extend((0..nodes.len()).filter(|&j| nodes[j] == col));
+        indptr.push(indices.len());
+    }
+    let data = vec![1.0; indices.len()];
+    CscMatrix {
+        nrows: nodes.len(),
+        ncols: n,
+        indptr: Cow::Owned(indptr),
+        indices: Cow::Owned(indices),
+        data: Cow::Owned(data),
+    }
+}
+
+/// OSQP's status, as its C library spells it.
+fn status_name(status: &Status<'_>) -> &'static str {
+    match status {
+        Status::Solved(_) => "solved",
+        Status::SolvedInaccurate(_) => "solved inaccurate",
+        Status::MaxIterationsReached(_) => "maximum iterations reached",
+        Status::TimeLimitReached(_) => "run time limit reached",
+        Status::PrimalInfeasible(_) => "primal infeasible",
+        Status::PrimalInfeasibleInaccurate(_) => "primal infeasible inaccurate",
+        Status::DualInfeasible(_) => "dual infeasible",
+        Status::DualInfeasibleInaccurate(_) => "dual infeasible inaccurate",
+        Status::NonConvex(_) => "problem non convex",
+        _ => "unknown status",
+    }
+}
+
+impl OsqpSolver {
+    /// Sets OSQP up for `C` and the constrained nodes (local indices).
+    pub fn new(
+        c: &SymTridiag,
+        nodes: &[usize],
+        settings: OsqpSettings,
+    ) -> Result<Self, OsqpSetupError> {
+        let n = c.dim();
+        let k = nodes.len();
+        if let Some(&bad) = nodes.iter().find(|&&j| j >= n) {
+            return Err(OsqpSetupError::Osqp(format!(
+                "constrained node {bad} outside 0..{n}"
+            )));
+        }
+        let audit = KktAudit::new(c, nodes, false)?;
+        let q = vec![0.0; n];
+        let l = vec![-OSQP_INFTY; k];
+        let u = vec![OSQP_INFTY; k];
+        let problem = Problem::new(
+            upper_csc(c),
+            &q,
+            selection_csc(n, nodes),
+            &l,
+            &u,
+            &settings.to_osqp(),
+        )
+        .map_err(|e| OsqpSetupError::Osqp(e.to_string()))?;
+        Ok(Self {
+            problem,
+            settings,
+            k,
+            q,
+            x_prev: vec![0.0; n],
+            y_prev: vec![0.0; k],
+            audit,
+            inaccurate_steps: 0,
+        })
+    }
+
+    pub fn settings(&self) -> OsqpSettings {
+        self.settings
+    }
+}
+
+impl StepSolver for OsqpSolver {
+    fn name(&self) -> &'static str {
+        "osqp"
+    }
+
+    fn solve(
+        &mut self,
+        rhs: &[f64],
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<SolveInfo, StepFailure> {
+        let k = self.k;
+        let lower = &lower[..k];
+        // OSQP takes non-finite data silently (and panics in the crate on l > u).
+        if !(rhs.iter().all(|v| v.is_finite())
+            && lower.iter().all(|v| v.is_finite() && v.abs() < OSQP_INFTY))
+        {
+            return Err(StepFailure::NonFinite);
+        }
+        for (qi, bi) in self.q.iter_mut().zip(rhs) {
+            *qi = -bi;
+        }
+        self.problem.update_lin_cost(&self.q);
+        if k > 0 {
+            self.problem.update_lower_bound(lower);
+        }
+        self.problem.warm_start(&self.x_prev, &self.y_prev);
+        let status = self.problem.solve();
+        let iterations = status.iter();
+        let (solution, inaccurate) = match status {
+            Status::Solved(s) => (s, false),
+            Status::SolvedInaccurate(s) if self.settings.accept_inaccurate => (s, true),
+            other => {
+                let hint = if matches!(other, Status::SolvedInaccurate(_)) {
+                    " (solver.accept_inaccurate = true accepts it)"
+                } else {
+                    ""
+                };
+                return Err(StepFailure::Status(format!(
+                    "OSQP returned `{}` after {iterations} iterations{hint}",
+                    status_name(&other)
+                )));
+            }
+        };
+        z.copy_from_slice(solution.x());
+        let y = solution.y();
+        for j in 0..k {
+            // 0.0 − y rather than −y: no −0.0 reactions in the outputs.
+            reactions[j] = 0.0 - y[j];
+        }
+        let factor = if inaccurate { INACCURATE_FACTOR } else { 1.0 };
+        let law = Law::Signorini {
+            eps_abs: factor * self.settings.eps_abs,
+            eps_rel: factor * self.settings.eps_rel,
+        };
+        self.audit.check(law, rhs, lower, z, reactions)?;
+        self.x_prev.copy_from_slice(z);
+        self.y_prev.copy_from_slice(y);
+        if inaccurate {
+            self.inaccurate_steps += 1;
+        }
+        Ok(SolveInfo { iterations })
+    }
+
+    fn report(&self) -> Option<SolverReport> {
+        Some(SolverReport {
+            audit: self.audit.report().clone(),
+            inaccurate_steps: Some(self.inaccurate_steps),
+        })
+    }
+}

@@ -1,0 +1,227 @@
+//! The penalty step solver: the talk's penalised problem (PP) (Petrov & Schatzman 2009), normal
+//! compliance. The unilateral constraint at each Signorini node is replaced by the force
+//! `(u + a)⁻/ε`, taken implicitly at `t^{n+1}`; in the increment `z` the step reads
+//!
+//! ```text
+//!   C z = b + Σ_j r_j e_j,   ε r_j = max(0, lo_j − z_j),
+//! ```
+//!
+//! the optimality condition of the strictly convex problem
+//! `min ½ zᵀCz − bᵀz + Σ_j ((lo_j − z_j)⁺)²/(2ε)`, so it has exactly one solution. The gap
+//! `z_j − lo_j = −ε r_j` is negative in contact: penetration ≈ ε × reaction, and
+//! complementarity holds only in the limit ε → 0.
+//!
+//! Solution, exact to round-off. As in [`crate::exact`], with `z⁰ = C⁻¹ b`, `c_j = C⁻¹ e_j`
+//! and `S_jk = (C⁻¹)_jk` on the constrained nodes, `z = z⁰ + Σ_j r_j c_j`, and the conditions
+//! become the linear complementarity problem in `r ∈ ℝᵏ` (k <= 2):
+//!
+//! ```text
+//!   w = (S + εI) r − (lo − z⁰_c) >= 0,   r >= 0,   wᵀ r = 0,     (w_j = z_j − lo_j + ε r_j)
+//! ```
+//!
+//! `S + εI` is symmetric positive definite (S is a principal block of `C⁻¹`), hence a
+//! P-matrix, so the LCP has exactly one solution for every right-hand side (Cottle, Pang &
+//! Stone, *The Linear Complementarity Problem*, Thm 3.3.7). Its support is one of the `2^k <= 4`
+//! subsets `A`, on which `(S + εI)_AA r_A = (lo − z⁰)_A` is linear. Trying the subsets in
+//! the order ∅, {first}, {second}, {both} and accepting the first whose `r_A >= 0` and
+//! `w >= 0` therefore terminates after at most four 1×1 or 2×2 solves; this is semismooth
+//! Newton on the piecewise-linear equation `ε r = (lo − z⁰ − S r)⁺` with every piece visited at
+//! most once. In floating point the candidates are ranked by their violation, as in the exact
+//! solver, so the choice is deterministic. `iterations` is the number of subsets tried.
+
+use crate::audit::{KktAudit, Law};
+use crate::error::{RunError, SceneError};
+use crate::solver::{SolveInfo, SolverReport, StepFailure, StepSolver};
+use crate::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
+
+/// Column `C⁻¹ e_j` on its numerical support (as in [`crate::exact`]).
+#[derive(Clone, Debug)]
+struct Column {
+    node: usize,
+    values: Vec<f64>,
+    /// Entries outside are below `f64::MIN_POSITIVE` in magnitude and dropped.
+    support: std::ops::Range<usize>,
+}
+
+/// Why the penalty solver could not be set up.
+#[derive(Debug, thiserror::Error)]
+pub enum PenaltySetupError {
+    #[error(transparent)]
+    Matrix(#[from] NotPositiveDefinite),
+    #[error("epsilon = {0} must be a finite number > 0")]
+    Epsilon(f64),
+}
+
+impl From<PenaltySetupError> for RunError {
+    fn from(e: PenaltySetupError) -> Self {
+        match e {
+            PenaltySetupError::Matrix(m) => RunError::Matrix(m),
+            PenaltySetupError::Epsilon(v) => RunError::Scene(SceneError::Invalid {
+                field: "solver.epsilon".into(),
+                value: v.to_string(),
+                allowed: "must be a finite number > 0".into(),
+            }),
+        }
+    }
+}
+
+/// Normal compliance with parameter `ε`, solved exactly per step, audited every step.
+#[derive(Clone, Debug)]
+pub struct PenaltySolver {
+    epsilon: f64,
+    factor: Ldlt,
+    columns: Vec<Column>,
+    /// `S + εI` on the constrained nodes.
+    matrix: [[f64; 2]; 2],
+    audit: KktAudit,
+}
+
+impl PenaltySolver {
+    /// Factorises `C`, precomputes `C⁻¹ e_j` for each constrained node (at most two).
+    pub fn new(c: &SymTridiag, nodes: &[usize], epsilon: f64) -> Result<Self, PenaltySetupError> {
+        assert!(
+            nodes.len() <= 2,
+            "the end-node enumeration handles at most two bounds"
+        );
+        if !(epsilon.is_finite() && epsilon > 0.0) {
+            return Err(PenaltySetupError::Epsilon(epsilon));
+        }
+        let factor = Ldlt::factor(c)?;
+        let columns: Vec<Column> = nodes
+            .iter()
+            .map(|&node| {
+                let mut values = factor.column_of_inverse(node);
+                for v in values.iter_mut() {
+                    if v.abs() < f64::MIN_POSITIVE {
+                        *v = 0.0;
+                    }
+                }
+                let start = values.iter().position(|v| *v != 0.0).unwrap_or(0);
+                let end = values.iter().rposition(|v| *v != 0.0).map_or(0, |e| e + 1);
+                Column {
+                    node,
+                    values,
+                    support: start..end,
+                }
+            })
+            .collect();
+        let mut matrix = [[0.0; 2]; 2];
+        for (a, ca) in columns.iter().enumerate() {
+            for (b, cb) in columns.iter().enumerate() {
+                matrix[a][b] = ca.values[cb.node];
+            }
+            matrix[a][a] += epsilon;
+        }
+        if columns.len() == 2 {
+            // Bitwise symmetric, so the choice does not depend on the order of the nodes.
+            let s = 0.5 * (matrix[0][1] + matrix[1][0]);
+            matrix[0][1] = s;
+            matrix[1][0] = s;
+        }
+        let audit = KktAudit::new(c, nodes, true)?;
+        Ok(Self {
+            epsilon,
+            factor,
+            columns,
+            matrix,
+            audit,
+        })
+    }
+
+    pub fn epsilon(&self) -> f64 {
+        self.epsilon
+    }
+
+    /// Reactions and LCP violation (in displacement) of support `mask`, given `d = lo − z⁰`.
+    fn candidate(&self, mask: u8, d: &[f64; 2]) -> ([f64; 2], f64) {
+        let k = self.columns.len();
+        let m = &self.matrix;
+        let r = match mask {
+            0 => [0.0, 0.0],
+            1 => [d[0] / m[0][0], 0.0],
+            2 => [0.0, d[1] / m[1][1]],
+            _ => {
+                let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+                [
+                    (m[1][1] * d[0] - m[0][1] * d[1]) / det,
+                    (m[0][0] * d[1] - m[1][0] * d[0]) / det,
+                ]
+            }
+        };
+        let mut violation: f64 = 0.0;
+        for j in 0..k {
+            if mask & (1 << j) != 0 {
+                violation = violation.max(-r[j] * m[j][j]);
+            } else {
+                // w_j = ((S + εI) r)_j − d_j with r_j = 0 must be >= 0.
+                let wj = (0..k).map(|i| m[j][i] * r[i]).sum::<f64>() - d[j];
+                violation = violation.max(-wj);
+            }
+        }
+        (r, violation)
+    }
+}
+
+impl StepSolver for PenaltySolver {
+    fn name(&self) -> &'static str {
+        "penalty"
+    }
+
+    fn solve(
+        &mut self,
+        rhs: &[f64],
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<SolveInfo, StepFailure> {
+        z.copy_from_slice(rhs);
+        self.factor.solve_in_place(z);
+        let k = self.columns.len();
+        let mut d = [0.0; 2];
+        for (j, col) in self.columns.iter().enumerate() {
+            d[j] = lower[j] - z[col.node];
+        }
+        if !d[..k].iter().all(|v| v.is_finite()) {
+            return Err(StepFailure::NonFinite);
+        }
+        let mut best = (0u8, [0.0; 2], f64::INFINITY);
+        let mut tried = 0;
+        for mask in 0..(1u8 << k) {
+            tried += 1;
+            let (r, violation) = self.candidate(mask, &d);
+            if violation < best.2 {
+                best = (mask, r, violation);
+            }
+            if violation <= 0.0 {
+                break; // the LCP holds exactly: this is the unique solution
+            }
+        }
+        let (mask, r, _) = best;
+        for (j, col) in self.columns.iter().enumerate() {
+            let active = mask & (1 << j) != 0;
+            reactions[j] = if active { r[j] } else { 0.0 };
+            if active && r[j] != 0.0 {
+                let rj = r[j];
+                for (zi, ci) in z[col.support.clone()]
+                    .iter_mut()
+                    .zip(&col.values[col.support.clone()])
+                {
+                    *zi += rj * ci;
+                }
+            }
+        }
+        let law = Law::Penalty {
+            epsilon: self.epsilon,
+        };
+        self.audit
+            .check(law, rhs, &lower[..k], z, &reactions[..k])?;
+        Ok(SolveInfo { iterations: tried })
+    }
+
+    fn report(&self) -> Option<SolverReport> {
+        Some(SolverReport {
+            audit: self.audit.report().clone(),
+            inaccurate_steps: None,
+        })
+    }
+}

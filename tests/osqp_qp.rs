@@ -1,0 +1,101 @@
+//! OSQP against the exact enumeration on random step problems: symmetric positive definite
+//! tridiagonal `C` (the generator of tests/exact_solver.rs) with one or two bounds, each solver
+//! solving two problems in a row so that OSQP's per-step updates and warm start are exercised.
+
+use proptest::prelude::*;
+use viscobar::audit::AUDIT_MARGIN;
+use viscobar::exact::ExactSolver;
+use viscobar::osqp_solver::{OsqpSettings, OsqpSolver};
+use viscobar::scene::OSQP_DEFAULT_EPS;
+use viscobar::solver::StepSolver;
+use viscobar::tridiag::SymTridiag;
+
+/// Smallest diagonal-dominance margin of the generator: by Varah's bound (1975)
+/// `‖C⁻¹‖_∞ <= 1 / MIN_MARGIN`.
+const MIN_MARGIN: f64 = 0.05;
+
+/// Random SPD tridiagonal matrices: diagonally dominant by a random margin >= MIN_MARGIN,
+/// off-diagonals of either sign.
+fn spd_tridiag() -> impl Strategy<Value = SymTridiag> {
+    (2usize..24).prop_flat_map(|n| {
+        (
+            prop::collection::vec(-1.0f64..1.0, n - 1),
+            prop::collection::vec(MIN_MARGIN..3.0, n),
+        )
+            .prop_map(move |(off, margin)| {
+                let diag = (0..n)
+                    .map(|i| {
+                        let l = if i > 0 { off[i - 1].abs() } else { 0.0 };
+                        let r = if i + 1 < n { off[i].abs() } else { 0.0 };
+                        l + r + margin[i]
+                    })
+                    .collect();
+                SymTridiag::new(diag, off)
+            })
+    })
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// OSQP's tolerance carried to the answer. The audit accepts a displacement-unit stationarity
+/// error and a primal violation up to `t_z = AUDIT_MARGIN·eps·(1 + ‖z‖)` and a multiplier (sign
+/// or complementarity) error up to `t_f = AUDIT_MARGIN·eps·(1 + s_f)`, which moves `z` by at most
+/// `‖C⁻¹‖_∞ t_f`; twice the sum covers both bounds of a two-bound problem. Returns the
+/// tolerances for `z` and for `r` (`r_j = (Cz − b)_j`, so `‖C‖_∞` times the first plus `t_f`).
+fn tolerances(c: &SymTridiag, b: &[f64], z: &[f64], r: &[f64]) -> (f64, f64) {
+    let eps = AUDIT_MARGIN * OSQP_DEFAULT_EPS;
+    let s_f = norm(b).max(norm(&c.mul(z))).max(norm(r));
+    let t_z = eps * (1.0 + norm(z));
+    let t_f = eps * (1.0 + s_f);
+    let tol_z = 2.0 * (t_z + t_f / MIN_MARGIN);
+    let n = c.dim();
+    let c_norm = (0..n)
+        .map(|i| {
+            let left = if i > 0 { c.off[i - 1].abs() } else { 0.0 };
+            let right = if i + 1 < n { c.off[i].abs() } else { 0.0 };
+            left + c.diag[i] + right
+        })
+        .fold(0.0, f64::max);
+    (tol_z, c_norm * tol_z + t_f)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    #[test]
+    fn osqp_agrees_with_exact_to_its_tolerance(
+        c in spd_tridiag(),
+        seed_b in prop::collection::vec(-5.0f64..5.0, 48),
+        lo in prop::collection::vec(-2.0f64..2.0, 4),
+        which in 0usize..3,
+    ) {
+        let n = c.dim();
+        let nodes: Vec<usize> = match which {
+            0 => vec![0],
+            1 => vec![n - 1],
+            _ => vec![0, n - 1],
+        };
+        let k = nodes.len();
+        let mut exact = ExactSolver::new(&c, &nodes).unwrap();
+        let mut osqp = OsqpSolver::new(&c, &nodes, OsqpSettings::default()).unwrap();
+        // Two problems in a row: the second starts from the first's answer.
+        for (b, lower) in [(&seed_b[..n], &lo[..k]), (&seed_b[24..24 + n], &lo[2..2 + k])] {
+            let (mut ze, mut re) = (vec![0.0; n], vec![0.0; k]);
+            exact.solve(b, lower, &mut ze, &mut re).unwrap();
+            let (mut zo, mut ro) = (vec![0.0; n], vec![0.0; k]);
+            osqp.solve(b, lower, &mut zo, &mut ro).unwrap();
+            let (tol_z, tol_r) = tolerances(&c, b, &ze, &re);
+            for i in 0..n {
+                prop_assert!((zo[i] - ze[i]).abs() <= tol_z,
+                    "node {i}: osqp {} exact {} (tol {tol_z:e})", zo[i], ze[i]);
+            }
+            for j in 0..k {
+                prop_assert!((ro[j] - re[j]).abs() <= tol_r,
+                    "reaction {j}: osqp {} exact {} (tol {tol_r:e})", ro[j], re[j]);
+            }
+        }
+        prop_assert_eq!(osqp.report().unwrap().audit.steps, 2);
+    }
+}
