@@ -160,7 +160,7 @@ impl StepSolver for Recorder {
 /// dual residual and tolerance, the reaction error, and the stationarity error mapped to
 /// displacement, against the exact answer.
 fn raw_first_step(scene: &Scene, s: OsqpSettings) -> String {
-    let disc = Discretisation::new(scene);
+    let disc = Discretisation::new(scene).unwrap();
     let c = disc.step_matrix.clone();
     let nodes = disc.constrained_locals();
     let log: Log = Rc::default();

@@ -50,6 +50,8 @@ pub enum PenaltySetupError {
     Matrix(#[from] NotPositiveDefinite),
     #[error("epsilon = {0} must be a finite number > 0")]
     Epsilon(f64),
+    #[error("the penalty solver handles the two Signorini ends only, not {0} constrained nodes")]
+    TooManyBounds(usize),
 }
 
 impl From<PenaltySetupError> for RunError {
@@ -60,6 +62,14 @@ impl From<PenaltySetupError> for RunError {
                 field: "solver.epsilon".into(),
                 value: v.to_string(),
                 allowed: "must be a finite number > 0".into(),
+            }),
+            PenaltySetupError::TooManyBounds(k) => RunError::Scene(SceneError::Invalid {
+                field: "solver.method".into(),
+                value: "\"penalty\"".into(),
+                allowed: format!(
+                    "the penalty solver handles the two Signorini ends only; this scene constrains \
+                     {k} nodes (use exact or osqp for an obstacle)"
+                ),
             }),
         }
     }
@@ -79,10 +89,9 @@ pub struct PenaltySolver {
 impl PenaltySolver {
     /// Factorises `C`, precomputes `C⁻¹ e_j` for each constrained node (at most two).
     pub fn new(c: &SymTridiag, nodes: &[usize], epsilon: f64) -> Result<Self, PenaltySetupError> {
-        assert!(
-            nodes.len() <= 2,
-            "the end-node enumeration handles at most two bounds"
-        );
+        if nodes.len() > 2 {
+            return Err(PenaltySetupError::TooManyBounds(nodes.len()));
+        }
         if !(epsilon.is_finite() && epsilon > 0.0) {
             return Err(PenaltySetupError::Epsilon(epsilon));
         }

@@ -75,20 +75,29 @@ pub struct Tracker {
     iterations_sum: u64,
     iterations_max: u32,
     records: usize,
+    /// The first `ends` entries of `sides` are Signorini ends; a last entry "obstacle" (the
+    /// whole contact set) follows for a distributed obstacle.
+    ends: usize,
 }
 
 impl Tracker {
     pub fn new(sim: &Simulation, unforced: bool) -> Self {
-        let sides: Vec<String> = sim
-            .discretisation()
+        let disc = sim.discretisation();
+        let mut sides: Vec<String> = disc
             .constraints
             .iter()
-            .map(|c| c.side.name().to_string())
+            .filter_map(|c| c.side.map(|s| s.name().to_string()))
             .collect();
+        let ends = sides.len();
+        let obstacle = !disc.ends_only();
+        if obstacle {
+            sides.push("obstacle".to_string());
+        }
         let k = sides.len();
         let first = sim.first_record();
         let mut t = Self {
             sides,
+            ends,
             unforced,
             energy_initial: first.energy,
             energy_prev: first.energy,
@@ -121,12 +130,15 @@ impl Tracker {
     }
 
     fn observe_contact(&mut self, r: &StepRecord) {
+        self.max_comp = self.max_comp.max(r.max_complementarity);
+        self.max_violation = self.max_violation.max(-r.min_gap);
+        self.min_reaction = self.min_reaction.min(r.min_reaction);
         for j in 0..self.sides.len() {
-            let (gap, reaction) = (r.gap[j], r.reaction[j]);
-            self.max_comp = self.max_comp.max((gap * reaction).abs());
-            self.max_violation = self.max_violation.max(-gap);
-            self.min_reaction = self.min_reaction.min(reaction);
-            let contact = gap <= CONTACT_GAP_TOL;
+            let contact = if j < self.ends {
+                r.gap[j] <= CONTACT_GAP_TOL
+            } else {
+                r.contact_nodes > 0
+            };
             match (contact, self.in_contact[j]) {
                 (true, false) => self.intervals[j].push([r.time, r.time]),
                 (true, true) => self.intervals[j].last_mut().expect("open interval")[1] = r.time,
@@ -244,17 +256,22 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
         .discretisation()
         .constraints
         .iter()
-        .map(|c| c.side.name())
+        .filter_map(|c| c.side.map(|s| s.name()))
         .collect();
+    let obstacle = !sim.discretisation().ends_only();
     let mut header = String::from(
         "step,t,energy,work,viscous_dissipation,contact_dissipation,identity_residual",
     );
     for s in &sides {
         header.push_str(&format!(",gap_{s},reaction_{s}"));
     }
+    if obstacle {
+        header.push_str(",contact_nodes,contact_x_min,contact_x_max,min_gap");
+    }
     header.push_str(",iterations");
     writeln!(hist, "{header}").map_err(io(&hist_path))?;
-    write_history_row(&mut hist, &sim.first_record(), sides.len()).map_err(io(&hist_path))?;
+    write_history_row(&mut hist, &sim.first_record(), sides.len(), obstacle)
+        .map_err(io(&hist_path))?;
 
     let nodes = sim.discretisation().nodes;
     let xs: Vec<f64> = (0..nodes).map(|i| sim.discretisation().x(i)).collect();
@@ -284,7 +301,7 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
     for _ in 1..steps {
         let r = sim.step()?;
         tracker.observe(&r);
-        write_history_row(&mut hist, &r, sides.len()).map_err(io(&hist_path))?;
+        write_history_row(&mut hist, &r, sides.len(), obstacle).map_err(io(&hist_path))?;
         if keep(r.step) {
             sim.displacement_into(&mut u);
             sim.velocity_into(&mut v);
@@ -308,7 +325,12 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
     Ok(summary)
 }
 
-fn write_history_row(w: &mut impl Write, r: &StepRecord, k: usize) -> std::io::Result<()> {
+fn write_history_row(
+    w: &mut impl Write,
+    r: &StepRecord,
+    k: usize,
+    obstacle: bool,
+) -> std::io::Result<()> {
     write!(
         w,
         "{},{},{},{},{},{},{}",
@@ -322,6 +344,17 @@ fn write_history_row(w: &mut impl Write, r: &StepRecord, k: usize) -> std::io::R
     )?;
     for j in 0..k {
         write!(w, ",{},{}", r.gap[j], r.reaction[j])?;
+    }
+    if obstacle {
+        let [lo, hi] = r.contact_extent;
+        let x = |v: f64| {
+            if v.is_nan() {
+                String::new()
+            } else {
+                v.to_string()
+            }
+        };
+        write!(w, ",{},{},{},{}", r.contact_nodes, x(lo), x(hi), r.min_gap)?;
     }
     writeln!(w, ",{}", r.iterations)
 }

@@ -22,6 +22,9 @@ pub struct Scene {
     pub initial: Initial,
     #[serde(default)]
     pub load: Load,
+    /// Distributed Signorini: an obstacle `u(x) >= -g(x)` under every node.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub obstacle: Option<Obstacle>,
     pub mesh: Mesh,
     pub time: Time,
     #[serde(default)]
@@ -92,6 +95,34 @@ pub struct Load {
     /// `l(x, t)`, force per unit length; absent means no load.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub density: Option<String>,
+}
+
+/// The obstacle under the whole bar (the talk's "distributed Signorini conditions").
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Obstacle {
+    /// `g(x)`: a number or an expression in `x`; the constraint is `u(x_i) >= -g(x_i)` at every
+    /// node (combined with a Signorini end's own gap by taking the tighter bound).
+    pub gap: GapValue,
+}
+
+/// A number or an expression in `x`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum GapValue {
+    Number(f64),
+    Expression(String),
+}
+
+impl GapValue {
+    /// As an expression for the scene field `field`.
+    pub fn expression(&self, field: &str) -> Result<Expression, SceneError> {
+        match self {
+            GapValue::Number(v) if !v.is_finite() => Err(invalid(field, *v, "must be finite")),
+            GapValue::Number(v) => Expression::parse(field, &format!("{v:?}"), false),
+            GapValue::Expression(text) => Expression::parse(field, text, false),
+        }
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -315,6 +346,11 @@ pub const BUILTIN: &[(&str, &str)] = &[
         "one-end-forced",
         include_str!("../scenes/one-end-forced.toml"),
     ),
+    ("distributed", include_str!("../scenes/distributed.toml")),
+    (
+        "distributed-forced",
+        include_str!("../scenes/distributed-forced.toml"),
+    ),
 ];
 
 /// The names of the built-in scenes, in order.
@@ -459,6 +495,9 @@ impl Scene {
         Expression::parse("initial.velocity", &self.initial.velocity, false)?;
         if let Some(d) = &self.load.density {
             Expression::parse("load.density", d, true)?;
+        }
+        if let Some(o) = &self.obstacle {
+            o.gap.expression("obstacle.gap")?;
         }
         Ok(())
     }

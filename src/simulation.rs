@@ -20,6 +20,7 @@
 //!
 //! where the contact term `½ r·δ = −½ r_j (u^{n−1}_j + a_j) <= 0` by complementarity.
 
+use crate::active_set::BlockPivotSolver;
 use crate::error::{RunError, SceneError};
 use crate::exact::ExactSolver;
 use crate::expr::Expression;
@@ -30,10 +31,11 @@ use crate::scene::{Condition, PENALTY_DEFAULT_EPSILON, Scene, Side, SolverMethod
 use crate::solver::{SolveInfo, SolverReport, StepSolver};
 use crate::tridiag::{Ldlt, SymTridiag, dot};
 
-/// A Signorini node: `u[node] >= -gap`.
+/// A constrained node: `u[node] >= -gap`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Constraint {
-    pub side: Side,
+    /// The end whose Signorini condition this is, or `None` for an obstacle node.
+    pub side: Option<Side>,
     /// Global node index in `0..=J+1`.
     pub node: usize,
     pub gap: f64,
@@ -60,7 +62,7 @@ pub struct Discretisation {
 }
 
 impl Discretisation {
-    pub fn new(scene: &Scene) -> Self {
+    pub fn new(scene: &Scene) -> Result<Self, SceneError> {
         let nodes = scene.elements() + 1;
         let dx = scene.dx();
         let dt = scene.time.step;
@@ -74,16 +76,44 @@ impl Discretisation {
         let stiffness = stiffness_full.sub(first, last);
         let step_matrix =
             SymTridiag::combine(1.0 / (dt * dt), &mass, 0.5 + alpha / (2.0 * dt), &stiffness);
-        let constraints = scene
-            .signorini_ends()
-            .into_iter()
-            .map(|(side, gap)| Constraint {
-                side,
-                node: if side == Side::Left { 0 } else { nodes - 1 },
-                gap,
-            })
-            .collect();
-        Self {
+        let node_of = |side: Side| if side == Side::Left { 0 } else { nodes - 1 };
+        let ends = scene.signorini_ends();
+        let end_gap = |node: usize| {
+            ends.iter()
+                .find(|(side, _)| node_of(*side) == node)
+                .copied()
+        };
+        let constraints = match &scene.obstacle {
+            None => ends
+                .iter()
+                .map(|&(side, gap)| Constraint {
+                    side: Some(side),
+                    node: node_of(side),
+                    gap,
+                })
+                .collect(),
+            Some(obstacle) => {
+                let g = obstacle.gap.expression("obstacle.gap")?;
+                (first..=last)
+                    .map(|node| {
+                        let obstacle_gap = g.eval(node as f64 * dx, 0.0)?;
+                        Ok(match end_gap(node) {
+                            Some((side, a)) => Constraint {
+                                side: Some(side),
+                                node,
+                                gap: a.min(obstacle_gap),
+                            },
+                            None => Constraint {
+                                side: None,
+                                node,
+                                gap: obstacle_gap,
+                            },
+                        })
+                    })
+                    .collect::<Result<Vec<_>, SceneError>>()?
+            }
+        };
+        Ok(Self {
             nodes,
             dx,
             dt,
@@ -94,7 +124,19 @@ impl Discretisation {
             stiffness,
             step_matrix,
             constraints,
-        }
+        })
+    }
+
+    /// Indices into `constraints` of the Signorini ends (left first), at most two.
+    pub fn end_constraints(&self) -> Vec<usize> {
+        (0..self.constraints.len())
+            .filter(|&j| self.constraints[j].side.is_some())
+            .collect()
+    }
+
+    /// Whether only end nodes are constrained (at most two bounds).
+    pub fn ends_only(&self) -> bool {
+        self.constraints.iter().all(|c| c.side.is_some())
     }
 
     /// Number of unknowns.
@@ -125,7 +167,10 @@ impl Discretisation {
 pub fn make_solver(scene: &Scene, disc: &Discretisation) -> Result<Box<dyn StepSolver>, RunError> {
     let nodes = disc.constrained_locals();
     match scene.solver.method {
-        SolverMethod::Exact => Ok(Box::new(ExactSolver::new(&disc.step_matrix, &nodes)?)),
+        SolverMethod::Exact if disc.ends_only() => {
+            Ok(Box::new(ExactSolver::new(&disc.step_matrix, &nodes)?))
+        }
+        SolverMethod::Exact => Ok(Box::new(BlockPivotSolver::new(&disc.step_matrix, &nodes)?)),
         SolverMethod::Osqp => Ok(Box::new(OsqpSolver::new(
             &disc.step_matrix,
             &nodes,
@@ -156,10 +201,19 @@ pub struct StepRecord {
     pub contact_dissipation: f64,
     /// `|E^{n+1/2} − E^{n−1/2} − work + viscous + contact|` divided by the largest of those terms.
     pub identity_residual: f64,
-    /// `u^{n+1}_j + a_j` for each constraint (unused entries 0).
+    /// `u^{n+1}_j + a_j` at each Signorini end (left first; unused entries 0).
     pub gap: [f64; 2],
-    /// `r^{n+1}_j`.
+    /// `r^{n+1}_j` at each Signorini end.
     pub reaction: [f64; 2],
+    /// Over all constrained nodes (ends and obstacle): the least gap, the least reaction and
+    /// the largest `|gap · reaction|`.
+    pub min_gap: f64,
+    pub min_reaction: f64,
+    pub max_complementarity: f64,
+    /// Constrained nodes in contact (gap at most [`crate::run::CONTACT_GAP_TOL`]) and the
+    /// extent `[x_min, x_max]` of that contact set (`NaN` when empty).
+    pub contact_nodes: usize,
+    pub contact_extent: [f64; 2],
     pub iterations: u32,
 }
 
@@ -215,7 +269,7 @@ pub struct Simulation {
 impl Simulation {
     /// Sets up a run of `scene` with the solver it names.
     pub fn new(scene: &Scene) -> Result<Self, RunError> {
-        let disc = Discretisation::new(scene);
+        let disc = Discretisation::new(scene)?;
         let solver = make_solver(scene, &disc)?;
         Self::with_solver(scene, disc, solver)
     }
@@ -276,7 +330,9 @@ impl Simulation {
             if u0_full[c.node] < -c.gap {
                 return Err(SceneError::Inadmissible {
                     field: "initial.displacement".into(),
-                    gap_field: format!("{}.gap", c.side.name()),
+                    gap_field: c
+                        .side
+                        .map_or("obstacle.gap".to_string(), |s| format!("{}.gap", s.name())),
                     node: c.node,
                     x: disc.x(c.node),
                     value: u0_full[c.node],
@@ -514,10 +570,49 @@ impl Simulation {
     }
 
     fn fill_contact(&self, record: &mut StepRecord) {
+        let (mut min_gap, mut min_reaction, mut max_comp) = (f64::INFINITY, f64::INFINITY, 0.0f64);
+        let (mut count, mut lo, mut hi) = (0, f64::NAN, f64::NAN);
+        let mut end = 0;
         for (j, c) in self.disc.constraints.iter().enumerate() {
-            record.gap[j] = self.u[self.locals[j]] + c.gap;
-            record.reaction[j] = self.reactions[j];
+            let gap = self.u[self.locals[j]] + c.gap;
+            let reaction = self.reactions[j];
+            if c.side.is_some() {
+                record.gap[end] = gap;
+                record.reaction[end] = reaction;
+                end += 1;
+            }
+            min_gap = min_gap.min(gap);
+            min_reaction = min_reaction.min(reaction);
+            max_comp = max_comp.max((gap * reaction).abs());
+            if gap <= crate::run::CONTACT_GAP_TOL {
+                let x = self.disc.x(c.node);
+                if count == 0 {
+                    lo = x;
+                }
+                hi = x;
+                count += 1;
+            }
         }
+        if self.disc.constraints.is_empty() {
+            (min_gap, min_reaction) = (0.0, 0.0);
+        }
+        record.min_gap = min_gap;
+        record.min_reaction = min_reaction;
+        record.max_complementarity = max_comp;
+        record.contact_nodes = count;
+        record.contact_extent = [lo, hi];
+    }
+
+    /// `u^n_j + a_j` at every constrained node, in the order of `constraints`.
+    pub fn constraint_gaps_into(&self, out: &mut [f64]) {
+        for (j, c) in self.disc.constraints.iter().enumerate() {
+            out[j] = self.u[self.locals[j]] + c.gap;
+        }
+    }
+
+    /// The reactions of the last step at every constrained node.
+    pub fn reactions(&self) -> &[f64] {
+        &self.reactions
     }
 
     /// The record of the start-up step (`E^{1/2}`, contact state of `u^1`).

@@ -84,7 +84,7 @@ pub fn rigid_mode_drift(elements: u64, steps: usize) -> Result<(f64, f64), RunEr
     }
     let increment = drift(&sim.displacement(), sim.time());
 
-    let disc = Discretisation::new(&scene);
+    let disc = Discretisation::new(&scene)?;
     let dt = disc.dt;
     let n = disc.unknowns();
     let c = Ldlt::factor(&disc.step_matrix)?;

@@ -83,6 +83,10 @@ struct Snapshot {
     x: Vec<f64>,
     rows: Vec<Row>,
     contact_intervals: BTreeMap<String, Vec<[f64; 2]>>,
+    /// Distributed obstacles only: per time bin (between consecutive sampled steps), the
+    /// extent `[x_min, x_max]` of the nodes in contact at some step of the bin (`~` if none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    contact_set_extent: Option<Vec<Option<[f64; 2]>>>,
     solver_iterations: Iterations,
 }
 
@@ -123,6 +127,19 @@ fn snapshot_of(name: &str) -> Snapshot {
             (end.clone(), spans)
         })
         .collect();
+    let h = &run.contact;
+    let contact_set_extent = (h.constraints() > 2).then(|| {
+        (0..h.times.len())
+            .map(|b| {
+                let xs: Vec<f64> = (0..h.constraints())
+                    .filter(|&j| h.in_contact(b, j))
+                    .map(|j| h.xs[j])
+                    .collect();
+                let (lo, hi) = (xs.first()?, xs.last()?);
+                Some([round_sig(*lo, run.length), round_sig(*hi, run.length)])
+            })
+            .collect()
+    });
     let it = run.summary.solver_iterations;
     Snapshot {
         scene: name.to_string(),
@@ -138,6 +155,7 @@ fn snapshot_of(name: &str) -> Snapshot {
         x: run.xs.iter().map(|&x| round_sig(x, run.length)).collect(),
         rows,
         contact_intervals,
+        contact_set_extent,
         solver_iterations: Iterations {
             mean: round_sig(it.mean, it.mean),
             max: it.max,
