@@ -9,6 +9,10 @@ use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_m
 use viscobar::{Scene, Simulation};
 
 fn scene(elements: u64, left: &str, right: &str) -> Scene {
+    scene_with(elements, left, right, &[])
+}
+
+fn scene_with(elements: u64, left: &str, right: &str, overrides: &[&str]) -> Scene {
     let end = |c: &str| {
         if c == "signorini" {
             "condition = \"signorini\"\ngap = 0.0".to_string()
@@ -25,7 +29,41 @@ fn scene(elements: u64, left: &str, right: &str) -> Scene {
         dt = 1.0 / elements as f64,
         end = 1000.0 / elements as f64,
     );
-    Scene::from_toml(&text, &[]).unwrap()
+    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    Scene::from_toml(&text, &o).unwrap()
+}
+
+/// An obstacle under every node and a load pressing the left half onto it and lifting the
+/// right half: a contact set with a boundary, the exact step solving up to J + 2 bounds.
+fn distributed(elements: u64, dt_over_dx: f64) -> Scene {
+    let dt = format!("time.step={}", dt_over_dx / elements as f64);
+    let end = format!("time.end={}", 1000.0 * dt_over_dx / elements as f64);
+    scene_with(
+        elements,
+        "free",
+        "free",
+        &[
+            "obstacle.gap=0.0",
+            "load.density=\"-10*cos(pi*x)\"",
+            &dt,
+            &end,
+        ],
+    )
+}
+
+fn settle_and_bench(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    label: &str,
+    elements: u64,
+    scene: &Scene,
+) {
+    let mut sim = Simulation::new(scene).unwrap();
+    for _ in 0..50 {
+        sim.step().unwrap();
+    }
+    group.bench_with_input(BenchmarkId::new(label, elements), &elements, |b, _| {
+        b.iter(|| sim.step().unwrap())
+    });
 }
 
 fn bench_step(c: &mut Criterion) {
@@ -50,5 +88,63 @@ fn bench_step(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_step);
+fn bench_other_solvers(c: &mut Criterion) {
+    let mut group = c.benchmark_group("step");
+    for elements in [100u64, 1_000, 10_000, 100_000] {
+        group.throughput(Throughput::Elements(elements + 1));
+        settle_and_bench(
+            &mut group,
+            "distributed-exact",
+            elements,
+            &distributed(elements, 1.0),
+        );
+        settle_and_bench(
+            &mut group,
+            "penalty-two-ends",
+            elements,
+            &scene_with(
+                elements,
+                "signorini",
+                "signorini",
+                &["solver.method=\"penalty\""],
+            ),
+        );
+        if elements <= 10_000 {
+            for (label, eps) in [
+                ("osqp-default-two-ends", "1e-5"),
+                ("osqp-tight-two-ends", "1e-10"),
+            ] {
+                let o = [
+                    "solver.method=\"osqp\"".to_string(),
+                    format!("solver.eps_abs={eps}"),
+                    format!("solver.eps_rel={eps}"),
+                ];
+                let o: Vec<&str> = o.iter().map(String::as_str).collect();
+                settle_and_bench(
+                    &mut group,
+                    label,
+                    elements,
+                    &scene_with(elements, "signorini", "signorini", &o),
+                );
+            }
+        }
+    }
+    // The stiff worst case of issue 4: J = 1e5, dt = 10 dx.
+    group.throughput(Throughput::Elements(100_001));
+    settle_and_bench(
+        &mut group,
+        "distributed-exact-dt10dx",
+        100_000,
+        &distributed(100_000, 10.0),
+    );
+    group.finish();
+}
+
+// No HTML plots: criterion's plotters backend would need a registered font (the project's
+// plotters is built with `ab_glyph` only); the numbers are in target/criterion/*/new/.
+criterion_group! {
+    name = benches;
+    config = Criterion::default().without_plots();
+    targets = bench_step, bench_other_solvers
+}
 criterion_main!(benches);
