@@ -389,6 +389,7 @@ fn reference_run(base: &Scene, levels: u32, ratio: f64) -> Result<SampledReferen
 }
 
 /// The outcome of a study.
+#[derive(Debug)]
 pub struct Study {
     pub scene: String,
     pub reference: String,
@@ -726,6 +727,7 @@ pub struct SweepRow {
 }
 
 /// The outcome of the sweep.
+#[derive(Debug)]
 pub struct Sweep {
     pub scene: String,
     pub rows: Vec<SweepRow>,
