@@ -23,6 +23,7 @@ pub mod active_set;
 pub mod audit;
 pub mod closed_form;
 pub mod compare;
+pub mod converge;
 pub mod error;
 pub mod exact;
 pub mod expr;

@@ -42,6 +42,27 @@ enum Command {
         #[arg(long)]
         solver: Option<String>,
     },
+    /// Refinement study of the step solvers (convergence.csv, work-precision.png/.svg), or
+    /// with --viscosity-sweep the alpha -> 0 study of the impact scene.
+    Converge {
+        scene: String,
+        /// Comma-separated solvers: exact, osqp (eps 1e-4, 1e-7, 1e-10), penalty (epsilon 1e-3,
+        /// 1e-5, 1e-7).
+        #[arg(long, default_value = "exact,osqp,penalty")]
+        solvers: String,
+        /// Levels of refinement (elements doubled per level from the scene's mesh).
+        #[arg(long, default_value_t = viscobar::converge::DEFAULT_LEVELS)]
+        levels: u32,
+        /// dt/dx at every level [default: the scene's].
+        #[arg(long)]
+        ratio: Option<f64>,
+        /// Output folder [default: out/converge-<scene>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// The alpha -> 0 sweep against the elastic closed form (impact only).
+        #[arg(long)]
+        viscosity_sweep: bool,
+    },
     /// List the built-in scenes.
     Scenes,
     /// Print a built-in scene as TOML.
@@ -82,6 +103,20 @@ fn main() {
             }
         },
         Command::Verify { update } => verify(update),
+        Command::Converge {
+            scene,
+            solvers,
+            levels,
+            ratio,
+            out,
+            viscosity_sweep,
+        } => match converge(&scene, &solvers, levels, ratio, out, viscosity_sweep) {
+            Ok(()) => 0,
+            Err(e) => {
+                eprintln!("error: {e}");
+                e.exit_code()
+            }
+        },
         Command::Run {
             scene: name,
             out,
@@ -143,6 +178,38 @@ fn run(name: &str, out: Option<PathBuf>, set: &[String]) -> Result<(), viscobar:
             "warning: {n} steps accepted although OSQP reported `solved inaccurate` \
              (solver.accept_inaccurate = true); see inaccurate_steps and audit in summary.json"
         );
+    }
+    Ok(())
+}
+
+fn converge(
+    name: &str,
+    solvers: &str,
+    levels: u32,
+    ratio: Option<f64>,
+    out: Option<PathBuf>,
+    viscosity_sweep: bool,
+) -> Result<(), viscobar::converge::ConvergeError> {
+    use viscobar::converge;
+    let settings = converge::parse_solvers(solvers)?;
+    let (scene_name, scene) = scene::load(name, &[])?;
+    let out = out.unwrap_or_else(|| PathBuf::from("out").join(format!("converge-{scene_name}")));
+    let files = if viscosity_sweep {
+        let sweep = converge::viscosity_sweep(
+            &scene_name,
+            &scene,
+            &converge::SWEEP_ALPHAS,
+            &converge::SWEEP_ELEMENTS,
+        )?;
+        print!("{}", sweep.markdown());
+        sweep.write(&out)?
+    } else {
+        let study = converge::study(&scene_name, &scene, &settings, levels, ratio)?;
+        print!("{}", study.markdown());
+        study.write(&out)?
+    };
+    for f in &files {
+        println!("wrote {}", f.display());
     }
     Ok(())
 }

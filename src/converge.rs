@@ -1,0 +1,885 @@
+//! `viscobar converge`: refinement studies of every step solver against a reference (the
+//! scene's closed form, or a finer run of the exact solver), the work-precision diagram, and
+//! the `α → 0` sweep of the impact scene against the elastic closed form.
+//!
+//! Runs are independent and go to rayon's pool; each worker builds its own [`Simulation`]
+//! (OSQP's workspace is not `Send`), and results are sorted before anything is written, so the
+//! files do not depend on the scheduling. Wall times do: they are the only non-deterministic
+//! column.
+
+use crate::closed_form::{self, ClosedForm, Impact, Modal};
+use crate::error::RunError;
+use crate::run::{Tracker, write_atomically};
+use crate::scene::{Scene, SolverMethod, SolverSpec};
+use crate::simulation::Simulation;
+use crate::study::observed_order;
+use rayon::prelude::*;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// OSQP tolerances (`eps_abs = eps_rel`) of the work-precision study.
+pub const OSQP_EPS: [f64; 3] = [1e-4, 1e-7, 1e-10];
+/// Penalty parameters ε of the work-precision study.
+pub const PENALTY_EPSILON: [f64; 3] = [1e-3, 1e-5, 1e-7];
+/// Levels of refinement unless `--levels` says otherwise.
+pub const DEFAULT_LEVELS: u32 = 4;
+/// How many levels finer than the finest level the exact reference run is.
+pub const REFERENCE_EXTRA_LEVELS: u32 = 2;
+/// Most reference time samples kept (memory: nodes of the finest level × this × 8 bytes).
+pub const REFERENCE_MAX_SAMPLES: usize = 512;
+/// Step used to differentiate the modal amplitude for the exact energy: central differences,
+/// truncation ~h² and round-off ~1e-16/h, both below 1e-9 relative.
+const AMPLITUDE_DIFF_STEP: f64 = 1e-5;
+
+/// Why `viscobar converge` failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ConvergeError {
+    #[error("{0}")]
+    BadInput(String),
+    #[error(transparent)]
+    Run(#[from] RunError),
+    #[error(transparent)]
+    Scene(#[from] crate::error::SceneError),
+    #[error("cannot draw {path}: {message}")]
+    Draw { path: PathBuf, message: String },
+    #[error("cannot write {path}: {source}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+impl ConvergeError {
+    /// 2 for bad input, 1 for a failure during a run or while writing.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            ConvergeError::BadInput(_) | ConvergeError::Scene(_) => 2,
+            ConvergeError::Run(e) => e.exit_code(),
+            _ => 1,
+        }
+    }
+}
+
+/// One solver with one setting.
+#[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]
+pub enum SolverSetting {
+    Exact,
+    /// `eps_abs = eps_rel`.
+    Osqp(f64),
+    /// ε of (PP).
+    Penalty(f64),
+}
+
+impl SolverSetting {
+    pub fn solver(&self) -> &'static str {
+        match self {
+            SolverSetting::Exact => "exact",
+            SolverSetting::Osqp(_) => "osqp",
+            SolverSetting::Penalty(_) => "penalty",
+        }
+    }
+    /// `eps=1e-7`, `epsilon=1e-5` or `-`.
+    pub fn setting(&self) -> String {
+        match self {
+            SolverSetting::Exact => "-".into(),
+            SolverSetting::Osqp(e) => format!("eps={e:e}"),
+            SolverSetting::Penalty(e) => format!("epsilon={e:e}"),
+        }
+    }
+    fn label(&self) -> String {
+        match self {
+            SolverSetting::Exact => "exact".into(),
+            _ => format!("{} {}", self.solver(), self.setting()),
+        }
+    }
+    /// `scene` with its `[solver]` table replaced by this setting.
+    pub fn apply(&self, scene: &Scene) -> Scene {
+        let mut s = scene.clone();
+        s.solver = match *self {
+            SolverSetting::Exact => SolverSpec::default(),
+            SolverSetting::Osqp(e) => SolverSpec {
+                method: SolverMethod::Osqp,
+                eps_abs: Some(e),
+                eps_rel: Some(e),
+                ..SolverSpec::default()
+            },
+            SolverSetting::Penalty(e) => SolverSpec {
+                method: SolverMethod::Penalty,
+                epsilon: Some(e),
+                ..SolverSpec::default()
+            },
+        };
+        s
+    }
+}
+
+/// The settings of a comma-separated solver list (`exact,osqp,penalty`), in that order.
+pub fn parse_solvers(list: &str) -> Result<Vec<SolverSetting>, ConvergeError> {
+    let mut out = Vec::new();
+    for name in list.split(',').map(str::trim) {
+        match name {
+            "exact" => out.push(SolverSetting::Exact),
+            "osqp" => out.extend(OSQP_EPS.iter().map(|e| SolverSetting::Osqp(*e))),
+            "penalty" => out.extend(PENALTY_EPSILON.iter().map(|e| SolverSetting::Penalty(*e))),
+            _ => {
+                return Err(ConvergeError::BadInput(format!(
+                    "--solvers: unknown solver `{name}` (known: exact, osqp, penalty)"
+                )));
+            }
+        }
+    }
+    out.dedup();
+    Ok(out)
+}
+
+/// `base` with `base.elements · 2^level` elements and `dt = ratio · dx`.
+pub fn refined(base: &Scene, level: u32, ratio: f64) -> Scene {
+    let mut s = base.clone();
+    s.mesh.elements = base.mesh.elements << level;
+    s.time.step = ratio * s.dx();
+    s
+}
+
+/// What the runs are measured against.
+pub enum Reference {
+    /// The closed form of the built-in scene `name`.
+    ClosedForm { name: String },
+    /// A run of the exact solver at `elements` elements, sampled at `times` on the nodes of the
+    /// finest level of the study.
+    Run(Arc<SampledReference>),
+}
+
+impl Reference {
+    pub fn describe(&self) -> String {
+        match self {
+            Reference::ClosedForm { name } => format!("closed form ({name})"),
+            Reference::Run(r) => format!("exact solver, {} elements", r.elements),
+        }
+    }
+}
+
+/// A reference run kept at a few times on a coarser node set.
+pub struct SampledReference {
+    pub elements: usize,
+    /// The step indices (of the coarsest level) at which `values` are kept.
+    pub coarse_steps: Vec<usize>,
+    /// Steps of the coarsest level.
+    pub coarse_dt: f64,
+    /// Nodes of the finest level.
+    pub nodes: usize,
+    pub values: Vec<Vec<f64>>,
+}
+
+/// One row of `convergence.csv`.
+#[derive(Clone, Debug)]
+pub struct Row {
+    pub setting: SolverSetting,
+    pub level: u32,
+    pub elements: usize,
+    pub dx: f64,
+    pub dt: f64,
+    pub steps: usize,
+    pub l2_error: f64,
+    pub h1_error: f64,
+    pub energy_error: Option<f64>,
+    pub contact_time_error: Option<f64>,
+    pub wall_time_s: f64,
+}
+
+/// The exact energy of a closed form, where known.
+fn exact_energy(name: &str, scene: &Scene) -> Option<Box<dyn Fn(f64) -> f64>> {
+    let exact = closed_form::for_scene(name, scene)?;
+    drop(exact);
+    match name {
+        "modal" => {
+            let m = Modal {
+                length: scene.bar.length,
+                alpha: scene.bar.viscosity,
+                k: 2,
+            };
+            let w = m.k as f64 * std::f64::consts::PI / m.length;
+            // u = A cos(wx): E = ¼ L (A'² + w² A²).
+            Some(Box::new(move |t| {
+                let h = AMPLITUDE_DIFF_STEP;
+                let da = (m.amplitude(t + h) - m.amplitude(t - h)) / (2.0 * h);
+                let a = m.amplitude(t);
+                0.25 * m.length * (da * da + w * w * a * a)
+            }))
+        }
+        // Elastic, no work by the obstacle (u(0) is fixed while in contact): ½ v0² L.
+        "impact" => {
+            let v0 = impact_of(scene)?.speed;
+            let e = 0.5 * v0 * v0 * scene.bar.length;
+            Some(Box::new(move |_| e))
+        }
+        // Released at rest from (1 − x)/2: ½ ∫ u_x² = 1/8, conserved.
+        "clamped-impact" => Some(Box::new(|_| 0.125)),
+        _ => None,
+    }
+}
+
+fn impact_of(scene: &Scene) -> Option<Impact> {
+    let v = crate::expr::Expression::parse("initial.velocity", &scene.initial.velocity, false)
+        .ok()?
+        .eval(0.0, 0.0)
+        .ok()?;
+    Some(Impact {
+        length: scene.bar.length,
+        gap: scene.left.gap?,
+        speed: -v,
+    })
+}
+
+/// Trapezoidal weights on a uniform mesh.
+fn l2_norm(e: &[f64], dx: f64) -> f64 {
+    let n = e.len();
+    let mut s = 0.0;
+    for (i, v) in e.iter().enumerate() {
+        let w = if i == 0 || i + 1 == n { 0.5 } else { 1.0 };
+        s += w * v * v;
+    }
+    (s * dx).sqrt()
+}
+
+fn h1_seminorm(e: &[f64], dx: f64) -> f64 {
+    (e.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum::<f64>() / dx).sqrt()
+}
+
+/// Runs `scene` (already set to its solver and level), measuring against `reference`. Only
+/// the steps are timed.
+fn measure(
+    scene_name: &str,
+    scene: &Scene,
+    setting: SolverSetting,
+    level: u32,
+    finest: u32,
+    reference: &Reference,
+) -> Result<Row, RunError> {
+    let closed: Option<Box<dyn ClosedForm>> = match reference {
+        Reference::ClosedForm { name } => closed_form::for_scene(name, scene),
+        Reference::Run(_) => None,
+    };
+    let energy = match reference {
+        Reference::ClosedForm { name } => exact_energy(name, scene),
+        Reference::Run(_) => None,
+    };
+    let mut sim = Simulation::new(scene)?;
+    let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
+    let nodes = sim.discretisation().nodes;
+    let xs: Vec<f64> = (0..nodes).map(|i| sim.discretisation().x(i)).collect();
+    let (dx, dt) = (scene.dx(), scene.time.step);
+    let mut u = vec![0.0; nodes];
+    let mut e = vec![0.0; nodes];
+    let (mut l2, mut h1, mut en) = (0.0f64, 0.0f64, 0.0f64);
+    let mut sample = 0usize;
+    let mut observe = |sim: &Simulation, step: usize, u: &mut Vec<f64>, e: &mut Vec<f64>| {
+        let have = match (&closed, reference) {
+            (Some(c), _) => {
+                sim.displacement_into(u);
+                let t = sim.time();
+                for i in 0..nodes {
+                    e[i] = u[i] - c.displacement(xs[i], t);
+                }
+                true
+            }
+            (None, Reference::Run(r)) => {
+                // Steps of this level per coarse step, and finest-level nodes per node here.
+                let per = 1usize << level;
+                let stride = 1usize << (finest - level);
+                if sample < r.coarse_steps.len() && step == r.coarse_steps[sample] * per {
+                    sim.displacement_into(u);
+                    let v = &r.values[sample];
+                    for i in 0..nodes {
+                        e[i] = u[i] - v[i * stride];
+                    }
+                    sample += 1;
+                    true
+                } else {
+                    false
+                }
+            }
+            (None, Reference::ClosedForm { .. }) => false,
+        };
+        if have {
+            l2 = l2.max(l2_norm(e, dx));
+            h1 = h1.max(h1_seminorm(e, dx));
+        }
+    };
+    observe(&sim, 0, &mut u, &mut e);
+    let mut wall = 0.0;
+    for n in 1..scene.steps() {
+        let start = Instant::now();
+        let r = sim.step()?;
+        wall += start.elapsed().as_secs_f64();
+        tracker.observe(&r);
+        if let Some(f) = &energy {
+            // E^{n+1/2} lives at t_{n+1} − Δt/2.
+            en = en.max((r.energy - f(r.time - 0.5 * dt)).abs());
+        }
+        observe(&sim, n, &mut u, &mut e);
+    }
+    let contact_time_error = match reference {
+        Reference::ClosedForm { name } if name == "impact" => {
+            let imp = impact_of(scene);
+            let summary = tracker.finish(scene_name, &sim, wall);
+            match (imp, summary.contact_intervals.get("left")) {
+                (Some(imp), Some(iv)) if !iv.is_empty() => Some(
+                    (iv[0][0] - imp.contact_start()).abs()
+                        + (iv[iv.len() - 1][1] - imp.contact_end()).abs(),
+                ),
+                _ => None,
+            }
+        }
+        _ => None,
+    };
+    Ok(Row {
+        setting,
+        level,
+        elements: scene.mesh.elements as usize,
+        dx,
+        dt,
+        steps: scene.steps(),
+        l2_error: l2,
+        h1_error: h1,
+        energy_error: energy.map(|_| en),
+        contact_time_error,
+        wall_time_s: wall,
+    })
+}
+
+/// The exact solver at `levels − 1 + REFERENCE_EXTRA_LEVELS`, kept at (at most
+/// [`REFERENCE_MAX_SAMPLES`]) steps of the coarsest level, on the finest level's nodes.
+fn reference_run(base: &Scene, levels: u32, ratio: f64) -> Result<SampledReference, RunError> {
+    let finest = levels - 1;
+    let scene = SolverSetting::Exact.apply(&refined(base, finest + REFERENCE_EXTRA_LEVELS, ratio));
+    let coarse = refined(base, 0, ratio);
+    let coarse_steps_total = coarse.steps();
+    let every = coarse_steps_total.div_ceil(REFERENCE_MAX_SAMPLES).max(1);
+    let coarse_steps: Vec<usize> = (0..coarse_steps_total).step_by(every).collect();
+    let per = 1usize << (finest + REFERENCE_EXTRA_LEVELS);
+    let stride = 1usize << REFERENCE_EXTRA_LEVELS;
+    let mut sim = Simulation::new(&scene)?;
+    let all = sim.discretisation().nodes;
+    let mut u = vec![0.0; all];
+    let mut values = Vec::with_capacity(coarse_steps.len());
+    let mut next = 0usize;
+    let mut n = 0usize;
+    loop {
+        if next < coarse_steps.len() && n == coarse_steps[next] * per {
+            sim.displacement_into(&mut u);
+            values.push(u.iter().step_by(stride).copied().collect::<Vec<f64>>());
+            next += 1;
+        }
+        if next == coarse_steps.len() || n + 1 >= scene.steps() {
+            break;
+        }
+        sim.step()?;
+        n += 1;
+    }
+    let kept = values.len();
+    Ok(SampledReference {
+        elements: scene.mesh.elements as usize,
+        coarse_steps: coarse_steps[..kept].to_vec(),
+        coarse_dt: coarse.time.step,
+        nodes: (all - 1) / stride + 1,
+        values,
+    })
+}
+
+/// The outcome of a study.
+#[derive(Debug)]
+pub struct Study {
+    pub scene: String,
+    pub reference: String,
+    pub rows: Vec<Row>,
+}
+
+/// Runs every setting at every level in parallel. `ratio`: `dt/dx` (default: the scene's).
+pub fn study(
+    scene_name: &str,
+    base: &Scene,
+    settings: &[SolverSetting],
+    levels: u32,
+    ratio: Option<f64>,
+) -> Result<Study, ConvergeError> {
+    if levels < 2 {
+        return Err(ConvergeError::BadInput(format!(
+            "--levels {levels}: at least 2 levels are needed for an observed order"
+        )));
+    }
+    if levels > 12 {
+        return Err(ConvergeError::BadInput(format!(
+            "--levels {levels}: at most 12 (each level doubles the elements)"
+        )));
+    }
+    let ratio = ratio.unwrap_or(base.time.step / base.dx());
+    if !(ratio.is_finite() && ratio > 0.0) {
+        return Err(ConvergeError::BadInput(format!(
+            "--ratio {ratio}: dt/dx must be positive and finite"
+        )));
+    }
+    let reference = if closed_form::for_scene(scene_name, base).is_some() {
+        Reference::ClosedForm {
+            name: scene_name.to_string(),
+        }
+    } else {
+        Reference::Run(Arc::new(reference_run(base, levels, ratio)?))
+    };
+    let tasks: Vec<(SolverSetting, u32)> = settings
+        .iter()
+        .flat_map(|s| (0..levels).map(move |l| (*s, l)))
+        .collect();
+    // Largest tasks first, so the pool is not left waiting on one long run at the end.
+    let mut order: Vec<usize> = (0..tasks.len()).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(tasks[i].1));
+    let mut rows = order
+        .par_iter()
+        .map(|&i| {
+            let (setting, level) = tasks[i];
+            let scene = setting.apply(&refined(base, level, ratio));
+            measure(scene_name, &scene, setting, level, levels - 1, &reference).map(|r| (i, r))
+        })
+        .collect::<Result<Vec<_>, RunError>>()?;
+    rows.sort_by_key(|(i, _)| *i);
+    Ok(Study {
+        scene: scene_name.to_string(),
+        reference: reference.describe(),
+        rows: rows.into_iter().map(|(_, r)| r).collect(),
+    })
+}
+
+/// The settings in the order they first appear.
+fn settings_of(rows: &[Row]) -> Vec<SolverSetting> {
+    let mut out: Vec<SolverSetting> = Vec::new();
+    for r in rows {
+        if !out.contains(&r.setting) {
+            out.push(r.setting);
+        }
+    }
+    out
+}
+
+impl Study {
+    /// Observed orders (L2, H1) per setting: least-squares slopes of log error against log dx.
+    pub fn orders(&self) -> Vec<(SolverSetting, f64, f64)> {
+        settings_of(&self.rows)
+            .into_iter()
+            .map(|s| {
+                let rs: Vec<&Row> = self.rows.iter().filter(|r| r.setting == s).collect();
+                let h: Vec<f64> = rs.iter().map(|r| r.dx).collect();
+                let l2: Vec<f64> = rs.iter().map(|r| r.l2_error).collect();
+                let h1: Vec<f64> = rs.iter().map(|r| r.h1_error).collect();
+                (s, observed_order(&h, &l2), observed_order(&h, &h1))
+            })
+            .collect()
+    }
+
+    pub fn csv(&self) -> String {
+        let mut out = String::from(
+            "solver,setting,elements,dt,steps,l2_error,h1_error,energy_error,contact_time_error,wall_time_s,reference\n",
+        );
+        let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:e}"));
+        for r in &self.rows {
+            let _ = writeln!(
+                out,
+                "{},{},{},{:e},{},{:e},{:e},{},{},{:.6},{}",
+                r.setting.solver(),
+                r.setting.setting(),
+                r.elements,
+                r.dt,
+                r.steps,
+                r.l2_error,
+                r.h1_error,
+                opt(r.energy_error),
+                opt(r.contact_time_error),
+                r.wall_time_s,
+                self.reference
+            );
+        }
+        out
+    }
+
+    pub fn markdown(&self) -> String {
+        let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3e}"));
+        let mut md = format!(
+            "Scene `{}`, reference: {}\n\n| solver | setting | elements | dt | L2 error | H1 error | energy error | contact time error | wall time (s) |\n|---|---|---|---|---|---|---|---|---|\n",
+            self.scene, self.reference
+        );
+        for r in &self.rows {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {:.3e} | {:.3e} | {:.3e} | {} | {} | {:.2e} |",
+                r.setting.solver(),
+                r.setting.setting(),
+                r.elements,
+                r.dt,
+                r.l2_error,
+                r.h1_error,
+                opt(r.energy_error),
+                opt(r.contact_time_error),
+                r.wall_time_s
+            );
+        }
+        md.push_str("\n| solver | setting | observed order (L2) | observed order (H1) |\n|---|---|---|---|\n");
+        for (s, p2, p1) in self.orders() {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {p2:.3} | {p1:.3} |",
+                s.solver(),
+                s.setting()
+            );
+        }
+        md
+    }
+
+    /// Writes `convergence.csv`, `work-precision.png` and `work-precision.svg` into `out`.
+    pub fn write(&self, out: &Path) -> Result<Vec<PathBuf>, ConvergeError> {
+        std::fs::create_dir_all(out).map_err(|source| ConvergeError::Write {
+            path: out.to_path_buf(),
+            source,
+        })?;
+        let csv = out.join("convergence.csv");
+        write_atomically(&csv, self.csv().as_bytes()).map_err(|source| ConvergeError::Write {
+            path: csv.clone(),
+            source,
+        })?;
+        let mut files = vec![csv];
+        for ext in ["png", "svg"] {
+            let path = out.join(format!("work-precision.{ext}"));
+            write_plot(&path, &self.title(), &self.lines())?;
+            files.push(path);
+        }
+        Ok(files)
+    }
+
+    fn title(&self) -> String {
+        format!(
+            "{}: L2 error against wall time (reference: {})",
+            self.scene, self.reference
+        )
+    }
+
+    /// `(label, [(wall time, L2 error)])` per setting.
+    fn lines(&self) -> Vec<(String, Vec<(f64, f64)>)> {
+        settings_of(&self.rows)
+            .into_iter()
+            .map(|s| {
+                let pts = self
+                    .rows
+                    .iter()
+                    .filter(|r| r.setting == s)
+                    .map(|r| (r.wall_time_s.max(1e-6), r.l2_error.max(1e-300)))
+                    .collect();
+                (s.label(), pts)
+            })
+            .collect()
+    }
+}
+
+/// Line colours, one per setting (exact, then OSQP shades, then penalty shades).
+const COLOURS: [(u8, u8, u8); 7] = [
+    (0, 0, 0),
+    (8, 81, 156),
+    (49, 130, 189),
+    (107, 174, 214),
+    (165, 15, 21),
+    (222, 45, 38),
+    (251, 106, 74),
+];
+/// Size of the work-precision figure (pixels).
+const PLOT_SIZE: (u32, u32) = (900, 640);
+
+/// Draws a log-log diagram and writes it (PNG or SVG, by extension) via a temporary file.
+fn write_plot(
+    path: &Path,
+    title: &str,
+    lines: &[(String, Vec<(f64, f64)>)],
+) -> Result<(), ConvergeError> {
+    use plotters::prelude::*;
+    crate::figures::register_font().map_err(|e| ConvergeError::Draw {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    let file = path
+        .file_name()
+        .map_or_else(String::new, |f| f.to_string_lossy().into_owned());
+    let tmp = path.with_file_name(format!(".partial-{}-{file}", std::process::id()));
+    let bounds = |f: fn(&(f64, f64)) -> f64| {
+        let vals = lines.iter().flat_map(|l| l.1.iter().map(f));
+        let (lo, hi) = vals.fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        (lo / 1.5, hi * 1.5)
+    };
+    let (x0, x1) = bounds(|p| p.0);
+    let (y0, y1) = bounds(|p| p.1);
+    fn draw<DB: DrawingBackend>(
+        root: DrawingArea<DB, plotters::coord::Shift>,
+        title: &str,
+        lines: &[(String, Vec<(f64, f64)>)],
+        (x0, x1, y0, y1): (f64, f64, f64, f64),
+    ) -> Result<(), Box<dyn std::error::Error>>
+    where
+        DB::ErrorType: 'static,
+    {
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(75)
+            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+        chart
+            .configure_mesh()
+            .x_desc("wall time of the steps (s)")
+            .y_desc("L2 error (max over t)")
+            .label_style(("sans-serif", 15))
+            .axis_desc_style(("sans-serif", 17))
+            .x_label_formatter(&|v| format!("{v:.0e}"))
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()?;
+        for (k, (label, pts)) in lines.iter().enumerate() {
+            let (r, g, b) = COLOURS[k % COLOURS.len()];
+            let colour = RGBColor(r, g, b);
+            chart
+                .draw_series(LineSeries::new(pts.iter().copied(), colour.stroke_width(2)))?
+                .label(label.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
+            chart.draw_series(pts.iter().map(|p| Circle::new(*p, 4, colour.filled())))?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 15))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()?;
+        root.present()?;
+        Ok(())
+    }
+    let b = (x0, x1, y0, y1);
+    let drawn = if path.extension().is_some_and(|e| e == "svg") {
+        let mut svg = String::new();
+        let r = draw(
+            SVGBackend::with_string(&mut svg, PLOT_SIZE).into_drawing_area(),
+            title,
+            lines,
+            b,
+        );
+        r.and_then(|()| Ok(std::fs::write(&tmp, svg)?))
+    } else {
+        draw(
+            BitMapBackend::new(&tmp, PLOT_SIZE).into_drawing_area(),
+            title,
+            lines,
+            b,
+        )
+    };
+    let result = drawn
+        .map_err(|e| ConvergeError::Draw {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })
+        .and_then(|()| {
+            std::fs::rename(&tmp, path).map_err(|source| ConvergeError::Write {
+                path: path.to_path_buf(),
+                source,
+            })
+        });
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Viscosities of the `α → 0` sweep: half-decades from 1e-1 down to 1e-6.
+pub const SWEEP_ALPHAS: [f64; 11] = [
+    1e-1,
+    3.162_277_660_168_379_5e-2,
+    1e-2,
+    3.162_277_660_168_379_5e-3,
+    1e-3,
+    3.162_277_660_168_379_5e-4,
+    1e-4,
+    3.162_277_660_168_379_5e-5,
+    1e-5,
+    3.162_277_660_168_379_5e-6,
+    1e-6,
+];
+/// Meshes of the sweep (dt = dx): a fixed fine mesh and one refined twice.
+pub const SWEEP_ELEMENTS: [u64; 2] = [1600, 6400];
+
+/// One row of `viscosity-sweep.csv`.
+#[derive(Clone, Debug)]
+pub struct SweepRow {
+    pub alpha: f64,
+    pub elements: u64,
+    pub dt: f64,
+    /// `max_n ‖u_h^α(t_n) − u^0(·, t_n)‖_{L2}`, `u^0` the elastic closed form.
+    pub l2_to_closed_form: f64,
+    /// `max_n ‖u_h^α(t_n) − u_h^0(t_n)‖_{L2}`: the same mesh and dt, α = 0 (no discretisation
+    /// error in the difference).
+    pub l2_to_discrete_elastic: f64,
+    /// `(E^{1/2} − E^{N−1/2}) / E^{1/2}`.
+    pub energy_loss: f64,
+}
+
+/// The outcome of the sweep.
+#[derive(Debug)]
+pub struct Sweep {
+    pub scene: String,
+    pub rows: Vec<SweepRow>,
+}
+
+/// Runs `scene` (the impact scene, any α) with `α` in `alphas` at each mesh of `elements`
+/// (dt = dx), in parallel, beside the α = 0 run on the same mesh.
+pub fn viscosity_sweep(
+    scene_name: &str,
+    base: &Scene,
+    alphas: &[f64],
+    elements: &[u64],
+) -> Result<Sweep, ConvergeError> {
+    let mut elastic = SolverSetting::Exact.apply(base);
+    elastic.bar.viscosity = 0.0;
+    if scene_name != "impact" || closed_form::for_scene(scene_name, &elastic).is_none() {
+        return Err(ConvergeError::BadInput(format!(
+            "--viscosity-sweep: needs the `impact` scene (its elastic closed form); got `{scene_name}`"
+        )));
+    }
+    let tasks: Vec<(u64, f64)> = elements
+        .iter()
+        .flat_map(|j| alphas.iter().map(move |a| (*j, *a)))
+        .collect();
+    let rows = tasks
+        .par_iter()
+        .map(|&(j, alpha)| sweep_one(&elastic, j, alpha))
+        .collect::<Result<Vec<_>, RunError>>()?;
+    Ok(Sweep {
+        scene: scene_name.to_string(),
+        rows,
+    })
+}
+
+fn sweep_one(elastic: &Scene, elements: u64, alpha: f64) -> Result<SweepRow, RunError> {
+    let mut e0 = elastic.clone();
+    e0.mesh.elements = elements;
+    e0.time.step = e0.dx();
+    let mut va = e0.clone();
+    va.bar.viscosity = alpha;
+    let exact = impact_of(&e0).expect("checked by viscosity_sweep");
+    let mut s0 = Simulation::new(&e0)?;
+    let mut sa = Simulation::new(&va)?;
+    let nodes = s0.discretisation().nodes;
+    let dx = e0.dx();
+    let xs: Vec<f64> = (0..nodes).map(|i| s0.discretisation().x(i)).collect();
+    let (mut u0, mut ua, mut d) = (vec![0.0; nodes], vec![0.0; nodes], vec![0.0; nodes]);
+    let (mut to_closed, mut to_discrete) = (0.0f64, 0.0f64);
+    let mut e_first = None;
+    let mut e_last = 0.0;
+    for n in 0..e0.steps() {
+        if n > 0 {
+            s0.step()?;
+            let r = sa.step()?;
+            e_first.get_or_insert(r.energy);
+            e_last = r.energy;
+        }
+        s0.displacement_into(&mut u0);
+        sa.displacement_into(&mut ua);
+        let t = sa.time();
+        for i in 0..nodes {
+            d[i] = ua[i] - exact.displacement(xs[i], t);
+        }
+        to_closed = to_closed.max(l2_norm(&d, dx));
+        for i in 0..nodes {
+            d[i] = ua[i] - u0[i];
+        }
+        to_discrete = to_discrete.max(l2_norm(&d, dx));
+    }
+    let e_first = e_first.unwrap_or(sa.first_record().energy);
+    Ok(SweepRow {
+        alpha,
+        elements,
+        dt: e0.time.step,
+        l2_to_closed_form: to_closed,
+        l2_to_discrete_elastic: to_discrete,
+        energy_loss: (e_first - e_last) / e_first,
+    })
+}
+
+impl Sweep {
+    /// Fitted exponents `p` of `distance ~ α^p` per mesh: (elements, p to the closed form, p to
+    /// the discrete elastic run, p of the energy loss).
+    pub fn exponents(&self) -> Vec<(u64, f64, f64, f64)> {
+        let mut meshes: Vec<u64> = self.rows.iter().map(|r| r.elements).collect();
+        meshes.dedup();
+        meshes
+            .into_iter()
+            .map(|j| {
+                let rs: Vec<&SweepRow> = self.rows.iter().filter(|r| r.elements == j).collect();
+                let a: Vec<f64> = rs.iter().map(|r| r.alpha).collect();
+                let f = |g: fn(&SweepRow) -> f64| {
+                    observed_order(&a, &rs.iter().map(|r| g(r)).collect::<Vec<f64>>())
+                };
+                (
+                    j,
+                    f(|r| r.l2_to_closed_form),
+                    f(|r| r.l2_to_discrete_elastic),
+                    f(|r| r.energy_loss),
+                )
+            })
+            .collect()
+    }
+
+    pub fn csv(&self) -> String {
+        let mut out = String::from(
+            "alpha,elements,dt,l2_to_closed_form,l2_to_discrete_elastic,energy_loss\n",
+        );
+        for r in &self.rows {
+            let _ = writeln!(
+                out,
+                "{:e},{},{:e},{:e},{:e},{:e}",
+                r.alpha,
+                r.elements,
+                r.dt,
+                r.l2_to_closed_form,
+                r.l2_to_discrete_elastic,
+                r.energy_loss
+            );
+        }
+        out
+    }
+
+    /// Deterministic (no timings): the table and the fitted exponents.
+    pub fn markdown(&self) -> String {
+        let mut md = String::from(
+            "| alpha | elements | L2 distance to elastic closed form | L2 distance to discrete elastic run | relative energy loss |\n|---|---|---|---|---|\n",
+        );
+        for r in &self.rows {
+            let _ = writeln!(
+                md,
+                "| {:.2e} | {} | {:.3e} | {:.3e} | {:.3e} |",
+                r.alpha, r.elements, r.l2_to_closed_form, r.l2_to_discrete_elastic, r.energy_loss
+            );
+        }
+        md.push_str("\n| elements | p (closed form) | p (discrete elastic) | p (energy loss) |\n|---|---|---|---|\n");
+        for (j, a, b, c) in self.exponents() {
+            let _ = writeln!(md, "| {j} | {a:.3} | {b:.3} | {c:.3} |");
+        }
+        md
+    }
+
+    pub fn write(&self, out: &Path) -> Result<Vec<PathBuf>, ConvergeError> {
+        std::fs::create_dir_all(out).map_err(|source| ConvergeError::Write {
+            path: out.to_path_buf(),
+            source,
+        })?;
+        let csv = out.join("viscosity-sweep.csv");
+        write_atomically(&csv, self.csv().as_bytes()).map_err(|source| ConvergeError::Write {
+            path: csv.clone(),
+            source,
+        })?;
+        Ok(vec![csv])
+    }
+}
