@@ -1,23 +1,35 @@
 //! The per-step path allocates nothing: a counting global allocator watches `Simulation::step`
-//! on every built-in scene (this test binary holds only this test, so no other thread
-//! allocates while it counts).
+//! on every built-in scene. The count is per thread, so the test harness's own threads (which
+//! may allocate while the test runs) are not counted.
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn count() {
+    // `try_with`: the thread-local may already be gone while a thread shuts down.
+    let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(Cell::get)
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        count();
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        count();
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 }
@@ -31,11 +43,11 @@ fn steps_do_not_allocate() {
         let (_, scene) = viscobar::scene::load(name, &[]).unwrap();
         let mut sim = viscobar::Simulation::new(&scene).unwrap();
         sim.step().unwrap(); // warm-up outside the count
-        let before = ALLOCATIONS.load(Ordering::SeqCst);
+        let before = allocations();
         for _ in 0..100 {
             sim.step().unwrap();
         }
-        let allocations = ALLOCATIONS.load(Ordering::SeqCst) - before;
+        let allocations = allocations() - before;
         assert_eq!(
             allocations, 0,
             "{name}: {allocations} allocations in 100 steps"
