@@ -31,6 +31,7 @@ pub fn sections() -> Result<Vec<Section>, RunError> {
         scenes_section()?,
         convergence_section()?,
         roundoff_section()?,
+        viscosity_section()?,
     ])
 }
 
@@ -200,4 +201,18 @@ pub fn update_document(doc: &str, sections: &[Section]) -> Result<String, String
         out.replace_range(a + open.len()..b, &s.markdown);
     }
     Ok(out)
+}
+
+/// The α → 0 study in reduced size (the full one: `viscobar converge impact --viscosity-sweep`).
+pub const SWEEP_ALPHAS: [f64; 4] = [1e-1, 1e-2, 1e-3, 1e-4];
+pub const SWEEP_ELEMENTS: [u64; 2] = [800, 1600];
+
+fn viscosity_section() -> Result<Section, RunError> {
+    let (_, base) = scene::load("impact", &[])?;
+    let sweep = crate::converge::viscosity_sweep("impact", &base, &SWEEP_ALPHAS, &SWEEP_ELEMENTS)
+        .map_err(|e| RunError::Scene(crate::error::SceneError::Syntax(e.to_string())))?;
+    Ok(Section {
+        id: "viscosity",
+        markdown: sweep.markdown(),
+    })
 }
