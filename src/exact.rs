@@ -15,10 +15,11 @@
 use crate::solver::{SolveInfo, StepFailure, StepSolver};
 use crate::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
 
-/// Column `C⁻¹ e_j`, truncated to where it is a normal floating-point number.
+/// Column `C⁻¹ e_j`, truncated to where it is a normal floating-point number. Shared with the
+/// penalty solver, which uses the same Schur complement.
 #[derive(Clone, Debug)]
-struct Column {
-    node: usize,
+pub(crate) struct Column {
+    pub(crate) node: usize,
     values: Vec<f64>,
     /// Entries outside `support` are below `f64::MIN_POSITIVE` in magnitude and are dropped:
     /// adding `r · c` with such `c` cannot change a displacement that is not itself subnormal.
@@ -42,36 +43,8 @@ impl ExactSolver {
             "the end-node enumeration handles at most two bounds"
         );
         let factor = Ldlt::factor(c)?;
-        let columns: Vec<Column> = nodes
-            .iter()
-            .map(|&node| {
-                let mut values = factor.column_of_inverse(node);
-                for v in values.iter_mut() {
-                    if v.abs() < f64::MIN_POSITIVE {
-                        *v = 0.0;
-                    }
-                }
-                let start = values.iter().position(|v| *v != 0.0).unwrap_or(0);
-                let end = values.iter().rposition(|v| *v != 0.0).map_or(0, |e| e + 1);
-                Column {
-                    node,
-                    values,
-                    support: start..end,
-                }
-            })
-            .collect();
-        let mut schur = [[0.0; 2]; 2];
-        for (a, ca) in columns.iter().enumerate() {
-            for (b, cb) in columns.iter().enumerate() {
-                schur[a][b] = ca.values[cb.node];
-            }
-        }
-        // C⁻¹ is symmetric; make S bitwise symmetric so the choice does not depend on order.
-        if columns.len() == 2 {
-            let s = 0.5 * (schur[0][1] + schur[1][0]);
-            schur[0][1] = s;
-            schur[1][0] = s;
-        }
+        let columns = inverse_columns(&factor, nodes);
+        let schur = schur_complement(&columns);
         Ok(Self {
             factor,
             columns,
@@ -154,13 +127,7 @@ impl StepSolver for ExactSolver {
             let active = mask & (1 << j) != 0;
             reactions[j] = if active { r[j] } else { 0.0 };
             if active && r[j] != 0.0 {
-                let rj = r[j];
-                for (zi, ci) in z[col.support.clone()]
-                    .iter_mut()
-                    .zip(&col.values[col.support.clone()])
-                {
-                    *zi += rj * ci;
-                }
+                col.add_scaled(r[j], z);
             }
         }
         for (j, col) in self.columns.iter().enumerate() {
@@ -172,5 +139,54 @@ impl StepSolver for ExactSolver {
             return Err(StepFailure::NonFinite);
         }
         Ok(SolveInfo { iterations: tried })
+    }
+}
+
+/// `C⁻¹ e_j` for each node, computed with `factor` (set-up only).
+pub(crate) fn inverse_columns(factor: &Ldlt, nodes: &[usize]) -> Vec<Column> {
+    nodes
+        .iter()
+        .map(|&node| {
+            let mut values = factor.column_of_inverse(node);
+            for v in values.iter_mut() {
+                if v.abs() < f64::MIN_POSITIVE {
+                    *v = 0.0;
+                }
+            }
+            let start = values.iter().position(|v| *v != 0.0).unwrap_or(0);
+            let end = values.iter().rposition(|v| *v != 0.0).map_or(0, |e| e + 1);
+            Column {
+                node,
+                values,
+                support: start..end,
+            }
+        })
+        .collect()
+}
+
+/// `S_jk = (C⁻¹)_{jk}` on the (at most two) nodes, made bitwise symmetric so that no choice
+/// made from it depends on the order of the nodes.
+pub(crate) fn schur_complement(columns: &[Column]) -> [[f64; 2]; 2] {
+    let mut schur = [[0.0; 2]; 2];
+    for (a, ca) in columns.iter().enumerate() {
+        for (b, cb) in columns.iter().enumerate() {
+            schur[a][b] = ca.values[cb.node];
+        }
+    }
+    if columns.len() == 2 {
+        let s = 0.5 * (schur[0][1] + schur[1][0]);
+        schur[0][1] = s;
+        schur[1][0] = s;
+    }
+    schur
+}
+
+impl Column {
+    /// `z += r · C⁻¹ e_j` over the column's numerical support.
+    pub(crate) fn add_scaled(&self, r: f64, z: &mut [f64]) {
+        let range = self.support.clone();
+        for (zi, ci) in z[range.clone()].iter_mut().zip(&self.values[range]) {
+            *zi += r * ci;
+        }
     }
 }

@@ -31,17 +31,9 @@
 
 use crate::audit::{KktAudit, Law};
 use crate::error::{RunError, SceneError};
+use crate::exact::{Column, inverse_columns, schur_complement};
 use crate::solver::{SolveInfo, SolverReport, StepFailure, StepSolver};
 use crate::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
-
-/// Column `C⁻¹ e_j` on its numerical support (as in [`crate::exact`]).
-#[derive(Clone, Debug)]
-struct Column {
-    node: usize,
-    values: Vec<f64>,
-    /// Entries outside are below `f64::MIN_POSITIVE` in magnitude and dropped.
-    support: std::ops::Range<usize>,
-}
 
 /// Why the penalty solver could not be set up.
 #[derive(Debug, thiserror::Error)]
@@ -96,36 +88,10 @@ impl PenaltySolver {
             return Err(PenaltySetupError::Epsilon(epsilon));
         }
         let factor = Ldlt::factor(c)?;
-        let columns: Vec<Column> = nodes
-            .iter()
-            .map(|&node| {
-                let mut values = factor.column_of_inverse(node);
-                for v in values.iter_mut() {
-                    if v.abs() < f64::MIN_POSITIVE {
-                        *v = 0.0;
-                    }
-                }
-                let start = values.iter().position(|v| *v != 0.0).unwrap_or(0);
-                let end = values.iter().rposition(|v| *v != 0.0).map_or(0, |e| e + 1);
-                Column {
-                    node,
-                    values,
-                    support: start..end,
-                }
-            })
-            .collect();
-        let mut matrix = [[0.0; 2]; 2];
-        for (a, ca) in columns.iter().enumerate() {
-            for (b, cb) in columns.iter().enumerate() {
-                matrix[a][b] = ca.values[cb.node];
-            }
-            matrix[a][a] += epsilon;
-        }
-        if columns.len() == 2 {
-            // Bitwise symmetric, so the choice does not depend on the order of the nodes.
-            let s = 0.5 * (matrix[0][1] + matrix[1][0]);
-            matrix[0][1] = s;
-            matrix[1][0] = s;
+        let columns = inverse_columns(&factor, nodes);
+        let mut matrix = schur_complement(&columns);
+        for (a, row) in matrix.iter_mut().enumerate().take(columns.len()) {
+            row[a] += epsilon;
         }
         let audit = KktAudit::new(c, nodes, true)?;
         Ok(Self {
@@ -210,13 +176,7 @@ impl StepSolver for PenaltySolver {
             let active = mask & (1 << j) != 0;
             reactions[j] = if active { r[j] } else { 0.0 };
             if active && r[j] != 0.0 {
-                let rj = r[j];
-                for (zi, ci) in z[col.support.clone()]
-                    .iter_mut()
-                    .zip(&col.values[col.support.clone()])
-                {
-                    *zi += rj * ci;
-                }
+                col.add_scaled(r[j], z);
             }
         }
         let law = Law::Penalty {
