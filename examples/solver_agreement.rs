@@ -1,4 +1,4 @@
-//! The figures of docs/solvers-verification.md, as markdown:
+//! The figures of VERIFICATION.md, section "Step solvers", as markdown:
 //!
 //!     cargo run --release --example solver_agreement
 //!
@@ -80,6 +80,9 @@ fn agreement_tables() {
     println!("|---|---|---|---|---|---|---|");
     for name in scene::builtin_names() {
         let exact = load(name, &[]);
+        if exact.obstacle.is_some() {
+            continue; // normal compliance is implemented for the two ends only
+        }
         let pen = load(name, &method("penalty", &[]));
         let c = compare(name, &exact, &pen).unwrap();
         let s = &c.summary;

@@ -24,7 +24,7 @@
 //! and adds one check OSQP does not make: the stationarity residual mapped to displacement,
 //! `‖C⁻¹(Cz − b − Σ r_j e_j)‖_∞`, the change of `z` that would make stationarity exact, with
 //! scale `‖z‖_∞`. A residual within OSQP's tolerance can hide an error in `z` up to `κ(C)` times
-//! larger; this check refuses such answers (the failure case in docs/solvers-verification.md).
+//! larger; this check refuses such answers (the failure case in VERIFICATION.md, section "Step solvers").
 //!
 //! Each tolerance also has a round-off floor: the residual that an answer exact to the last bit
 //! still shows when recomputed in floating point (see [`ROUNDOFF_ULPS`]); with `eps = 0` (the

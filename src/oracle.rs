@@ -16,18 +16,26 @@ pub struct OracleSolution {
 /// Largest number of bounds the oracle accepts (2^k dense solves).
 pub const MAX_ORACLE_BOUNDS: usize = 16;
 
+/// The oracle refuses problems with more than [`MAX_ORACLE_BOUNDS`] bounds.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error("the brute-force oracle refuses {0} bounds (2^{0} solves); at most {MAX_ORACLE_BOUNDS}")]
+pub struct TooManyBounds(pub usize);
+
 /// `min ½ zᵀCz − bᵀz` s.t. `z[nodes[j]] >= lower[j]`, by enumeration; `C` dense SPD.
 /// Feasibility of each candidate is judged with slack `tol` (round-off in the dense solve).
+/// `Ok(None)` when no active set gives a feasible point (only possible through round-off).
 pub fn brute_force(
     c: &DMatrix<f64>,
     b: &[f64],
     nodes: &[usize],
     lower: &[f64],
     tol: f64,
-) -> Option<OracleSolution> {
+) -> Result<Option<OracleSolution>, TooManyBounds> {
     let n = b.len();
     let k = nodes.len();
-    assert!(k <= MAX_ORACLE_BOUNDS, "refusing 2^{k} solves");
+    if k > MAX_ORACLE_BOUNDS {
+        return Err(TooManyBounds(k));
+    }
     let bv = DVector::from_column_slice(b);
     let mut best: Option<OracleSolution> = None;
     for mask in 0u32..(1 << k) {
@@ -65,5 +73,5 @@ pub fn brute_force(
             });
         }
     }
-    best
+    Ok(best)
 }

@@ -219,6 +219,7 @@ pub fn run_to_dir(
         move |source| RunError::Write { path, source }
     };
     std::fs::create_dir_all(out).map_err(write_err(out))?;
+    remove_stale_partials(out);
     let tmp = out.join(format!(".viscobar-partial-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&tmp);
     std::fs::create_dir_all(&tmp).map_err(write_err(&tmp))?;
@@ -388,4 +389,22 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+/// Removes the temporary folders that interrupted runs (killed before they could clean up)
+/// left in `out`, unless their process is still running.
+fn remove_stale_partials(out: &Path) {
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some(pid) = name.strip_prefix(".viscobar-partial-") else {
+            continue;
+        };
+        let alive = Path::new("/proc").join(pid).exists();
+        if !alive {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
 }

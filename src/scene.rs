@@ -196,7 +196,7 @@ pub struct SolverSpec {
 }
 
 /// OSQP's `eps_abs` and `eps_rel` unless set: tight enough that, polished, the answer agrees
-/// with the exact solver to round-off on the talk's scenes (docs/solvers-verification.md).
+/// with the exact solver to round-off on the talk's scenes (VERIFICATION.md, section "Step solvers").
 pub const OSQP_DEFAULT_EPS: f64 = 1e-10;
 /// OSQP's iteration limit unless set: far above what the talk's scenes need per step.
 pub const OSQP_DEFAULT_MAX_ITER: u32 = 100_000;

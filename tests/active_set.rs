@@ -76,7 +76,7 @@ proptest! {
         let nodes: Vec<usize> = (0..n).filter(|i| mask & (1 << i) != 0).collect();
         let lo: Vec<f64> = nodes.iter().map(|&i| lo[i]).collect();
         let (z, r, _) = solve(&c, b, &nodes, &lo);
-        let oracle = brute_force(&c.to_dense(), b, &nodes, &lo, 1e-12).unwrap();
+        let oracle = brute_force(&c.to_dense(), b, &nodes, &lo, 1e-12).unwrap().unwrap();
         let scale = 1.0 + z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for i in 0..n {
             prop_assert!((z[i] - oracle.z[i]).abs() <= AGREEMENT_TOL * scale, "node {i}: {} vs {}", z[i], oracle.z[i]);
@@ -185,4 +185,13 @@ fn near_ties_terminate_deterministically() {
         first.0 == second.0 && first.1 == second.1,
         "same input, same bits"
     );
+}
+
+#[test]
+fn the_oracle_refuses_more_than_16_bounds() {
+    let c = step_matrix(20, 1.0, 0.0);
+    let n = c.dim();
+    let nodes: Vec<usize> = (0..17).collect();
+    let e = brute_force(&c.to_dense(), &vec![0.0; n], &nodes, &[0.0; 17], 1e-12).unwrap_err();
+    assert_eq!(e.0, 17);
 }

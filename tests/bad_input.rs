@@ -266,3 +266,24 @@ fn a_failed_run_exits_1_names_the_step_and_keeps_the_earlier_result() {
         "the earlier result must survive, and nothing else appear"
     );
 }
+
+#[test]
+fn a_rerun_removes_what_an_interrupted_run_left_behind() {
+    let dir = fresh_dir("interrupted");
+    // What a run killed mid-way leaves: its hidden temporary folder with half-written files.
+    // PID 0 is never a user process, so the folder cannot belong to a running viscobar.
+    let stale = dir.join(".viscobar-partial-0");
+    std::fs::create_dir_all(&stale).unwrap();
+    std::fs::write(stale.join("history.csv"), "step,t\n1,").unwrap();
+    let o = viscobar(&[
+        "run",
+        "impact",
+        "--out",
+        dir.to_str().unwrap(),
+        "--set",
+        "time.end=0.2",
+    ]);
+    assert!(o.status.success());
+    let names: Vec<String> = snapshot(&dir).into_iter().map(|(n, _)| n).collect();
+    assert_eq!(names, ["displacement.csv", "history.csv", "summary.json"]);
+}

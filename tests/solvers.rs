@@ -26,7 +26,7 @@ use viscobar::tridiag::SymTridiag;
 // ---- tolerances -------------------------------------------------------------------------
 
 /// Energy identity, exact and penalty: exact algebra given `C z = b + r` to round-off, which
-/// both solvers meet by a direct solve (measured below 1e-14, docs/solvers-verification.md).
+/// both solvers meet by a direct solve (measured below 1e-14, VERIFICATION.md, section "Step solvers").
 const IDENTITY_TOL: f64 = 1e-12;
 /// Energy identity, OSQP: it holds up to `½ ρ·δ` with `ρ` the stationarity residual, which the
 /// audit allows up to `AUDIT_MARGIN · eps_rel = 1e-9` relative to `‖Cz‖`.
