@@ -10,14 +10,13 @@
 //!
 //! Everything is deterministic: the same build prints the same numbers.
 
-use std::borrow::Cow;
 use std::cell::RefCell;
 use std::rc::Rc;
 
-use osqp::{CscMatrix, Problem, Settings, Status};
+use osqp::Status;
 use viscobar::compare::compare;
 use viscobar::exact::ExactSolver;
-use viscobar::osqp_solver::{OSQP_INFTY, OsqpSettings, OsqpSolver};
+use viscobar::osqp_solver::{OsqpSettings, OsqpSolver, raw_problem};
 use viscobar::run::run_in_memory;
 use viscobar::scene::{self, PENALTY_DEFAULT_EPSILON, Scene};
 use viscobar::simulation::{Discretisation, Simulation};
@@ -174,44 +173,7 @@ fn raw_first_step(scene: &Scene, s: OsqpSettings) -> String {
     Simulation::with_solver(scene, disc, Box::new(rec)).unwrap();
     let (b, lo, z_exact, r_exact) = log.borrow()[0].clone();
     let n = c.dim();
-    let (mut indptr, mut indices, mut data) = (vec![0], vec![], vec![]);
-    for j in 0..n {
-        if j > 0 {
-            indices.push(j - 1);
-            data.push(c.off[j - 1]);
-        }
-        indices.push(j);
-        data.push(c.diag[j]);
-        indptr.push(indices.len());
-    }
-    let p = CscMatrix {
-        nrows: n,
-        ncols: n,
-        indptr: Cow::Owned(indptr),
-        indices: Cow::Owned(indices),
-        data: Cow::Owned(data),
-    };
-    let mut aptr = vec![0];
-    for col in 0..n {
-        aptr.push(aptr[col] + usize::from(nodes.contains(&col)));
-    }
-    let a = CscMatrix {
-        nrows: nodes.len(),
-        ncols: n,
-        indptr: Cow::Owned(aptr),
-        indices: Cow::Owned((0..nodes.len()).collect()),
-        data: Cow::Owned(vec![1.0; nodes.len()]),
-    };
-    let settings = Settings::default()
-        .verbose(false)
-        .eps_abs(s.eps_abs)
-        .eps_rel(s.eps_rel)
-        .max_iter(s.max_iter)
-        .polish(s.polish)
-        .adaptive_rho_interval(Some(s.adaptive_rho_interval));
-    let q: Vec<f64> = b.iter().map(|v| -v).collect();
-    let mut prob =
-        Problem::new(&p, &q, &a, &lo, &vec![OSQP_INFTY; nodes.len()], &settings).unwrap();
+    let mut prob = raw_problem(&c, &nodes, &b, &lo, s).unwrap();
     let status = prob.solve();
     let iterations = status.iter();
     let (name, sol) = match status {

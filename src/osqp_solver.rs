@@ -172,6 +172,29 @@ fn selection_csc(n: usize, nodes: &[usize]) -> CscMatrix<'static> {
     }
 }
 
+/// The OSQP problem of one step exactly as [`OsqpSolver`] builds it (same matrices and
+/// settings), with `q = −b` and lower bounds `lower`, but without the audit: for the tests and
+/// studies that examine OSQP's own answer.
+pub fn raw_problem(
+    c: &SymTridiag,
+    nodes: &[usize],
+    b: &[f64],
+    lower: &[f64],
+    settings: OsqpSettings,
+) -> Result<Problem, OsqpSetupError> {
+    let q: Vec<f64> = b.iter().map(|v| -v).collect();
+    let u = vec![OSQP_INFTY; nodes.len()];
+    Problem::new(
+        upper_csc(c),
+        &q,
+        selection_csc(c.dim(), nodes),
+        lower,
+        &u,
+        &settings.to_osqp(),
+    )
+    .map_err(|e| OsqpSetupError::Osqp(e.to_string()))
+}
+
 /// OSQP's status, as its C library spells it.
 fn status_name(status: &Status<'_>) -> &'static str {
     match status {
