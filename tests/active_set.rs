@@ -2,6 +2,8 @@
 //! brute-force oracle on small problems, against KKT on large ones, and on the hard cases an
 //! independent probe found for plain primal-dual active sets.
 
+mod common;
+
 use proptest::prelude::*;
 use viscobar::active_set::BlockPivotSolver;
 use viscobar::matrices::{MatrixVariant, mass, stiffness};
@@ -12,25 +14,6 @@ use viscobar::tridiag::SymTridiag;
 /// Agreement with the dense oracle and KKT residuals, relative: both are backward-stable
 /// solves of systems with condition number below 1e4 here.
 const AGREEMENT_TOL: f64 = 1e-9;
-
-fn spd_tridiag(max_n: usize) -> impl Strategy<Value = SymTridiag> {
-    (2usize..=max_n).prop_flat_map(|n| {
-        (
-            prop::collection::vec(-1.0f64..1.0, n - 1),
-            prop::collection::vec(0.05f64..3.0, n),
-        )
-            .prop_map(move |(off, margin)| {
-                let diag = (0..n)
-                    .map(|i| {
-                        let l = if i > 0 { off[i - 1].abs() } else { 0.0 };
-                        let r = if i + 1 < n { off[i].abs() } else { 0.0 };
-                        l + r + margin[i]
-                    })
-                    .collect();
-                SymTridiag::new(diag, off)
-            })
-    })
-}
 
 /// KKT residuals of `(z, r)`, relative to the data: (stationarity, feasibility, sign, complementarity).
 fn kkt(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64], z: &[f64], r: &[f64]) -> f64 {
@@ -66,7 +49,7 @@ proptest! {
 
     #[test]
     fn small_problems_match_brute_force(
-        c in spd_tridiag(10),
+        c in common::spd_tridiag(10),
         b in prop::collection::vec(-5.0f64..5.0, 10),
         lo in prop::collection::vec(-2.0f64..2.0, 10),
         mask in 0u32..1024,
@@ -88,7 +71,7 @@ proptest! {
 
     #[test]
     fn large_problems_satisfy_kkt(
-        c in spd_tridiag(3000),
+        c in common::spd_tridiag(3000),
         seed in any::<u64>(),
     ) {
         let n = c.dim();

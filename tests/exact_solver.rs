@@ -1,6 +1,8 @@
 //! The exact step solver against KKT and against the dense brute-force oracle, on random
 //! symmetric positive definite tridiagonal problems with zero, one or two bounds.
 
+mod common;
+
 use proptest::prelude::*;
 use viscobar::exact::ExactSolver;
 use viscobar::oracle::brute_force;
@@ -11,33 +13,12 @@ use viscobar::tridiag::SymTridiag;
 /// of systems with condition number below 1e4 here, so 1e-9 leaves a wide margin over round-off.
 const AGREEMENT_TOL: f64 = 1e-9;
 
-/// Random SPD tridiagonal matrices: diagonally dominant with a random margin, off-diagonals of
-/// either sign (C is not an M-matrix when the mass term dominates).
-fn spd_tridiag() -> impl Strategy<Value = SymTridiag> {
-    (2usize..24).prop_flat_map(|n| {
-        (
-            prop::collection::vec(-1.0f64..1.0, n - 1),
-            prop::collection::vec(0.05f64..3.0, n),
-        )
-            .prop_map(move |(off, margin)| {
-                let diag = (0..n)
-                    .map(|i| {
-                        let l = if i > 0 { off[i - 1].abs() } else { 0.0 };
-                        let r = if i + 1 < n { off[i].abs() } else { 0.0 };
-                        l + r + margin[i]
-                    })
-                    .collect();
-                SymTridiag::new(diag, off)
-            })
-    })
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(2000))]
 
     #[test]
     fn exact_solver_satisfies_kkt_and_matches_brute_force(
-        c in spd_tridiag(),
+        c in common::spd_tridiag(23),
         seed_b in prop::collection::vec(-5.0f64..5.0, 24),
         lo in prop::collection::vec(-2.0f64..2.0, 2),
         which in 0usize..4,

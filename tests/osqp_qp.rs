@@ -2,6 +2,8 @@
 //! tridiagonal `C` (the generator of tests/exact_solver.rs) with one or two bounds, each solver
 //! solving two problems in a row so that OSQP's per-step updates and warm start are exercised.
 
+mod common;
+
 use proptest::prelude::*;
 use viscobar::audit::AUDIT_MARGIN;
 use viscobar::exact::ExactSolver;
@@ -11,29 +13,6 @@ use viscobar::solver::StepSolver;
 use viscobar::tridiag::SymTridiag;
 
 /// Smallest diagonal-dominance margin of the generator: by Varah's bound (1975)
-/// `‖C⁻¹‖_∞ <= 1 / MIN_MARGIN`.
-const MIN_MARGIN: f64 = 0.05;
-
-/// Random SPD tridiagonal matrices: diagonally dominant by a random margin >= MIN_MARGIN,
-/// off-diagonals of either sign.
-fn spd_tridiag() -> impl Strategy<Value = SymTridiag> {
-    (2usize..24).prop_flat_map(|n| {
-        (
-            prop::collection::vec(-1.0f64..1.0, n - 1),
-            prop::collection::vec(MIN_MARGIN..3.0, n),
-        )
-            .prop_map(move |(off, margin)| {
-                let diag = (0..n)
-                    .map(|i| {
-                        let l = if i > 0 { off[i - 1].abs() } else { 0.0 };
-                        let r = if i + 1 < n { off[i].abs() } else { 0.0 };
-                        l + r + margin[i]
-                    })
-                    .collect();
-                SymTridiag::new(diag, off)
-            })
-    })
-}
 
 fn norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
@@ -49,7 +28,7 @@ fn tolerances(c: &SymTridiag, b: &[f64], z: &[f64], r: &[f64]) -> (f64, f64) {
     let s_f = norm(b).max(norm(&c.mul(z))).max(norm(r));
     let t_z = eps * (1.0 + norm(z));
     let t_f = eps * (1.0 + s_f);
-    let tol_z = 2.0 * (t_z + t_f / MIN_MARGIN);
+    let tol_z = 2.0 * (t_z + t_f / common::MIN_MARGIN);
     let n = c.dim();
     let c_norm = (0..n)
         .map(|i| {
@@ -66,7 +45,7 @@ proptest! {
 
     #[test]
     fn osqp_agrees_with_exact_to_its_tolerance(
-        c in spd_tridiag(),
+        c in common::spd_tridiag(23),
         seed_b in prop::collection::vec(-5.0f64..5.0, 48),
         lo in prop::collection::vec(-2.0f64..2.0, 4),
         which in 0usize..3,
