@@ -341,11 +341,18 @@ impl Simulation {
                 .into());
             }
         }
+        let range = disc.first..disc.first + n;
+        // `force` holds F^n; a time-independent load fills it once, here.
+        let mut force = vec![0.0; n];
         let load = match &scene.load.density {
             None => LoadTerm::None,
             Some(text) => {
                 let expr = Expression::parse("load.density", text, true)?;
                 if !expr.depends_on_t() {
+                    let nodal = (0..nodes)
+                        .map(|i| expr.eval(disc.x(i), 0.0))
+                        .collect::<Result<Vec<_>, _>>()?;
+                    force.copy_from_slice(&disc.mass_full.mul(&nodal)[range.clone()]);
                     LoadTerm::Constant
                 } else if !expr.depends_on_x() {
                     let ones = vec![1.0; nodes];
@@ -362,7 +369,6 @@ impl Simulation {
         };
         let locals = disc.constrained_locals();
         let k = locals.len();
-        let range = disc.first..disc.first + n;
         let mut sim = Self {
             solver,
             load,
@@ -373,7 +379,7 @@ impl Simulation {
             z: vec![0.0; n],
             mz: vec![0.0; n],
             rhs: vec![0.0; n],
-            force: vec![0.0; n],
+            force,
             lower: vec![0.0; k],
             reactions: vec![0.0; k],
             locals,
@@ -386,15 +392,6 @@ impl Simulation {
             first_record: StepRecord::default(),
             disc,
         };
-        if let LoadTerm::Constant = sim.load {
-            let expr =
-                Expression::parse("load.density", scene.load.density.as_ref().unwrap(), true)?;
-            let nodal = (0..nodes)
-                .map(|i| expr.eval(sim.disc.x(i), 0.0))
-                .collect::<Result<Vec<_>, _>>()?;
-            sim.force = sim.disc.mass_full.mul(&nodal)[range.clone()].to_vec();
-            // (range is reused below for the initial velocity)
-        }
         let v0 = sim.initial_v[range].to_vec();
         sim.start_up(&v0)?;
         Ok(sim)

@@ -25,7 +25,8 @@ pub const RIGID_ELEMENTS: u64 = 8193;
 pub const RIGID_STEPS: usize = 26_000;
 
 /// All sections, in document order.
-pub fn sections() -> Result<Vec<Section>, RunError> {
+/// Errors are those of the runs and of the α-sweep (both carry their exit code).
+pub fn sections() -> Result<Vec<Section>, crate::converge::ConvergeError> {
     Ok(vec![
         matrices_section(),
         scenes_section()?,
@@ -207,10 +208,9 @@ pub fn update_document(doc: &str, sections: &[Section]) -> Result<String, String
 pub const SWEEP_ALPHAS: [f64; 4] = [1e-1, 1e-2, 1e-3, 1e-4];
 pub const SWEEP_ELEMENTS: [u64; 2] = [800, 1600];
 
-fn viscosity_section() -> Result<Section, RunError> {
+fn viscosity_section() -> Result<Section, crate::converge::ConvergeError> {
     let (_, base) = scene::load("impact", &[])?;
-    let sweep = crate::converge::viscosity_sweep("impact", &base, &SWEEP_ALPHAS, &SWEEP_ELEMENTS)
-        .map_err(|e| RunError::Scene(crate::error::SceneError::Syntax(e.to_string())))?;
+    let sweep = crate::converge::viscosity_sweep("impact", &base, &SWEEP_ALPHAS, &SWEEP_ELEMENTS)?;
     Ok(Section {
         id: "viscosity",
         markdown: sweep.markdown(),
