@@ -136,8 +136,7 @@ pub fn parse_solvers(list: &str) -> Result<Vec<SolverSetting>, ConvergeError> {
 
 /// `base` with `base.elements · 2^level` elements and `dt = ratio · dx`.
 pub fn refined(base: &Scene, level: u32, ratio: f64) -> Scene {
-    let mut s = base.clone();
-    s.mesh.elements = base.mesh.elements << level;
+    let mut s = base.refined(level);
     s.time.step = ratio * s.dx();
     s
 }

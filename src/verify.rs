@@ -7,7 +7,7 @@ use crate::closed_form;
 use crate::error::RunError;
 use crate::matrices::{MatrixVariant, mass, stiffness};
 use crate::run::run_in_memory;
-use crate::scene::{self, Scene};
+use crate::scene;
 use crate::study::{error_against, observed_order, rigid_mode_drift};
 use std::fmt::Write;
 
@@ -116,13 +116,6 @@ fn scenes_section() -> Result<Section, RunError> {
     })
 }
 
-fn refined(base: &Scene, level: u32) -> Scene {
-    let mut s = base.clone();
-    s.mesh.elements = base.mesh.elements << level;
-    s.time.step = base.time.step / f64::from(1u32 << level);
-    s
-}
-
 fn convergence_section() -> Result<Section, RunError> {
     let mut md = String::from(
         "| scene | elements | dt | L2 error (max over t) | max-norm error | observed order (L2, all levels) |\n|---|---|---|---|---|---|\n",
@@ -132,7 +125,7 @@ fn convergence_section() -> Result<Section, RunError> {
         let exact = closed_form::for_scene(name, &base).expect("built-in closed form");
         let mut rows = Vec::new();
         for level in 0..CONVERGENCE_LEVELS {
-            let s = refined(&base, level);
+            let s = base.refined(level);
             let e = error_against(&s, exact.as_ref())?;
             rows.push((s.mesh.elements, s.time.step, s.dx(), e));
         }

@@ -12,14 +12,6 @@ pub fn builtin(name: &str, overrides: &[&str]) -> Scene {
     scene::load(name, &o).expect("built-in scene loads").1
 }
 
-/// Scales the mesh and the time step of a scene by `2^level` together.
-pub fn refined(base: &Scene, level: u32) -> Scene {
-    let mut s = base.clone();
-    s.mesh.elements = base.mesh.elements << level;
-    s.time.step = base.time.step / f64::from(1u32 << level);
-    s
-}
-
 /// Smallest diagonal-dominance margin of [`spd_tridiag`]: keeps the condition number below
 /// about 1e4 for the sizes the tests draw.
 pub const MIN_MARGIN: f64 = 0.05;
