@@ -635,9 +635,12 @@ fn solver_settings_of_another_method_or_out_of_range_are_refused() {
         (&["solver.method=\"gurobi\""][..], "method"),
         (&["solver.method=\"osqp\"", "solver.rho=0.1"][..], "rho"),
     ];
-    for (overrides, needle) in refused {
+    let load_impact = |overrides: &[&str]| {
         let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-        let err = viscobar::scene::load("impact", &o).expect_err("refused");
+        viscobar::scene::load("impact", &o)
+    };
+    for (overrides, needle) in refused {
+        let err = load_impact(overrides).expect_err("refused");
         assert!(err.to_string().contains(needle), "{overrides:?}: {err}");
     }
     for ok in [
@@ -648,8 +651,7 @@ fn solver_settings_of_another_method_or_out_of_range_are_refused() {
         ][..],
         &["solver.method=\"penalty\"", "solver.epsilon=1e-4"][..],
     ] {
-        let o: Vec<String> = ok.iter().map(|s| s.to_string()).collect();
-        viscobar::scene::load("impact", &o).unwrap();
+        load_impact(ok).unwrap();
     }
 }
 
