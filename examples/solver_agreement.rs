@@ -10,17 +10,13 @@
 //!
 //! Everything is deterministic: the same build prints the same numbers.
 
-use std::cell::RefCell;
-use std::rc::Rc;
-
 use osqp::Status;
-use viscobar::compare::compare;
+use viscobar::compare::{StepProblem, compare, start_up_problem};
 use viscobar::exact::ExactSolver;
 use viscobar::osqp_solver::{OsqpSettings, OsqpSolver, raw_problem};
 use viscobar::run::run_in_memory;
 use viscobar::scene::{self, PENALTY_DEFAULT_EPSILON, Scene};
-use viscobar::simulation::{Discretisation, Simulation};
-use viscobar::solver::{SolveInfo, StepFailure, StepSolver};
+use viscobar::solver::StepSolver;
 use viscobar::study::observed_order;
 use viscobar::tridiag::{Ldlt, SymTridiag};
 
@@ -133,45 +129,18 @@ fn penalty_rate() {
     println!();
 }
 
-/// Records the step data `(b, lo)` and the exact answer of every step.
-type Log = Rc<RefCell<Vec<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)>>>;
-struct Recorder {
-    inner: ExactSolver,
-    log: Log,
-}
-impl StepSolver for Recorder {
-    fn name(&self) -> &'static str {
-        "recorder"
-    }
-    fn solve(
-        &mut self,
-        b: &[f64],
-        lo: &[f64],
-        z: &mut [f64],
-        r: &mut [f64],
-    ) -> Result<SolveInfo, StepFailure> {
-        let info = self.inner.solve(b, lo, z, r)?;
-        self.log
-            .borrow_mut()
-            .push((b.to_vec(), lo.to_vec(), z.to_vec(), r.to_vec()));
-        Ok(info)
-    }
-}
-
 /// OSQP called directly (no audit) on the start-up step of `scene`: status, polish, OSQP's own
 /// dual residual and tolerance, the reaction error, and the stationarity error mapped to
 /// displacement, against the exact answer.
 fn raw_first_step(scene: &Scene, s: OsqpSettings) -> String {
-    let disc = Discretisation::new(scene).unwrap();
-    let c = disc.step_matrix.clone();
-    let nodes = disc.constrained_locals();
-    let log: Log = Rc::default();
-    let rec = Recorder {
-        inner: ExactSolver::new(&c, &nodes).unwrap(),
-        log: log.clone(),
-    };
-    Simulation::with_solver(scene, disc, Box::new(rec)).unwrap();
-    let (b, lo, z_exact, r_exact) = log.borrow()[0].clone();
+    let StepProblem {
+        c,
+        nodes,
+        b,
+        lo,
+        z: z_exact,
+        r: r_exact,
+    } = start_up_problem(scene).unwrap();
     let n = c.dim();
     let mut prob = raw_problem(&c, &nodes, &b, &lo, s).unwrap();
     let status = prob.solve();

@@ -4,21 +4,18 @@
 
 mod common;
 
-use std::cell::RefCell;
 use std::path::Path;
 use std::process::Command;
-use std::rc::Rc;
 
 use osqp::Status;
 use viscobar::RunError;
 use viscobar::audit::AUDIT_MARGIN;
-use viscobar::compare::compare;
-use viscobar::exact::ExactSolver;
+use viscobar::compare::{compare, start_up_problem};
 use viscobar::osqp_solver::{OSQP_INFTY, OsqpSettings, OsqpSolver, raw_problem};
 use viscobar::run::run_in_memory;
 use viscobar::scene::{OSQP_DEFAULT_EPS, PENALTY_DEFAULT_EPSILON, Scene, builtin_names};
-use viscobar::simulation::{Discretisation, Simulation};
-use viscobar::solver::{SolveInfo, StepFailure, StepSolver};
+use viscobar::simulation::Simulation;
+use viscobar::solver::{StepFailure, StepSolver};
 use viscobar::study::observed_order;
 use viscobar::tridiag::SymTridiag;
 
@@ -248,62 +245,6 @@ fn penalty_converges_to_exact_at_first_order_in_epsilon() {
 
 // ---- OSQP's failures are errors ---------------------------------------------------------
 
-/// Wraps the exact solver and keeps every step's data `(b, lo)` and answer `(z, r)`.
-type Log = Rc<RefCell<Vec<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)>>>;
-struct Recorder {
-    inner: ExactSolver,
-    log: Log,
-}
-
-impl StepSolver for Recorder {
-    fn name(&self) -> &'static str {
-        "recorder"
-    }
-    fn solve(
-        &mut self,
-        b: &[f64],
-        lo: &[f64],
-        z: &mut [f64],
-        r: &mut [f64],
-    ) -> Result<SolveInfo, StepFailure> {
-        let info = self.inner.solve(b, lo, z, r)?;
-        self.log
-            .borrow_mut()
-            .push((b.to_vec(), lo.to_vec(), z.to_vec(), r.to_vec()));
-        Ok(info)
-    }
-}
-
-/// The start-up step of a scene: its matrix, constrained nodes, data and exact reactions
-/// (identical for every solver: the step depends on the initial data only).
-struct FirstStep {
-    c: SymTridiag,
-    nodes: Vec<usize>,
-    b: Vec<f64>,
-    lo: Vec<f64>,
-    r_exact: Vec<f64>,
-}
-
-fn first_step(scene: &Scene) -> FirstStep {
-    let disc = Discretisation::new(scene).unwrap();
-    let c = disc.step_matrix.clone();
-    let nodes = disc.constrained_locals();
-    let log: Log = Rc::default();
-    let rec = Recorder {
-        inner: ExactSolver::new(&c, &nodes).unwrap(),
-        log: log.clone(),
-    };
-    Simulation::with_solver(scene, disc, Box::new(rec)).unwrap();
-    let (b, lo, _, r_exact) = log.borrow()[0].clone();
-    FirstStep {
-        c,
-        nodes,
-        b,
-        lo,
-        r_exact,
-    }
-}
-
 /// What OSQP itself says about one step problem, called through the `osqp` crate directly
 /// (independently of `OsqpSolver`): status, answer, its own dual residual and tolerance.
 struct RawOsqp {
@@ -375,7 +316,7 @@ fn step_failure(
 #[test]
 fn osqp_success_that_misses_its_own_tolerance_is_an_error() {
     let exact_scene = stiff_impact(1000.0, &[]);
-    let f = first_step(&exact_scene);
+    let f = start_up_problem(&exact_scene).unwrap();
     let raw = raw_osqp(&f.c, &f.nodes, &f.b, &f.lo, OsqpSettings::default());
     assert!(raw.solved, "OSQP reports solved");
     assert!(
@@ -384,7 +325,7 @@ fn osqp_success_that_misses_its_own_tolerance_is_an_error() {
         raw.dual_residual,
         raw.dual_tolerance
     );
-    let reaction_error = (raw.reaction[0] - f.r_exact[0]).abs() / f.r_exact[0];
+    let reaction_error = (raw.reaction[0] - f.r[0]).abs() / f.r[0];
     assert!(reaction_error > 1e-6, "reaction error {reaction_error:e}");
 
     let scene = stiff_impact(1000.0, &["solver.method=\"osqp\""]);
@@ -415,7 +356,7 @@ fn osqp_loose_answer_far_from_exact_is_an_error() {
         "solver.polish=false",
     ];
     let exact_scene = stiff_impact(100.0, &[]);
-    let f = first_step(&exact_scene);
+    let f = start_up_problem(&exact_scene).unwrap();
     let settings = OsqpSettings {
         eps_abs: 1e-3,
         eps_rel: 1e-3,
@@ -424,7 +365,7 @@ fn osqp_loose_answer_far_from_exact_is_an_error() {
     };
     let raw = raw_osqp(&f.c, &f.nodes, &f.b, &f.lo, settings);
     assert!(raw.solved && raw.dual_residual <= raw.dual_tolerance);
-    let reaction_error = (raw.reaction[0] - f.r_exact[0]).abs() / f.r_exact[0];
+    let reaction_error = (raw.reaction[0] - f.r[0]).abs() / f.r[0];
     assert!(reaction_error > 1e-2, "reaction error {reaction_error:e}");
 
     let mut o = vec!["solver.method=\"osqp\""];
