@@ -225,7 +225,13 @@ impl ClosedForm for FallingBar {
             return -0.5 * g * t * t;
         }
         if tau <= 2.0 * l {
-            let h = |s: f64| if s > 0.0 { v1 * s + 0.5 * g * s * s } else { 0.0 };
+            let h = |s: f64| {
+                if s > 0.0 {
+                    v1 * s + 0.5 * g * s * s
+                } else {
+                    0.0
+                }
+            };
             return -a0 - v1 * tau - 0.5 * g * tau * tau + h(tau - x) + h(tau + x - 2.0 * l);
         }
         let s = tau - 2.0 * l;
@@ -312,16 +318,13 @@ pub fn for_scene(name: &str, scene: &Scene) -> Option<Box<dyn ClosedForm>> {
         "falling-bar"
             if ends == (Signorini, Free) && scene.bar.viscosity == 0.0 && velocity0 == 0.0 =>
         {
-            let load = Expression::parse("load.density", scene.load.density.as_ref()?, true).ok()?;
+            let load =
+                Expression::parse("load.density", scene.load.density.as_ref()?, true).ok()?;
             if load.depends_on_x() || load.depends_on_t() {
                 return None;
             }
             let gravity = -load.eval(0.0, 0.0).ok()?;
-            Box::new(FallingBar::new(
-                scene.bar.length,
-                gravity,
-                scene.left.gap?,
-            )?)
+            Box::new(FallingBar::new(scene.bar.length, gravity, scene.left.gap?)?)
         }
         _ => return None,
     };

@@ -219,7 +219,9 @@ fn exact_energy(name: &str, scene: &Scene) -> Option<Box<dyn Fn(f64) -> f64>> {
         "falling-bar" => {
             let fb = closed_form::for_scene(name, scene)?;
             fb.energy(0.0)?;
-            Some(Box::new(move |t| fb.energy(t).expect("FallingBar has an energy")))
+            Some(Box::new(move |t| {
+                fb.energy(t).expect("FallingBar has an energy")
+            }))
         }
         _ => None,
     }
@@ -325,10 +327,18 @@ fn measure(
         }
         observe(&sim, n, &mut u, &mut e);
     }
-    let contact_time_error = match (&closed, closed.as_ref().and_then(|c| c.contact_intervals(sim.time()))) {
+    let contact_time_error = match (
+        &closed,
+        closed
+            .as_ref()
+            .and_then(|c| c.contact_intervals(sim.time())),
+    ) {
         (Some(_), Some(exact)) => {
             let summary = tracker.finish(scene_name, &sim, wall);
-            let discrete = summary.contact_intervals.get("left").map_or(&[][..], |v| &v[..]);
+            let discrete = summary
+                .contact_intervals
+                .get("left")
+                .map_or(&[][..], |v| &v[..]);
             contact_time_error(&exact, discrete)
         }
         _ => None,
