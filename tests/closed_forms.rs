@@ -170,6 +170,8 @@ fn falling_bar_closed_form_solves_the_wave_equation_with_its_boundary_conditions
 const FD_STEP: f64 = 1e-7;
 /// Midpoints of the energy quadrature.
 const QUAD_POINTS: usize = 20_000;
+/// Round-off of a difference quotient of step [`FD_STEP`]: a few ulps of `|u| ≤ 1` over it.
+const FD_ROUNDOFF: f64 = 1e-8;
 
 #[test]
 fn falling_bar_closed_form_is_continuous_conserves_energy_and_has_its_reaction() {
@@ -183,6 +185,7 @@ fn falling_bar_closed_form_is_continuous_conserves_energy_and_has_its_reaction()
     // A kink line spoils at most one midpoint of each difference (stencil 2·FD_STEP ≪ dx), at
     // most two kinks cross the bar at a time, and a spoiled term is off by at most ½ slope² dx:
     // 4 · ½ slope² dx for u_t² and u_x²; the rest (midpoint rule on quadratics) is ~dx².
+    // Worst cases, not estimates: the sampled times use about 1/500 of them.
     let energy_tol = 2.0 * slope * slope * dx;
     for i in 0..=320 {
         let t = 0.05 * i as f64 + 0.0123; // off the phase boundaries, two periods
@@ -198,13 +201,16 @@ fn falling_bar_closed_form_is_continuous_conserves_energy_and_has_its_reaction()
         // Total energy with gravity's potential g∫u: zero, as at the release.
         let total = kinetic + elastic + g * mass;
         assert!(total.abs() <= energy_tol, "t {t}: total energy {total:e}");
-        // ∫u in closed form against the quadrature (midpoint rule on piecewise quadratics).
-        assert!((mass - fb.integral(t)).abs() <= 1e-8, "t {t}");
+        // ∫u in closed form against the quadrature: the midpoint rule errs by dx²/24 · u_xx = g
+        // per unit length, and by at most dx² · (slope jump ≤ 2 slope) in a cell with a kink.
+        let mass_tol = dx * dx * (g * l / 24.0 + 2.0 * 2.0 * slope);
+        assert!((mass - fb.integral(t)).abs() <= mass_tol, "t {t}");
         assert_eq!(fb.energy(t), Some(-g * fb.integral(t)));
         // The reaction −u_x(0) (one-sided: u is linear in x near 0 within a phase, slope g).
         let one_sided = -(u(FD_STEP, t) - u(0.0, t)) / FD_STEP;
         assert!(
-            (one_sided - fb.reaction(t)).abs() <= g * FD_STEP + 1e-7 || fb.reaction(t) == 0.0,
+            (one_sided - fb.reaction(t)).abs() <= g * FD_STEP + FD_ROUNDOFF
+                || fb.reaction(t) == 0.0,
             "t {t}: reaction {} against {one_sided}",
             fb.reaction(t)
         );
