@@ -169,77 +169,75 @@ impl FallingBar {
     pub fn period(&self) -> f64 {
         4.0 * (self.fall_time() + self.length)
     }
-    /// `t` folded into the first half period, `[0, T/2]`, by periodicity and time symmetry.
-    fn fold(&self, t: f64) -> f64 {
+    /// The phase at `t`, folded into the first half period `[0, T/2]` by periodicity and time
+    /// symmetry.
+    fn phase(&self, t: f64) -> Phase {
         let p = self.period();
         let r = t.rem_euclid(p);
-        if r > 0.5 * p { p - r } else { r }
+        let t = if r > 0.5 * p { p - r } else { r };
+        let tau = t - self.fall_time();
+        if tau <= 0.0 {
+            Phase::Fall(t)
+        } else if tau <= 2.0 * self.length {
+            Phase::Contact(tau)
+        } else {
+            Phase::Flight(tau - 2.0 * self.length)
+        }
     }
     /// `−u_x(0, t)`: the contact force per unit section on the obstacle.
     pub fn reaction(&self, t: f64) -> f64 {
-        let tau = self.fold(t) - self.fall_time();
-        if (0.0..=2.0 * self.length).contains(&tau) {
-            self.impact_speed() + self.gravity * tau
-        } else {
-            0.0
+        match self.phase(t) {
+            Phase::Contact(tau) => self.impact_speed() + self.gravity * tau,
+            _ => 0.0,
         }
     }
     /// `∫_0^L u(x, t) dx`, in closed form (integrals of the phases' polynomials).
     pub fn integral(&self, t: f64) -> f64 {
-        let (l, g, a0, v1, t1) = (
-            self.length,
-            self.gravity,
-            self.gap,
-            self.impact_speed(),
-            self.fall_time(),
-        );
-        let t = self.fold(t);
-        let tau = t - t1;
-        if tau <= 0.0 {
-            -0.5 * g * t * t * l
-        } else if tau <= 2.0 * l {
+        let (l, g, a0, v1) = (self.length, self.gravity, self.gap, self.impact_speed());
+        match self.phase(t) {
+            Phase::Fall(t) => -0.5 * g * t * t * l,
             // ∫h(τ − x) + ∫h(τ + x − 2L) = H(τ) − H(τ − 2L), H' = h, H(τ − 2L) = 0.
-            -a0 * l - l * (v1 * tau + 0.5 * g * tau * tau)
-                + 0.5 * v1 * tau * tau
-                + g * tau * tau * tau / 6.0
-        } else {
-            let s = tau - 2.0 * l;
+            Phase::Contact(tau) => {
+                -a0 * l - l * (v1 * tau + 0.5 * g * tau * tau)
+                    + 0.5 * v1 * tau * tau
+                    + g * tau * tau * tau / 6.0
+            }
             // The deviation has mean zero; the mean of the release shape is −2gL²/3.
-            -a0 * l + l * (-2.0 * g * l * l / 3.0 + v1 * s - 0.5 * g * s * s)
+            Phase::Flight(s) => -a0 * l + l * (-2.0 * g * l * l / 3.0 + v1 * s - 0.5 * g * s * s),
         }
     }
 }
 
+/// Where [`FallingBar`] is in its first half period, with the time since the phase began.
+enum Phase {
+    Fall(f64),
+    Contact(f64),
+    Flight(f64),
+}
+
 impl ClosedForm for FallingBar {
     fn displacement(&self, x: f64, t: f64) -> f64 {
-        let (l, g, a0, v1, t1) = (
-            self.length,
-            self.gravity,
-            self.gap,
-            self.impact_speed(),
-            self.fall_time(),
-        );
-        let t = self.fold(t);
-        let tau = t - t1;
-        if tau <= 0.0 {
-            return -0.5 * g * t * t;
+        let (l, g, a0, v1) = (self.length, self.gravity, self.gap, self.impact_speed());
+        match self.phase(t) {
+            Phase::Fall(t) => -0.5 * g * t * t,
+            Phase::Contact(tau) => {
+                let h = |s: f64| {
+                    if s > 0.0 {
+                        v1 * s + 0.5 * g * s * s
+                    } else {
+                        0.0
+                    }
+                };
+                -a0 - v1 * tau - 0.5 * g * tau * tau + h(tau - x) + h(tau + x - 2.0 * l)
+            }
+            Phase::Flight(s) => {
+                let p = |y: f64| {
+                    let d = (y - 2.0 * l * (y / (2.0 * l)).round()).abs();
+                    g * (l - d) * (l - d)
+                };
+                -a0 - g * l * l + v1 * s - 0.5 * g * s * s + 0.5 * (p(x - s) + p(x + s))
+            }
         }
-        if tau <= 2.0 * l {
-            let h = |s: f64| {
-                if s > 0.0 {
-                    v1 * s + 0.5 * g * s * s
-                } else {
-                    0.0
-                }
-            };
-            return -a0 - v1 * tau - 0.5 * g * tau * tau + h(tau - x) + h(tau + x - 2.0 * l);
-        }
-        let s = tau - 2.0 * l;
-        let p = |y: f64| {
-            let d = (y - 2.0 * l * (y / (2.0 * l)).round()).abs();
-            g * (l - d) * (l - d)
-        };
-        -a0 - g * l * l + v1 * s - 0.5 * g * s * s + 0.5 * (p(x - s) + p(x + s))
     }
     fn energy(&self, t: f64) -> Option<f64> {
         Some(-self.gravity * self.integral(t))

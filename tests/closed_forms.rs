@@ -237,3 +237,24 @@ const FALLING_BAR_L2_BOUND: f64 = 1.25 * 2.987e-2;
 fn falling_bar_error_is_bounded_and_decreases_at_the_kink_rate() {
     assert_kinked_convergence("falling-bar", FALLING_BAR_L2_BOUND);
 }
+
+#[test]
+fn closed_forms_are_refused_when_overrides_leave_their_assumptions() {
+    let fits = |name: &str, o: &[&str]| closed_form::for_scene(name, &common::builtin(name, o));
+    assert!(fits("falling-bar", &[]).is_some());
+    // a0 = 1: V1/(gL) = 4, another whole number: still periodic, still a closed form.
+    assert!(fits("falling-bar", &["left.gap=1.0"]).is_some());
+    for o in [
+        "left.gap=2.0",              // V1/(gL) = 5.66: the second impact is not derived
+        "load.density=\"-0.1\"",     // V1/(gL) = 3.35
+        "load.density=\"-0.125*x\"", // not uniform gravity
+        "bar.viscosity=0.01",
+        "initial.velocity=\"-0.1\"",
+        "right.condition=\"clamped\"",
+    ] {
+        assert!(fits("falling-bar", &[o]).is_none(), "{o}");
+    }
+    // A non-uniform initial velocity leaves every closed form (they all start uniform).
+    assert!(fits("impact", &["initial.velocity=\"-1 + x\""]).is_none());
+    assert!(fits("modal", &["initial.velocity=\"1\""]).is_none());
+}
