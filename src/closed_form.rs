@@ -96,7 +96,7 @@ fn clip(intervals: &[[f64; 2]], t_end: f64) -> Vec<[f64; 2]> {
 /// rest with `u = 0` at height `a0` above a rigid obstacle under its left end (Signorini,
 /// `u(0) ≥ −a0`); right end free. The benchmark class of Doyen, Ern & Piperno, "Time-integration
 /// schemes for the finite element dynamic Signorini problem", SIAM J. Sci. Comput. 33(1), 2011,
-/// §5 (a bar dropped on a rigid obstacle, exact solution); their data were not available to us,
+/// (a bar dropped on a rigid obstacle, with an exact solution); their data were not available to us,
 /// so the data and the closed form below are ours, derived here (checked by
 /// `tests/closed_forms.rs`).
 ///
