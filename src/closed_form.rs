@@ -95,9 +95,9 @@ fn clip(intervals: &[[f64; 2]], t_end: f64) -> Vec<[f64; 2]> {
 /// The falling bar: an elastic bar (`α = 0`) on `[0, L]` under gravity, `l = −g`, released at
 /// rest with `u = 0` at height `a0` above a rigid obstacle under its left end (Signorini,
 /// `u(0) ≥ −a0`); right end free. The benchmark class of Doyen, Ern & Piperno, "Time-integration
-/// schemes for the finite element dynamic Signorini problem", SIAM J. Sci. Comput. 33(1), 2011,
-/// (a bar dropped on a rigid obstacle, with an exact solution); their data were not available to us,
-/// so the data and the closed form below are ours, derived here (checked by
+/// schemes for the finite element dynamic Signorini problem", SIAM J. Sci. Comput. 33(1), 2011:
+/// a bar dropped on a rigid obstacle, with an exact solution. Their data were not available to
+/// us, so the data and the closed form below are ours, derived here (checked by
 /// `tests/closed_forms.rs`).
 ///
 /// With `V1 = √(2 g a0)` (impact speed) we require `m = V1/(gL)` to be an integer `≥ 3`; then
