@@ -7,6 +7,15 @@ use crate::scene::Scene;
 /// An exact solution `u(x, t)`.
 pub trait ClosedForm {
     fn displacement(&self, x: f64, t: f64) -> f64;
+    /// Kinetic plus elastic energy `½∫u_t² + ½∫u_x²` (the scheme's `E`), where derived here.
+    fn energy(&self, _t: f64) -> Option<f64> {
+        None
+    }
+    /// The contact intervals of the left end that start before `t_end` (clipped to it), where
+    /// derived here.
+    fn contact_intervals(&self, _t_end: f64) -> Option<Vec<[f64; 2]>> {
+        None
+    }
 }
 
 /// Free-free Kelvin–Voigt bar in mode `k`: `u = A(t) cos(kπx/L)` with
@@ -69,6 +78,181 @@ impl ClosedForm for Impact {
         let (v0, t1, l) = (self.speed, self.contact_start(), self.length);
         (-v0 * t.min(t1 + x)).max(v0 * (t - 2.0 * t1 - 2.0 * l))
     }
+    fn contact_intervals(&self, t_end: f64) -> Option<Vec<[f64; 2]>> {
+        Some(clip(&[[self.contact_start(), self.contact_end()]], t_end))
+    }
+}
+
+/// The intervals that start at or before `t_end`, the last one cut at `t_end`.
+fn clip(intervals: &[[f64; 2]], t_end: f64) -> Vec<[f64; 2]> {
+    intervals
+        .iter()
+        .filter(|iv| iv[0] <= t_end)
+        .map(|iv| [iv[0], iv[1].min(t_end)])
+        .collect()
+}
+
+/// The falling bar: an elastic bar (`α = 0`) on `[0, L]` under gravity, `l = −g`, released at
+/// rest with `u = 0` at height `a0` above a rigid obstacle under its left end (Signorini,
+/// `u(0) ≥ −a0`); right end free. The benchmark class of Doyen, Ern & Piperno, "Time-integration
+/// schemes for the finite element dynamic Signorini problem", SIAM J. Sci. Comput. 33(1), 2011:
+/// a bar dropped on a rigid obstacle, with an exact solution. Their data were not available to
+/// us, so the data and the closed form below are ours, derived here (checked by
+/// `tests/closed_forms.rs`).
+///
+/// With `V1 = √(2 g a0)` (impact speed) we require `m = V1/(gL)` to be an integer `≥ 3`; then
+/// the motion is periodic with period `T = 4(t1 + L)`, `t1 = V1/g = mL`, and symmetric in time
+/// about `T/2`: `u(x, t) = u(x, T − t)`. On `t ∈ [0, T/2]`:
+///
+/// 1. Free fall, `t ≤ t1`: `u = −g t²/2`; the left end reaches `−a0` at `t1` with speed `V1`.
+/// 2. Contact, `τ = t − t1 ∈ [0, 2L]`: with `h(s) = V1 s + g s²/2` for `s ≥ 0`, `0` for `s < 0`,
+///    `u = −a0 − V1 τ − g τ²/2 + h(τ − x) + h(τ + x − 2L)` (d'Alembert; the second wave is the
+///    reflection at the free end). It solves `u_tt − u_xx = −g`, `u(0) = −a0`, `u_x(L) = 0`,
+///    and the reaction `−u_x(0) = V1 + g τ > 0`. Staying in contact past `τ = 2L` would need the
+///    reaction `2gL − V1 < 0` (`m ≥ 3`), so the end releases at `τ = 2L`, when the bar has the
+///    shape `u = −a0 + g(x² − 2Lx)` and the uniform velocity `+V1`.
+/// 3. Flight, `s = τ − 2L ∈ [0, mL]`, free–free under gravity: the mean moves as a projectile
+///    and the deviation, at rest initially, is d'Alembert with even reflections at both ends:
+///    `u = −a0 − gL² + V1 s − g s²/2 + (P(x − s) + P(x + s))/2`, `P(y) = g (L − d(y))²`, `d(y)`
+///    the distance from `y` to the nearest multiple of `2L` (the even, `2L`-periodic extension
+///    of `g(L − x)²`). At `s = 2mL` (beyond `T/2`) the state is the release state with the
+///    velocity reversed (`2mL = 2V1/g` is a whole number of periods `2L` of the deviation), so
+///    the second half of the period is the first, reversed: a second contact of length `2L`,
+///    then the rigid rise back to rest at `u = 0`.
+///
+/// The left end stays off the obstacle during the flight: on `s ∈ [2kL, 2(k+1)L]`,
+/// `u(0) + a0 = g s²/2 + (V1 − 2jgL) s + g(j² − 1)L²`, `j = 2k + 1`, whose minimum over the
+/// interval is either at an end (`u(0) + a0 = s(V1 − g s/2) > 0` at `s = 2kL ∈ (0, 2mL)`) or,
+/// when `|m − j| ≤ 1`, at `s = (2j − m)L` with value `gL²(m²/2 − (m − j)² − 1) > 0` for `m ≥ 3`.
+///
+/// Contact intervals: `[t1, t1 + 2L]` and `[T − t1 − 2L, T − t1]` in every period, reaction
+/// `V1 + g τ` (`τ` the time since the start of the first, or until the end of the second).
+/// Total energy `½∫u_t² + ½∫u_x² + g∫u = 0`, so the scheme's `E` is `−g∫u`.
+#[derive(Clone, Copy, Debug)]
+pub struct FallingBar {
+    pub length: f64,
+    pub gravity: f64,
+    pub gap: f64,
+}
+
+/// How far `V1/(gL)` may be from an integer and still count as one: a few ulps of the square
+/// root and the division (the built-in data give an exact 3).
+const WHOLE_RATIO_TOL: f64 = 1e-12;
+
+impl FallingBar {
+    /// The closed form, or `None` when the data leave its assumptions (positive length, gravity
+    /// and gap, `V1/(gL)` an integer `≥ 3`).
+    pub fn new(length: f64, gravity: f64, gap: f64) -> Option<Self> {
+        let fb = Self {
+            length,
+            gravity,
+            gap,
+        };
+        let m = fb.impact_speed() / (gravity * length);
+        let ok = length > 0.0
+            && gravity > 0.0
+            && gap > 0.0
+            && m.is_finite()
+            && m >= 3.0 - WHOLE_RATIO_TOL
+            && (m - m.round()).abs() <= WHOLE_RATIO_TOL * m;
+        ok.then_some(fb)
+    }
+    /// `V1 = √(2 g a0)`.
+    pub fn impact_speed(&self) -> f64 {
+        (2.0 * self.gravity * self.gap).sqrt()
+    }
+    /// `t1 = V1/g`, the end of the free fall.
+    pub fn fall_time(&self) -> f64 {
+        self.impact_speed() / self.gravity
+    }
+    /// `T = 4(t1 + L)`.
+    pub fn period(&self) -> f64 {
+        4.0 * (self.fall_time() + self.length)
+    }
+    /// The phase at `t`, folded into the first half period `[0, T/2]` by periodicity and time
+    /// symmetry.
+    fn phase(&self, t: f64) -> Phase {
+        let p = self.period();
+        let r = t.rem_euclid(p);
+        let t = if r > 0.5 * p { p - r } else { r };
+        let tau = t - self.fall_time();
+        if tau <= 0.0 {
+            Phase::Fall(t)
+        } else if tau <= 2.0 * self.length {
+            Phase::Contact(tau)
+        } else {
+            Phase::Flight(tau - 2.0 * self.length)
+        }
+    }
+    /// `−u_x(0, t)`: the contact force per unit section on the obstacle.
+    pub fn reaction(&self, t: f64) -> f64 {
+        match self.phase(t) {
+            Phase::Contact(tau) => self.impact_speed() + self.gravity * tau,
+            _ => 0.0,
+        }
+    }
+    /// `∫_0^L u(x, t) dx`, in closed form (integrals of the phases' polynomials).
+    pub fn integral(&self, t: f64) -> f64 {
+        let (l, g, a0, v1) = (self.length, self.gravity, self.gap, self.impact_speed());
+        match self.phase(t) {
+            Phase::Fall(t) => -0.5 * g * t * t * l,
+            // ∫h(τ − x) + ∫h(τ + x − 2L) = H(τ) − H(τ − 2L), H' = h, H(τ − 2L) = 0.
+            Phase::Contact(tau) => {
+                -a0 * l - l * (v1 * tau + 0.5 * g * tau * tau)
+                    + 0.5 * v1 * tau * tau
+                    + g * tau * tau * tau / 6.0
+            }
+            // The deviation has mean zero; the mean of the release shape is −2gL²/3.
+            Phase::Flight(s) => -a0 * l + l * (-2.0 * g * l * l / 3.0 + v1 * s - 0.5 * g * s * s),
+        }
+    }
+}
+
+/// Where [`FallingBar`] is in its first half period, with the time since the phase began.
+enum Phase {
+    Fall(f64),
+    Contact(f64),
+    Flight(f64),
+}
+
+impl ClosedForm for FallingBar {
+    fn displacement(&self, x: f64, t: f64) -> f64 {
+        let (l, g, a0, v1) = (self.length, self.gravity, self.gap, self.impact_speed());
+        match self.phase(t) {
+            Phase::Fall(t) => -0.5 * g * t * t,
+            Phase::Contact(tau) => {
+                let h = |s: f64| {
+                    if s > 0.0 {
+                        v1 * s + 0.5 * g * s * s
+                    } else {
+                        0.0
+                    }
+                };
+                -a0 - v1 * tau - 0.5 * g * tau * tau + h(tau - x) + h(tau + x - 2.0 * l)
+            }
+            Phase::Flight(s) => {
+                let p = |y: f64| {
+                    let d = (y - 2.0 * l * (y / (2.0 * l)).round()).abs();
+                    g * (l - d) * (l - d)
+                };
+                -a0 - g * l * l + v1 * s - 0.5 * g * s * s + 0.5 * (p(x - s) + p(x + s))
+            }
+        }
+    }
+    fn energy(&self, t: f64) -> Option<f64> {
+        Some(-self.gravity * self.integral(t))
+    }
+    fn contact_intervals(&self, t_end: f64) -> Option<Vec<[f64; 2]>> {
+        let (p, t1, c) = (self.period(), self.fall_time(), 2.0 * self.length);
+        let periods = (t_end / p).floor().max(0.0) as usize + 1;
+        let all: Vec<[f64; 2]> = (0..periods)
+            .flat_map(|k| {
+                let o = k as f64 * p;
+                [[o + t1, o + t1 + c], [o + p - t1 - c, o + p - t1]]
+            })
+            .collect();
+        Some(clip(&all, t_end))
+    }
 }
 
 /// Elastic bar on `[0, 1]`, clamped at 1, Signorini with gap 0 at 0, released at rest from
@@ -93,20 +277,24 @@ impl ClosedForm for ClampedImpact {
 }
 
 /// The closed form of a built-in scene, with its parameters read from the scene (so that
-/// `--set` overrides of the length, gap, speed or viscosity are honoured). `None` for scenes
-/// without one, or when overrides have made the scene leave the closed form's assumptions
-/// (checked: end conditions, elastic bar where required, initial displacement at 101 points).
+/// `--set` overrides of the length, gap, speed, gravity or viscosity are honoured). `None` for
+/// scenes without one, or when overrides have made the scene leave the closed form's
+/// assumptions (checked: end conditions, no distributed obstacle, elastic bar and load where
+/// required, a uniform initial velocity, initial displacement at 101 points).
 pub fn for_scene(name: &str, scene: &Scene) -> Option<Box<dyn ClosedForm>> {
+    use crate::expr::Expression;
     use crate::scene::Condition::{Clamped, Free, Signorini};
     let ends = (scene.left.condition, scene.right.condition);
-    let elastic = scene.bar.viscosity == 0.0 && scene.load.density.is_none();
-    let velocity0 =
-        crate::expr::Expression::parse("initial.velocity", &scene.initial.velocity, false)
-            .ok()?
-            .eval(0.0, 0.0)
-            .ok()?;
+    let unloaded = scene.load.density.is_none();
+    let elastic = scene.bar.viscosity == 0.0 && unloaded;
+    let velocity = Expression::parse("initial.velocity", &scene.initial.velocity, false).ok()?;
+    // Every closed form here starts from a uniform velocity.
+    if velocity.depends_on_x() || scene.obstacle.is_some() {
+        return None;
+    }
+    let velocity0 = velocity.eval(0.0, 0.0).ok()?;
     let exact: Box<dyn ClosedForm> = match name {
-        "modal" if ends == (Free, Free) && scene.load.density.is_none() => Box::new(Modal {
+        "modal" if ends == (Free, Free) && unloaded && velocity0 == 0.0 => Box::new(Modal {
             length: scene.bar.length,
             alpha: scene.bar.viscosity,
             k: 2,
@@ -119,16 +307,26 @@ pub fn for_scene(name: &str, scene: &Scene) -> Option<Box<dyn ClosedForm>> {
         "clamped-impact"
             if ends == (Signorini, Clamped)
                 && elastic
+                && velocity0 == 0.0
                 && scene.bar.length == 1.0
                 && scene.left.gap == Some(0.0) =>
         {
             Box::new(ClampedImpact)
         }
+        "falling-bar"
+            if ends == (Signorini, Free) && scene.bar.viscosity == 0.0 && velocity0 == 0.0 =>
+        {
+            let load =
+                Expression::parse("load.density", scene.load.density.as_ref()?, true).ok()?;
+            if load.depends_on_x() || load.depends_on_t() {
+                return None;
+            }
+            let gravity = -load.eval(0.0, 0.0).ok()?;
+            Box::new(FallingBar::new(scene.bar.length, gravity, scene.left.gap?)?)
+        }
         _ => return None,
     };
-    let u0 =
-        crate::expr::Expression::parse("initial.displacement", &scene.initial.displacement, false)
-            .ok()?;
+    let u0 = Expression::parse("initial.displacement", &scene.initial.displacement, false).ok()?;
     let fits = (0..=100).all(|i| {
         let x = scene.bar.length * i as f64 / 100.0;
         u0.eval(x, 0.0)

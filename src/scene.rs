@@ -332,6 +332,7 @@ pub const MAX_STEPS: u64 = 1_000_000_000;
 pub const BUILTIN: &[(&str, &str)] = &[
     ("modal", include_str!("../scenes/modal.toml")),
     ("impact", include_str!("../scenes/impact.toml")),
+    ("falling-bar", include_str!("../scenes/falling-bar.toml")),
     (
         "clamped-impact",
         include_str!("../scenes/clamped-impact.toml"),

@@ -31,6 +31,7 @@ pub fn sections() -> Result<Vec<Section>, crate::converge::ConvergeError> {
         matrices_section(),
         scenes_section()?,
         convergence_section()?,
+        falling_bar_section()?,
         roundoff_section()?,
         viscosity_section()?,
     ])
@@ -120,7 +121,7 @@ fn convergence_section() -> Result<Section, RunError> {
     let mut md = String::from(
         "| scene | elements | dt | L2 error (max over t) | max-norm error | observed order (L2, all levels) |\n|---|---|---|---|---|---|\n",
     );
-    for name in ["modal", "impact", "clamped-impact"] {
+    for name in ["modal", "impact", "clamped-impact", "falling-bar"] {
         let (_, base) = scene::load(name, &[])?;
         let exact = closed_form::for_scene(name, &base).expect("built-in closed form");
         let mut rows = Vec::new();
@@ -148,6 +149,56 @@ fn convergence_section() -> Result<Section, RunError> {
     }
     Ok(Section {
         id: "convergence",
+        markdown: md,
+    })
+}
+
+/// The falling bar through `viscobar converge` (exact solver; the wall times are left out):
+/// the errors in displacement, energy and contact times, and their observed orders.
+fn falling_bar_section() -> Result<Section, crate::converge::ConvergeError> {
+    use crate::converge::{SolverSetting, study};
+    let (_, base) = scene::load("falling-bar", &[])?;
+    let st = study(
+        "falling-bar",
+        &base,
+        &[SolverSetting::Exact],
+        CONVERGENCE_LEVELS,
+        None,
+    )?;
+    let mut md = format!(
+        "Reference: {}.\n\n| elements | dt | L2 error | H1 error | energy error | contact time error |\n|---|---|---|---|---|---|\n",
+        st.reference
+    );
+    let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3e}"));
+    for r in &st.rows {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.3e} | {:.3e} | {} | {} |",
+            r.elements,
+            r.dt,
+            r.l2_error,
+            r.h1_error,
+            opt(r.energy_error),
+            opt(r.contact_time_error)
+        );
+    }
+    let h: Vec<f64> = st.rows.iter().map(|r| r.dx).collect();
+    let order = |f: fn(&crate::converge::Row) -> Option<f64>| {
+        let e: Option<Vec<f64>> = st.rows.iter().map(f).collect();
+        e.map_or("-".to_string(), |e| {
+            format!("{:.3}", observed_order(&h, &e))
+        })
+    };
+    let _ = writeln!(
+        md,
+        "| observed order | | {} | {} | {} | {} |",
+        order(|r| Some(r.l2_error)),
+        order(|r| Some(r.h1_error)),
+        order(|r| r.energy_error),
+        order(|r| r.contact_time_error)
+    );
+    Ok(Section {
+        id: "falling-bar",
         markdown: md,
     })
 }

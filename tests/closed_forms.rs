@@ -5,7 +5,7 @@
 //! with L2 errors 2.10e-2 and 1.09e-2 at the scenes' own meshes.
 
 mod common;
-use viscobar::closed_form;
+use viscobar::closed_form::{self, ClosedForm, FallingBar};
 use viscobar::study::{error_against, observed_order};
 
 /// The scheme is second order in (dx, dt) for smooth solutions (the card asks for 2 ± 0.15).
@@ -93,4 +93,168 @@ fn impact_contact_interval_and_reaction_match_the_closed_form() {
         (mean - 1.0).abs() <= MEAN_REACTION_TOL,
         "mean reaction {mean}"
     );
+}
+
+/// The built-in falling bar's closed form (the scene's own data).
+fn falling_bar() -> FallingBar {
+    let scene = common::builtin("falling-bar", &[]);
+    let gravity = -scene.load.density.as_ref().unwrap().parse::<f64>().unwrap();
+    FallingBar::new(scene.bar.length, gravity, scene.left.gap.unwrap()).expect("V1/(gL) = 3")
+}
+
+/// The closed form is built from polynomials of size ≤ 1: its identities hold to round-off.
+const FALLING_BAR_ROUNDOFF: f64 = 1e-12;
+
+/// Deterministic sample points in `[0, 1)` (a Weyl sequence), so the tests do not need a seed.
+fn weyl(i: usize, a: f64) -> f64 {
+    (i as f64 * a).fract()
+}
+
+#[test]
+fn falling_bar_closed_form_solves_the_wave_equation_with_its_boundary_conditions() {
+    let fb = falling_bar();
+    let (l, g, a0) = (fb.length, fb.gravity, fb.gap);
+    let p = fb.period();
+    let u = |x: f64, t: f64| fb.displacement(x, t);
+    // Data: V1 = 3gL, period 16, contact on [3, 5] and [11, 13] (the scene's description).
+    assert_eq!((fb.impact_speed(), fb.fall_time(), p), (0.375, 3.0, 16.0));
+    let contact = fb.contact_intervals(2.0 * p).unwrap();
+    assert_eq!(contact[..2], [[3.0, 5.0], [11.0, 13.0]]);
+    assert_eq!(contact.len(), 4);
+    let in_contact = |t: f64| contact.iter().any(|iv| iv[0] <= t && t <= iv[1]);
+    for i in 1..4000 {
+        // Two periods, so periodicity and the time reversal at T/2 are crossed.
+        let t = 2.0 * p * weyl(i, 0.618_033_988_749_894_9);
+        let k = 0.5 * l * weyl(i, 0.414_213_562_373_095_1);
+        // Interior: the characteristic diamond identity holds exactly for every weak solution of
+        // u_tt − u_xx = −g, kinks and impacts included.
+        let x = k + (l - 2.0 * k) * weyl(i, 0.732_050_807_568_877_3);
+        let diamond = u(x, t + k) + u(x, t - k) - u(x + k, t) - u(x - k, t) + g * k * k;
+        assert!(
+            diamond.abs() <= FALLING_BAR_ROUNDOFF,
+            "x {x} t {t} k {k}: {diamond:e}"
+        );
+        // Free end x = L: the half diamond (even reflection, u_x(L) = 0).
+        let free = u(l, t + k) + u(l, t - k) - 2.0 * u(l - k, t) + g * k * k;
+        assert!(
+            free.abs() <= FALLING_BAR_ROUNDOFF,
+            "x = L, t {t} k {k}: {free:e}"
+        );
+        // Left end: on the obstacle with a positive reaction in contact, above it otherwise,
+        // and free (half diamond) in flight.
+        let gap = u(0.0, t) + a0;
+        if in_contact(t) {
+            assert!(gap.abs() <= FALLING_BAR_ROUNDOFF && fb.reaction(t) >= fb.impact_speed());
+        } else {
+            assert!(gap > 0.0 && fb.reaction(t) == 0.0, "t {t}: gap {gap:e}");
+            let kf = k.min(t);
+            if !contact.iter().any(|iv| iv[0] < t + kf && t - kf < iv[1]) {
+                let half = u(0.0, t + kf) + u(0.0, t - kf) - 2.0 * u(kf, t) + g * kf * kf;
+                assert!(half.abs() <= FALLING_BAR_ROUNDOFF, "x = 0, t {t}: {half:e}");
+            }
+        }
+        // Periodic.
+        let x = l * weyl(i, 0.236_067_977_499_789_7);
+        assert!((u(x, t + p) - u(x, t)).abs() <= FALLING_BAR_ROUNDOFF);
+    }
+    // Released at rest from u = 0 (u = −g t²/2 until the impact).
+    for i in 0..=100 {
+        let x = l * i as f64 / 100.0;
+        assert_eq!(u(x, 0.0), 0.0);
+        assert!((u(x, 1e-3) + 0.5 * g * 1e-6).abs() <= FALLING_BAR_ROUNDOFF);
+    }
+}
+
+/// Central differences of step [`FD_STEP`] for `u_t`, `u_x` and `−u_x(0)`; the closed form is
+/// piecewise quadratic, so they are exact away from the kinks up to round-off `1e-16/FD_STEP`.
+const FD_STEP: f64 = 1e-7;
+/// Midpoints of the energy quadrature.
+const QUAD_POINTS: usize = 20_000;
+/// Round-off of a difference quotient of step [`FD_STEP`]: a few ulps of `|u| ≤ 1` over it.
+const FD_ROUNDOFF: f64 = 1e-8;
+
+#[test]
+fn falling_bar_closed_form_is_continuous_conserves_energy_and_has_its_reaction() {
+    let fb = falling_bar();
+    let (l, g) = (fb.length, fb.gravity);
+    let u = |x: f64, t: f64| fb.displacement(x, t);
+    let v1 = fb.impact_speed();
+    // |u_t|, |u_x| ≤ V1 + 2gL + V1 + 2gL (two waves of slope h' ≤ V1 + 2gL on −V1 − gτ).
+    let slope = 2.0 * (v1 + 2.0 * g * l);
+    let dx = l / QUAD_POINTS as f64;
+    // A kink line spoils at most one midpoint of each difference (stencil 2·FD_STEP ≪ dx), at
+    // most two kinks cross the bar at a time, and a spoiled term is off by at most ½ slope² dx:
+    // 4 · ½ slope² dx for u_t² and u_x²; the rest (midpoint rule on quadratics) is ~dx².
+    // Worst cases, not estimates: the sampled times use about 1/500 of them.
+    let energy_tol = 2.0 * slope * slope * dx;
+    for i in 0..=320 {
+        let t = 0.05 * i as f64 + 0.0123; // off the phase boundaries, two periods
+        let (mut kinetic, mut elastic, mut mass) = (0.0, 0.0, 0.0);
+        for j in 0..QUAD_POINTS {
+            let x = (j as f64 + 0.5) * dx;
+            let ut = (u(x, t + FD_STEP) - u(x, t - FD_STEP)) / (2.0 * FD_STEP);
+            let ux = (u(x + FD_STEP, t) - u(x - FD_STEP, t)) / (2.0 * FD_STEP);
+            kinetic += 0.5 * ut * ut * dx;
+            elastic += 0.5 * ux * ux * dx;
+            mass += u(x, t) * dx;
+        }
+        // Total energy with gravity's potential g∫u: zero, as at the release.
+        let total = kinetic + elastic + g * mass;
+        assert!(total.abs() <= energy_tol, "t {t}: total energy {total:e}");
+        // ∫u in closed form against the quadrature: the midpoint rule errs by dx²/24 · u_xx = g
+        // per unit length, and by at most dx² · (slope jump ≤ 2 slope) in a cell with a kink.
+        let mass_tol = dx * dx * (g * l / 24.0 + 2.0 * 2.0 * slope);
+        assert!((mass - fb.integral(t)).abs() <= mass_tol, "t {t}");
+        assert_eq!(fb.energy(t), Some(-g * fb.integral(t)));
+        // The reaction −u_x(0) (one-sided: u is linear in x near 0 within a phase, slope g).
+        let one_sided = -(u(FD_STEP, t) - u(0.0, t)) / FD_STEP;
+        assert!(
+            (one_sided - fb.reaction(t)).abs() <= g * FD_STEP + FD_ROUNDOFF
+                || fb.reaction(t) == 0.0,
+            "t {t}: reaction {} against {one_sided}",
+            fb.reaction(t)
+        );
+    }
+    // Continuous across the phase boundaries: impact, release, mid-flight, second contact.
+    let (t1, p) = (fb.fall_time(), fb.period());
+    for tb in [t1, t1 + 2.0 * l, 0.5 * p, p - t1 - 2.0 * l, p - t1, p] {
+        for j in 0..=10 {
+            let x = l * j as f64 / 10.0;
+            let jump = u(x, tb + FD_STEP) - u(x, tb - FD_STEP);
+            assert!(
+                jump.abs() <= 2.0 * slope * FD_STEP,
+                "t {tb} x {x}: {jump:e}"
+            );
+        }
+    }
+}
+
+/// Measured by `cargo run --release -- verify` (falling-bar rows of the convergence table):
+/// L2 error 2.987e-2 at the scene's mesh.
+const FALLING_BAR_L2_BOUND: f64 = 1.25 * 2.987e-2;
+
+#[test]
+fn falling_bar_error_is_bounded_and_decreases_at_the_kink_rate() {
+    assert_kinked_convergence("falling-bar", FALLING_BAR_L2_BOUND);
+}
+
+#[test]
+fn closed_forms_are_refused_when_overrides_leave_their_assumptions() {
+    let fits = |name: &str, o: &[&str]| closed_form::for_scene(name, &common::builtin(name, o));
+    assert!(fits("falling-bar", &[]).is_some());
+    // a0 = 1: V1/(gL) = 4, another whole number: still periodic, still a closed form.
+    assert!(fits("falling-bar", &["left.gap=1.0"]).is_some());
+    for o in [
+        "left.gap=2.0",              // V1/(gL) = 5.66: the second impact is not derived
+        "load.density=\"-0.1\"",     // V1/(gL) = 3.35
+        "load.density=\"-0.125*x\"", // not uniform gravity
+        "bar.viscosity=0.01",
+        "initial.velocity=\"-0.1\"",
+        "right.condition=\"clamped\"",
+    ] {
+        assert!(fits("falling-bar", &[o]).is_none(), "{o}");
+    }
+    // A non-uniform initial velocity leaves every closed form (they all start uniform).
+    assert!(fits("impact", &["initial.velocity=\"-1 + x\""]).is_none());
+    assert!(fits("modal", &["initial.velocity=\"1\""]).is_none());
 }

@@ -108,3 +108,55 @@ fn bad_input_is_an_error_not_a_panic() {
     let e = converge::viscosity_sweep("modal", &base, &SWEEP_ALPHAS, &SWEEP_ELEMENTS).unwrap_err();
     assert_eq!(e.exit_code(), 2);
 }
+
+/// Falling bar, contact times: the study `cargo run --release -- converge falling-bar --solvers
+/// exact --levels 5` measured errors 5.0e-2, 3.5e-2, 2.0e-2, 1.25e-2, 8.1e-3 (whole numbers of
+/// steps: 5, 7, 8, 10, 13), order 0.66 over the first three levels, 0.67 over all five. The band
+/// allows ±1 step at each of three levels (at most ±0.15 on the fit) and fails for first order
+/// and for no convergence.
+const CONTACT_TIME_ORDER_BAND: (f64, f64) = (0.45, 0.87);
+/// The L2 order of a kinked solution, as in tests/closed_forms.rs (five levels: 0.683).
+const KINK_ORDER_BAND: (f64, f64) = (0.56, 0.80);
+
+#[test]
+fn falling_bar_converges_in_displacement_energy_and_contact_times() {
+    let base = common::builtin("falling-bar", &[]);
+    let study = converge::study("falling-bar", &base, &[SolverSetting::Exact], 3, None).unwrap();
+    assert_eq!(study.reference, "closed form (falling-bar)");
+    let (_, l2, _) = study.orders()[0];
+    assert!(
+        l2 >= KINK_ORDER_BAND.0 && l2 <= KINK_ORDER_BAND.1,
+        "L2 order {l2:.3}"
+    );
+    let h: Vec<f64> = study.rows.iter().map(|r| r.dx).collect();
+    // Both exact contact episodes are matched (a missing one scores infinity).
+    let c: Vec<f64> = study
+        .rows
+        .iter()
+        .map(|r| r.contact_time_error.unwrap())
+        .collect();
+    let p = viscobar::study::observed_order(&h, &c);
+    assert!(
+        c.iter().all(|e| e.is_finite())
+            && p >= CONTACT_TIME_ORDER_BAND.0
+            && p <= CONTACT_TIME_ORDER_BAND.1,
+        "contact time errors {c:?}, order {p:.3}"
+    );
+    // The energy E = −g∫u of the closed form is approached too.
+    let e: Vec<f64> = study.rows.iter().map(|r| r.energy_error.unwrap()).collect();
+    assert!(e.windows(2).all(|w| w[1] < w[0]), "energy errors {e:?}");
+}
+
+#[test]
+fn contact_time_error_groups_episodes_and_reports_a_missing_one() {
+    let exact = [[3.0, 5.0], [11.0, 13.0]];
+    // A brief separation inside the first episode counts as one episode.
+    let d = [[3.0, 4.0], [4.1, 5.05], [10.97, 13.01]];
+    let e = converge::contact_time_error(&exact, &d).unwrap();
+    assert!((e - 0.05).abs() <= 1e-12, "{e}");
+    assert_eq!(
+        converge::contact_time_error(&exact, &[[3.0, 5.0]]),
+        Some(f64::INFINITY)
+    );
+    assert_eq!(converge::contact_time_error(&[], &d), None);
+}

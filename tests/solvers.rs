@@ -47,7 +47,9 @@ const OSQP_AGREEMENT_TOL: f64 = 1e-7;
 /// Penalty against exact, in units of the penalty run's largest penetration `ε r`: the penalty
 /// run is the exact scheme with each obstacle moved by its penetration; a boundary displacement
 /// perturbs the wave by up to twice itself where it reflects at a free end, and the release
-/// from contact is delayed by O(ε), which can double that again.
+/// from contact is delayed by O(ε), which can double that again. Per contact episode: between
+/// episodes the runs are linear, so the perturbations of successive episodes add (falling-bar,
+/// two episodes, measured 2.0 after the first and 5.0 after the second).
 const PENALTY_AGREEMENT_FACTOR: f64 = 4.0;
 
 // ---- the generic checker ----------------------------------------------------------------
@@ -183,9 +185,11 @@ fn check_solver(method: Method) {
                     "{name}: penetration {penetration:e}, ε r_max {:e}",
                     PENALTY_DEFAULT_EPSILON * max_reaction
                 );
+                let episodes = summary.contact_intervals.values().map(Vec::len).max();
+                let episodes = episodes.unwrap_or(0).max(1) as f64;
                 assert!(
-                    agreement.max_difference <= PENALTY_AGREEMENT_FACTOR * penetration,
-                    "{name}: penalty differs from exact by {:e}, penetration {penetration:e}",
+                    agreement.max_difference <= PENALTY_AGREEMENT_FACTOR * episodes * penetration,
+                    "{name}: penalty differs from exact by {:e}, penetration {penetration:e}, {episodes} episodes",
                     agreement.max_difference
                 );
             }
