@@ -20,6 +20,7 @@
 //! energy balance), [`closed_form`] (exact solutions), [`run`] (outputs).
 
 pub mod active_set;
+pub mod agreement;
 pub mod audit;
 pub mod closed_form;
 pub mod compare;

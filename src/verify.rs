@@ -30,6 +30,10 @@ pub fn sections() -> Result<Vec<Section>, crate::converge::ConvergeError> {
     Ok(vec![
         matrices_section(),
         scenes_section()?,
+        Section {
+            id: "solver-agreement",
+            markdown: crate::agreement::markdown()?,
+        },
         convergence_section()?,
         falling_bar_section()?,
         roundoff_section()?,
