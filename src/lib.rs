@@ -36,6 +36,7 @@ pub mod run;
 pub mod scene;
 pub mod simulation;
 pub mod solver;
+pub mod spectrum;
 pub mod study;
 pub mod tridiag;
 pub mod verify;
