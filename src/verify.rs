@@ -209,3 +209,13 @@ fn viscosity_section() -> Result<Section, crate::converge::ConvergeError> {
         markdown: sweep.markdown(),
     })
 }
+
+/// The stiff and extreme case matrix (`viscobar verify --stiff`; not part of [`sections`],
+/// whose runs must stay within a few minutes; `tests/stiff.rs` checks the rows it shares with
+/// the reduced matrix against the document).
+pub fn stiff_section(size: crate::stiff::Size) -> Section {
+    Section {
+        id: "stiff",
+        markdown: crate::stiff::markdown(&crate::stiff::run_all(size)),
+    }
+}
