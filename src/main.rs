@@ -219,7 +219,9 @@ fn converge(
 
 fn verify(update: Option<PathBuf>, stiff: bool) -> i32 {
     let sections = if stiff {
-        Ok(vec![viscobar::verify::stiff_section(viscobar::stiff::Size::Full)])
+        Ok(vec![viscobar::verify::stiff_section(
+            viscobar::stiff::Size::Full,
+        )])
     } else {
         viscobar::verify::sections()
     };

@@ -112,7 +112,12 @@ mod tests {
 
     /// Dense symmetric eigenvalues (nalgebra), ascending.
     fn dense_eigenvalues(a: &SymTridiag) -> Vec<f64> {
-        let mut v: Vec<f64> = a.to_dense().symmetric_eigenvalues().iter().copied().collect();
+        let mut v: Vec<f64> = a
+            .to_dense()
+            .symmetric_eigenvalues()
+            .iter()
+            .copied()
+            .collect();
         v.sort_by(f64::total_cmp);
         v
     }
@@ -193,7 +198,10 @@ mod tests {
             assert!((hi - exact_hi).abs() <= tol, "n = {n}: {hi} vs {exact_hi}");
             assert!((lo - exact_lo).abs() <= tol, "n = {n}: {lo} vs {exact_lo}");
             let spd_lo = smallest_eigenvalue_spd(&a);
-            assert!((spd_lo - exact_lo).abs() <= tol, "n = {n}: {spd_lo} vs {exact_lo}");
+            assert!(
+                (spd_lo - exact_lo).abs() <= tol,
+                "n = {n}: {spd_lo} vs {exact_lo}"
+            );
         }
     }
 

@@ -206,7 +206,7 @@ impl Case {
     /// refuses obstacles by design; the refusal is part of the table).
     pub fn solvers(&self) -> Vec<&'static str> {
         let long = matches!(self.family, Family::Rigid | Family::Bounce);
-        let small = self.elements as usize + 1 <= OSQP_MAX_NODES;
+        let small = (self.elements as usize) < OSQP_MAX_NODES;
         let mut v = vec!["exact"];
         if !long && small {
             v.push("osqp");
@@ -616,11 +616,10 @@ fn compare_with_exact(live: &mut [Live]) {
         return;
     }
     for l in others.iter_mut().filter(|l| l.sim.is_some()) {
-        let d = l
-            .u
-            .iter()
-            .zip(&exact.u)
-            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        let d =
+            l.u.iter()
+                .zip(&exact.u)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
         if let Some(dist) = l.out.distance.as_mut() {
             *dist = dist.max(d);
         }
@@ -643,7 +642,9 @@ pub fn checks(result: &CaseResult, run: &SolverRun) -> Vec<(&'static str, f64, f
     // The drift is the sum of the per-step residuals, each within the identity tolerance.
     v.push(("energy drift", run.energy_drift, steps as f64 * id_tol));
     let violation_tol = match run.solver {
-        "osqp" => AUDIT_MARGIN * OSQP_DEFAULT_EPS * (1.0 + scale) + violation_tolerance(kappa, scale),
+        "osqp" => {
+            AUDIT_MARGIN * OSQP_DEFAULT_EPS * (1.0 + scale) + violation_tolerance(kappa, scale)
+        }
         "exact" => violation_tolerance(kappa, scale),
         // (PP) penetrates by ε r by design; `z_j = z⁰_j + Σ S_jk r_k` is rounded to ulps of
         // `|z⁰_j| <= |z_j| + S_jj r` (as in the audit's penalty-law floor).
@@ -678,7 +679,11 @@ pub fn checks(result: &CaseResult, run: &SolverRun) -> Vec<(&'static str, f64, f
     }
     if let Some(d) = run.rigid_drift {
         // Each step rounds u + z to an ulp of |u|: at most N ulps of the final |u| = t.
-        v.push(("rigid drift |u - t|", d, rigid_drift_tolerance(steps, scale)));
+        v.push((
+            "rigid drift |u - t|",
+            d,
+            rigid_drift_tolerance(steps, scale),
+        ));
     }
     v
 }
@@ -703,7 +708,10 @@ pub fn verdict(result: &CaseResult, run: &SolverRun) -> Option<String> {
         None => {
             let bad: Vec<String> = checks(result, run)
                 .into_iter()
-                .filter(|(_, v, t)| !(v <= t))
+                // A NaN value or tolerance fails too.
+                .filter(|(_, v, t)| {
+                    matches!(v.partial_cmp(t), None | Some(std::cmp::Ordering::Greater))
+                })
                 .map(|(w, v, t)| format!("{w} {v:.1e} > {t:.1e}"))
                 .collect();
             (!bad.is_empty()).then(|| bad.join("; "))
@@ -748,9 +756,8 @@ pub fn markdown(results: &[CaseResult]) -> String {
                         false => sci(*v),
                     })
             };
-            let pre = run.solver.starts_with("penalty")
-                && run.error.is_none()
-                && !penalty_asymptotic(r);
+            let pre =
+                run.solver.starts_with("penalty") && run.error.is_none() && !penalty_asymptotic(r);
             let distance = if pre {
                 format!("{} (pre-asymptotic)", cell("distance to exact"))
             } else if run.solver == "exact" {

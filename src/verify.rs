@@ -33,6 +33,7 @@ pub fn sections() -> Result<Vec<Section>, crate::converge::ConvergeError> {
         convergence_section()?,
         roundoff_section()?,
         viscosity_section()?,
+        stiff_section(crate::stiff::Size::Full),
     ])
 }
 
@@ -210,9 +211,8 @@ fn viscosity_section() -> Result<Section, crate::converge::ConvergeError> {
     })
 }
 
-/// The stiff and extreme case matrix (`viscobar verify --stiff`; not part of [`sections`],
-/// whose runs must stay within a few minutes; `tests/stiff.rs` checks the rows it shares with
-/// the reduced matrix against the document).
+/// The stiff and extreme case matrix at full size (about 40 s on 2 cores; alone:
+/// `viscobar verify --stiff`); `tests/stiff.rs` runs the reduced size.
 pub fn stiff_section(size: crate::stiff::Size) -> Section {
     Section {
         id: "stiff",
