@@ -37,6 +37,8 @@ pub mod run;
 pub mod scene;
 pub mod simulation;
 pub mod solver;
+pub mod spectrum;
+pub mod stiff;
 pub mod study;
 pub mod tridiag;
 pub mod verify;

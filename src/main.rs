@@ -72,6 +72,9 @@ enum Command {
         /// Rewrite the generated blocks of this file in place instead of printing.
         #[arg(long, value_name = "FILE")]
         update: Option<PathBuf>,
+        /// The stiff and extreme case matrix instead (full size: 1e6 nodes, 1e6-step runs).
+        #[arg(long)]
+        stiff: bool,
     },
 }
 
@@ -102,7 +105,7 @@ fn main() {
                 2
             }
         },
-        Command::Verify { update } => verify(update),
+        Command::Verify { update, stiff } => verify(update, stiff),
         Command::Converge {
             scene,
             solvers,
@@ -214,8 +217,15 @@ fn converge(
     Ok(())
 }
 
-fn verify(update: Option<PathBuf>) -> i32 {
-    let sections = match viscobar::verify::sections() {
+fn verify(update: Option<PathBuf>, stiff: bool) -> i32 {
+    let sections = if stiff {
+        Ok(vec![viscobar::verify::stiff_section(
+            viscobar::stiff::Size::Full,
+        )])
+    } else {
+        viscobar::verify::sections()
+    };
+    let sections = match sections {
         Ok(s) => s,
         Err(e) => {
             eprintln!("error: {e}");

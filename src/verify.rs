@@ -38,6 +38,7 @@ pub fn sections() -> Result<Vec<Section>, crate::converge::ConvergeError> {
         falling_bar_section()?,
         roundoff_section()?,
         viscosity_section()?,
+        stiff_section(crate::stiff::Size::Full),
     ])
 }
 
@@ -263,4 +264,13 @@ fn viscosity_section() -> Result<Section, crate::converge::ConvergeError> {
         id: "viscosity",
         markdown: sweep.markdown(),
     })
+}
+
+/// The stiff and extreme case matrix at full size (about 40 s on 2 cores; alone:
+/// `viscobar verify --stiff`); `tests/stiff.rs` runs the reduced size.
+pub fn stiff_section(size: crate::stiff::Size) -> Section {
+    Section {
+        id: "stiff",
+        markdown: crate::stiff::markdown(&crate::stiff::run_all(size)),
+    }
 }

@@ -1,0 +1,790 @@
+//! The stiff and extreme case matrix (`viscobar verify --stiff`, `tests/stiff.rs`): the scheme
+//! at the corners of its parameter space, every step solver that applies, and for each run
+//! either a result checked against round-off tolerances derived from `κ(C)` or an error that
+//! names the step. Never a silent wrong answer.
+//!
+//! Axes: `α ∈ {0, 1e-8, 1e3, 1e6}`, `Δt/Δx ∈ {1e-3, 1, 100, 1e4}`, meshes from 1 element to
+//! 999 999 (1e6 nodes), two Signorini ends at gap 0 with initial contact, a bar lying on a
+//! distributed obstacle, forcing 1e6, overflowing forcing, and 1e6-step runs for drift.
+//!
+//! Per run (solver): the largest relative energy-identity residual, the largest penetration,
+//! the distance to the exact solver (max over nodes and steps), the cumulative drift of the
+//! energy balance, and, for the exact solver, the KKT audit of [`crate::audit`] at its
+//! round-off floors (`eps = 0`), an independent check of the reference itself. `κ(C)` comes
+//! from [`crate::spectrum`].
+//!
+//! Tolerances. A backward-stable tridiagonal solve leaves a stationarity residual
+//! `ρ = Cz − b − r` of about `ROUNDOFF_ULPS·ε·|C||z|` ([`crate::audit::ROUNDOFF_ULPS`]). The
+//! energy identity is the scheme multiplied by `δ/2` (`δ = u^{n+1} − u^{n−1}`), so its
+//! residual is `½ρ·δ` plus the rounding of the energy sums (`n` terms each). The terms of the
+//! identity are quadratic forms of size `δᵀCδ ≥ λ_min |δ|²`, while `|ρ·δ| ≲ ε λ_max |z||δ|`:
+//! relative residual `≲ ROUNDOFF_ULPS·ε·(κ(C) + n)` ([`identity_tolerance`]). The same
+//! forward-error argument bounds a displacement computed by two exact-to-round-off solvers
+//! apart by `ROUNDOFF_ULPS·ε·κ(C)·|u|` per step; the stable scheme carries such a
+//! perturbation forward without growth, so over `N` steps `N` times that ([`roundoff_distance`]).
+
+use crate::audit::{AUDIT_MARGIN, KktAudit, Law, ROUNDOFF_ULPS};
+use crate::error::RunError;
+use crate::scene::{OSQP_DEFAULT_EPS, PENALTY_DEFAULT_EPSILON, Scene};
+use crate::simulation::{Discretisation, Simulation, make_solver};
+use crate::solver::{SolveInfo, SolverReport, StepFailure, StepSolver};
+use rayon::prelude::*;
+use std::fmt::Write;
+
+/// Full size (`viscobar verify --stiff`) or the reduced size of `tests/stiff.rs`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Size {
+    Full,
+    Reduced,
+}
+
+/// Largest mesh of the reduced matrix (the full one goes to 999 999 elements, 1e6 nodes).
+pub const REDUCED_MAX_ELEMENTS: u64 = 100_000;
+/// Steps of the long drift runs: full and reduced.
+pub const LONG_STEPS: usize = 1_000_000;
+pub const REDUCED_LONG_STEPS: usize = 100_000;
+/// OSQP runs only up to this many nodes: its ADMM iterations (up to 100 000 per step at the
+/// default settings) make larger stiff meshes a matter of hours, not of verification.
+pub const OSQP_MAX_NODES: usize = 1001;
+
+/// OSQP against exact, relative to the largest displacement: the requirement of
+/// `tests/solvers.rs` (`1e-7` on displacements of order 1), made relative so that the
+/// forcing-1e6 cases are held to the same standard.
+pub const OSQP_AGREEMENT_REL: f64 = 1e-7;
+/// Penalty against exact: (PP) converges to the exact scheme at first order in ε, with a
+/// constant that depends on the regime (at `Δt ≪ Δx` the penalty contact is a resolved spring
+/// bounce, tens of penetrations away from the exact impact), so no a-priori bound at one ε is
+/// honest. The matrix runs ε and ε/10 and requires the distance to shrink by at least this
+/// factor: first order predicts 10; 5 accepts an observed order down to 0.7 (the talk scenes
+/// measure 0.93–1.0 over ε = 1e-2 … 1e-6, VERIFICATION.md, section "Step solvers").
+pub const PENALTY_CONVERGENCE_FACTOR: f64 = 5.0;
+/// The convergence check applies where (PP) is in its asymptotic regime, `ε <= this · S_jj`
+/// at every constrained node (`S = C⁻¹` there): the penalty reaction is the exact one times
+/// `S_jj/(S_jj + ε)`, linear in ε to within 10 % only then. Elsewhere (`Δt ≪ Δx`, where
+/// `C ≈ M/Δt²` is stiffer than the penalty spring `1/ε`) the distances are reported as
+/// pre-asymptotic, and the penalty answer is still audited against (PP)'s own law.
+pub const PENALTY_ASYMPTOTIC: f64 = 0.1;
+/// The second penalty run of each case: ε/10.
+pub const PENALTY_SMALL_EPSILON: f64 = PENALTY_DEFAULT_EPSILON / 10.0;
+/// OSQP's audit allows, per step, an error in `z` of `AUDIT_MARGIN (eps_abs + eps_rel ‖z‖)`;
+/// its absolute part, carried forward over `N` steps by the stable scheme, is what the relative
+/// requirement above cannot express when `|u| ≪ 1` (gap-0 cases).
+pub const OSQP_STEP_ABS: f64 = AUDIT_MARGIN * OSQP_DEFAULT_EPS;
+
+/// The geometry and data of a case.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Family {
+    /// The `impact` scene: elastic/viscous bar at velocity −1, obstacle 0.1 below the left end,
+    /// right end free.
+    Impact,
+    /// Both ends Signorini at gap 0, bar at rest on them and moving down (velocity −1): contact
+    /// at both ends from the first step.
+    GapZero,
+    /// A distributed obstacle `g(x) = 0.2 + 0.1 cos 2x` with the bar lying on it (`u⁰ = −g`),
+    /// pushed down by gravity `l = −1`: every node in contact (block pivoting).
+    Resting,
+    /// `impact` under the load `l = −1e6` pushing it into the obstacle.
+    Forced,
+    /// `impact` under `l = −1e300`: the displacement overflows; the run must stop with an error.
+    Overflow,
+    /// Free-free bar translating at unit velocity: `u = t` exactly (rigid-mode drift).
+    Rigid,
+    /// Both ends Signorini at gap 0.1, gravity `l = −1`: the bar bounces on the ends forever.
+    Bounce,
+}
+
+impl Family {
+    fn name(self) -> &'static str {
+        match self {
+            Family::Impact => "impact",
+            Family::GapZero => "gap0",
+            Family::Resting => "resting",
+            Family::Forced => "force1e6",
+            Family::Overflow => "overflow",
+            Family::Rigid => "rigid",
+            Family::Bounce => "bounce",
+        }
+    }
+
+    /// The scene's TOML without `[mesh]` and `[time]`.
+    fn toml(self, alpha: f64) -> String {
+        let ends = |l: &str, r: &str| format!("[left]\n{l}\n[right]\n{r}\n");
+        let sig = |a: f64| format!("condition = \"signorini\"\ngap = {a:?}");
+        let free = "condition = \"free\"";
+        let (ends, initial, load, obstacle) = match self {
+            Family::Impact => (ends(&sig(0.1), free), ("0", "-1"), None, None),
+            Family::GapZero => (ends(&sig(0.0), &sig(0.0)), ("0", "-1"), None, None),
+            Family::Resting => (
+                ends(free, free),
+                ("-(0.2 + 0.1*cos(2*x))", "0"),
+                Some("-1"),
+                Some("0.2 + 0.1*cos(2*x)"),
+            ),
+            Family::Forced => (ends(&sig(0.1), free), ("0", "-1"), Some("-1e6"), None),
+            Family::Overflow => (ends(&sig(0.1), free), ("0", "-1"), Some("-1e300"), None),
+            Family::Rigid => (ends(free, free), ("0", "1"), None, None),
+            Family::Bounce => (ends(&sig(0.1), &sig(0.1)), ("0", "0"), Some("-1"), None),
+        };
+        let mut t = format!("[bar]\nlength = 1.0\nviscosity = {alpha:?}\n{ends}");
+        let _ = write!(
+            t,
+            "[initial]\ndisplacement = \"{}\"\nvelocity = \"{}\"\n",
+            initial.0, initial.1
+        );
+        if let Some(l) = load {
+            let _ = write!(t, "[load]\ndensity = \"{l}\"\n");
+        }
+        if let Some(g) = obstacle {
+            let _ = write!(t, "[obstacle]\ngap = \"{g}\"\n");
+        }
+        t
+    }
+}
+
+/// One case of the matrix.
+#[derive(Clone, Debug)]
+pub struct Case {
+    pub family: Family,
+    pub alpha: f64,
+    /// `Δt / Δx`.
+    pub ratio: f64,
+    pub elements: u64,
+    pub steps: usize,
+    /// Whether the exact solver must fail (overflow): any other exact failure is a defect.
+    pub exact_must_fail: bool,
+}
+
+impl Case {
+    fn new(family: Family, alpha: f64, ratio: f64, elements: u64, steps: usize) -> Self {
+        Self {
+            family,
+            alpha,
+            ratio,
+            elements,
+            steps,
+            exact_must_fail: family == Family::Overflow,
+        }
+    }
+
+    /// A short identifier, unique in the matrix.
+    pub fn id(&self) -> String {
+        format!(
+            "{}-a{}-r{}-e{}",
+            self.family.name(),
+            short(self.alpha),
+            short(self.ratio),
+            self.elements
+        )
+    }
+
+    pub fn dx(&self) -> f64 {
+        1.0 / self.elements as f64
+    }
+
+    pub fn dt(&self) -> f64 {
+        self.ratio * self.dx()
+    }
+
+    /// The scene with step solver `solver` (a name of [`Case::solvers`]).
+    pub fn scene(&self, solver: &str) -> Result<Scene, RunError> {
+        let method = match solver {
+            PENALTY_SMALL => format!("method = \"penalty\"\nepsilon = {PENALTY_SMALL_EPSILON:?}"),
+            other => format!("method = \"{other}\""),
+        };
+        let text = format!(
+            "{}[mesh]\nelements = {}\n[time]\nstep = {:?}\nend = {:?}\n[solver]\n{method}\n",
+            self.family.toml(self.alpha),
+            self.elements,
+            self.dt(),
+            self.steps as f64 * self.dt()
+        );
+        Ok(Scene::from_toml(&text, &[])?)
+    }
+
+    /// The solvers run on this case: exact always; OSQP on meshes up to [`OSQP_MAX_NODES`] and
+    /// short runs; penalty wherever OSQP runs and on the large meshes with ends only (it
+    /// refuses obstacles by design; the refusal is part of the table).
+    pub fn solvers(&self) -> Vec<&'static str> {
+        let long = matches!(self.family, Family::Rigid | Family::Bounce);
+        let small = (self.elements as usize) < OSQP_MAX_NODES;
+        let mut v = vec!["exact"];
+        if !long && small {
+            v.push("osqp");
+        }
+        if !long {
+            v.push("penalty");
+            v.push(PENALTY_SMALL);
+        }
+        v
+    }
+}
+
+/// The name of the penalty run at [`PENALTY_SMALL_EPSILON`].
+pub const PENALTY_SMALL: &str = "penalty ε/10";
+
+/// ε of a penalty run.
+fn epsilon_of(solver: &str) -> f64 {
+    if solver == PENALTY_SMALL {
+        PENALTY_SMALL_EPSILON
+    } else {
+        PENALTY_DEFAULT_EPSILON
+    }
+}
+
+/// `1e6`, `0.001` → `1e-3`, `0` → `0`, `1` → `1`.
+fn short(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else if v == 1.0 {
+        "1".into()
+    } else {
+        let s = format!("{v:e}");
+        s.replace("e0", "").replace(".0e", "e")
+    }
+}
+
+/// Steps of a short case: the impact's first contact and release (`t ≤ 2.5`), at least 10
+/// steps and at most 2400 (at `Δt = 1e-3 Δx` that still reaches the first contact at t = 0.1).
+fn steps_for(dt: f64) -> usize {
+    ((2.5 / dt).round() as usize).clamp(10, 2400)
+}
+
+/// The case list. The grid `α × Δt/Δx` runs on 20 elements, the mesh of the independent
+/// figure `κ(C) ≈ 4.1e9` at `α = 1e6`, `Δt = 100 Δx` (see VERIFICATION.md).
+pub fn cases(size: Size) -> Vec<Case> {
+    const ALPHAS: [f64; 4] = [0.0, 1e-8, 1e3, 1e6];
+    const RATIOS: [f64; 4] = [1e-3, 1.0, 100.0, 1e4];
+    const GRID_ELEMENTS: u64 = 20;
+    let dx = 1.0 / GRID_ELEMENTS as f64;
+    let mut v = Vec::new();
+    for family in [Family::Impact] {
+        for alpha in ALPHAS {
+            for ratio in RATIOS {
+                v.push(Case::new(
+                    family,
+                    alpha,
+                    ratio,
+                    GRID_ELEMENTS,
+                    steps_for(ratio * dx),
+                ));
+            }
+        }
+    }
+    // The independent probe's "κ ≈ 3.3 at Δt = Δx", probably at α = 0.1.
+    v.push(Case::new(Family::Impact, 0.1, 1.0, GRID_ELEMENTS, 50));
+    for family in [Family::GapZero, Family::Resting] {
+        for alpha in [0.0, 1e6] {
+            for ratio in RATIOS {
+                v.push(Case::new(family, alpha, ratio, GRID_ELEMENTS, 20));
+            }
+        }
+    }
+    for ratio in RATIOS {
+        v.push(Case::new(Family::Forced, 0.0, ratio, GRID_ELEMENTS, 20));
+    }
+    for ratio in [1.0, 1e4] {
+        v.push(Case::new(Family::Overflow, 0.0, ratio, GRID_ELEMENTS, 20));
+    }
+    let max_elements = match size {
+        Size::Full => 999_999,
+        Size::Reduced => REDUCED_MAX_ELEMENTS,
+    };
+    for elements in [1u64, 2, 1000, 100_000, 999_999] {
+        if elements <= max_elements {
+            let steps = if elements > 1000 { 5 } else { 20 };
+            v.push(Case::new(Family::GapZero, 0.0, 1.0, elements, steps));
+        }
+    }
+    for elements in [100_000u64, 999_999] {
+        if elements <= max_elements {
+            v.push(Case::new(Family::Resting, 0.0, 100.0, elements, 3));
+        }
+    }
+    let long = match size {
+        Size::Full => LONG_STEPS,
+        Size::Reduced => REDUCED_LONG_STEPS,
+    };
+    v.push(Case::new(Family::Rigid, 0.0, 1.0, 10, long));
+    v.push(Case::new(Family::Bounce, 0.0, 1.0, 10, long));
+    v.push(Case::new(Family::Bounce, 1e-8, 1.0, 10, long));
+    v
+}
+
+/// The energy-identity tolerance of a solver exact to round-off (module doc).
+pub fn identity_tolerance(kappa: f64, nodes: usize) -> f64 {
+    ROUNDOFF_ULPS * f64::EPSILON * (kappa + nodes as f64)
+}
+
+/// OSQP's identity residual adds `½ρ·δ` with the stationarity residual `ρ` its audit allows,
+/// `AUDIT_MARGIN · eps` relative to `‖Cz‖`, amplified by `κ(C)` as above.
+pub fn osqp_identity_tolerance(kappa: f64, nodes: usize) -> f64 {
+    identity_tolerance(kappa, nodes) + AUDIT_MARGIN * OSQP_DEFAULT_EPS * kappa
+}
+
+/// Two round-off-exact solvers apart after `steps` steps, displacement scale `scale`.
+pub fn roundoff_distance(kappa: f64, steps: usize, scale: f64) -> f64 {
+    ROUNDOFF_ULPS * f64::EPSILON * kappa * steps as f64 * scale
+}
+
+/// Penetration of a solver meeting the bounds to round-off: the exact solvers put an active
+/// node on its bound exactly and leave inactive ones above it up to the forward error of `z`.
+pub fn violation_tolerance(kappa: f64, scale: f64) -> f64 {
+    ROUNDOFF_ULPS * f64::EPSILON * kappa * scale
+}
+
+/// What happened to one solver on one case.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolverRun {
+    pub solver: &'static str,
+    /// `None`: the run completed; `Some`: the error, shortened for the table.
+    pub error: Option<String>,
+    /// Whether the error names the step it occurred at (or came before the first step, from
+    /// the set-up).
+    pub error_located: bool,
+    pub steps_done: usize,
+    pub max_identity_residual: f64,
+    /// `max(0, −(u_j + a_j))` over steps and constrained nodes.
+    pub max_violation: f64,
+    pub max_reaction: f64,
+    /// `max_{n,i} |u − u_exact|` over the steps both completed (`None` for exact itself).
+    pub distance: Option<f64>,
+    /// Largest displacement of this run.
+    pub max_displacement: f64,
+    /// `|E^{N−1/2} − E^{1/2} − Σ (work − viscous − contact)|` over the largest of `E` and the
+    /// summed magnitudes of the terms.
+    pub energy_drift: f64,
+    /// Exact solver: worst ratio of its KKT audit at round-off floors to its tolerance.
+    pub audit_ratio: Option<f64>,
+    /// Rigid case, exact solver: `max_i |u_i − t|` at the end.
+    pub rigid_drift: Option<f64>,
+    pub all_finite: bool,
+}
+
+/// One case with its condition number and the runs of its solvers (exact first).
+#[derive(Clone, Debug)]
+pub struct CaseResult {
+    pub case: Case,
+    pub kappa: Option<f64>,
+    pub nodes: usize,
+    pub max_gap: f64,
+    /// `min_j` and `max_j (C⁻¹)_jj` over the constrained nodes (ends only; `None` for an
+    /// obstacle or when there is none).
+    pub schur: Option<(f64, f64)>,
+    pub runs: Vec<SolverRun>,
+}
+
+/// The exact solver with the KKT audit at round-off floors recorded after every step (not
+/// enforced: a miss is reported in the table, the run goes on).
+struct Audited {
+    inner: Box<dyn StepSolver>,
+    audit: KktAudit,
+}
+
+impl StepSolver for Audited {
+    fn name(&self) -> &'static str {
+        self.inner.name()
+    }
+
+    fn solve(
+        &mut self,
+        rhs: &[f64],
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<SolveInfo, StepFailure> {
+        let info = self.inner.solve(rhs, lower, z, reactions)?;
+        let law = Law::Signorini {
+            eps_abs: 0.0,
+            eps_rel: 0.0,
+        };
+        match self.audit.check(law, rhs, lower, z, reactions) {
+            Err(StepFailure::NonFinite) => Err(StepFailure::NonFinite),
+            _ => Ok(info),
+        }
+    }
+
+    fn report(&self) -> Option<SolverReport> {
+        Some(SolverReport {
+            audit: self.audit.report().clone(),
+            inaccurate_steps: None,
+        })
+    }
+}
+
+/// The worst audit ratio of the exact solver, force stationarity `‖Cz − b − r‖` left out: the
+/// end enumeration puts an active node on its bound exactly, moving `z_j` by its forward error
+/// (up to `κ ε |z|`), which leaves a force residual `C_jj` times that by design. Its image in
+/// displacement, `‖C⁻¹(Cz − b − r)‖`, is checked: that is the error of the answer.
+fn worst_ratio(r: &crate::audit::AuditReport) -> f64 {
+    [
+        r.primal_violation.map_or(0.0, |w| w.max_over_tolerance),
+        r.negative_reaction.max_over_tolerance,
+        r.complementarity.map_or(0.0, |w| w.max_over_tolerance),
+        r.stationarity_displacement.max_over_tolerance,
+    ]
+    .into_iter()
+    .fold(0.0, f64::max)
+}
+
+fn build(case: &Case, method: &str) -> Result<Simulation, RunError> {
+    let scene = case.scene(method)?;
+    if method != "exact" {
+        return Simulation::new(&scene);
+    }
+    let disc = Discretisation::new(&scene)?;
+    let inner = make_solver(&scene, &disc)?;
+    let audit = KktAudit::new(&disc.step_matrix, &disc.constrained_locals(), false)?;
+    Simulation::with_solver(&scene, disc, Box::new(Audited { inner, audit }))
+}
+
+/// The table's short form of an error.
+fn short_error(e: &RunError) -> (String, bool) {
+    match e {
+        RunError::Step { step, failure, .. } => {
+            let what = match failure {
+                StepFailure::AuditFailed { what, .. } => format!("audit: {what}"),
+                other => other.to_string(),
+            };
+            (format!("error at step {step}: {what}"), true)
+        }
+        // Set-up errors come before the first step (a refused solver, a singular C).
+        other => (format!("refused: {other}"), true),
+    }
+}
+
+/// One solver's run state while stepping in lockstep with the others.
+struct Live {
+    sim: Option<Simulation>,
+    out: SolverRun,
+    u: Vec<f64>,
+    energy_first: f64,
+    energy_last: f64,
+    energy_max: f64,
+    balance: f64,
+    magnitude: f64,
+}
+
+impl Live {
+    fn fail(&mut self, e: &RunError) {
+        let (msg, located) = short_error(e);
+        self.out.error = Some(msg);
+        self.out.error_located = located;
+        self.sim = None;
+    }
+
+    fn observe(&mut self, r: &crate::simulation::StepRecord, first: bool) {
+        let o = &mut self.out;
+        o.steps_done = r.step;
+        o.max_violation = o.max_violation.max(-r.min_gap);
+        if !first {
+            o.max_identity_residual = o.max_identity_residual.max(r.identity_residual);
+            self.balance += r.work - r.viscous_dissipation - r.contact_dissipation;
+            self.magnitude += r.work.abs() + r.viscous_dissipation + r.contact_dissipation.abs();
+        } else {
+            self.energy_first = r.energy;
+        }
+        self.energy_last = r.energy;
+        self.energy_max = self.energy_max.max(r.energy.abs());
+        if let Some(sim) = &self.sim {
+            sim.displacement_into(&mut self.u);
+            let m = self.u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            o.all_finite &= self.u.iter().all(|v| v.is_finite());
+            o.max_displacement = o.max_displacement.max(m);
+            let rmax = sim.reactions().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            o.max_reaction = o.max_reaction.max(rmax);
+        }
+    }
+}
+
+/// Runs one case: every solver in lockstep with the exact one, compared after every step.
+pub fn run_case(case: &Case) -> CaseResult {
+    let nodes = case.elements as usize + 1;
+    let mut kappa = None;
+    let mut max_gap = 0.0f64;
+    let mut schur = None;
+    let mut live: Vec<Live> = case
+        .solvers()
+        .into_iter()
+        .map(|solver| {
+            let mut l = Live {
+                sim: None,
+                out: SolverRun {
+                    solver,
+                    error: None,
+                    error_located: false,
+                    steps_done: 0,
+                    max_identity_residual: 0.0,
+                    max_violation: 0.0,
+                    max_reaction: 0.0,
+                    distance: (solver != "exact").then_some(0.0),
+                    max_displacement: 0.0,
+                    energy_drift: 0.0,
+                    audit_ratio: None,
+                    rigid_drift: None,
+                    all_finite: true,
+                },
+                u: vec![0.0; nodes],
+                energy_first: 0.0,
+                energy_last: 0.0,
+                energy_max: 0.0,
+                balance: 0.0,
+                magnitude: 0.0,
+            };
+            match build(case, solver) {
+                Ok(sim) => {
+                    if kappa.is_none() {
+                        let d = sim.discretisation();
+                        kappa = crate::spectrum::condition_number(&d.step_matrix);
+                        max_gap = d.constraints.iter().fold(0.0, |m, c| m.max(c.gap));
+                        schur = d.ends_only().then(|| inverse_diagonal_range(d)).flatten();
+                    }
+                    let first = sim.first_record();
+                    l.sim = Some(sim);
+                    l.observe(&first, true);
+                }
+                Err(e) => l.fail(&e),
+            }
+            l
+        })
+        .collect();
+    compare_with_exact(&mut live);
+    for _ in 1..case.steps {
+        if live.iter().all(|l| l.sim.is_none()) {
+            break;
+        }
+        for l in live.iter_mut() {
+            let Some(sim) = l.sim.as_mut() else { continue };
+            match sim.step() {
+                Ok(r) => l.observe(&r, false),
+                Err(e) => l.fail(&e),
+            }
+        }
+        compare_with_exact(&mut live);
+    }
+    let runs = live
+        .into_iter()
+        .map(|mut l| {
+            let scale = l.energy_max.max(l.magnitude);
+            let drift = (l.energy_last - l.energy_first - l.balance).abs();
+            l.out.energy_drift = if scale > 0.0 { drift / scale } else { 0.0 };
+            if let Some(sim) = &l.sim {
+                l.out.audit_ratio = (l.out.solver == "exact")
+                    .then(|| sim.solver_report().map_or(0.0, |r| worst_ratio(&r.audit)));
+                if case.family == Family::Rigid {
+                    let t = sim.time();
+                    let d = l.u.iter().fold(0.0f64, |m, v| m.max((v - t).abs()));
+                    l.out.rigid_drift = Some(d);
+                }
+            }
+            l.out
+        })
+        .collect();
+    CaseResult {
+        case: case.clone(),
+        kappa,
+        nodes,
+        max_gap,
+        schur,
+        runs,
+    }
+}
+
+/// `(min_j, max_j) (C⁻¹)_jj` over the constrained nodes, one O(n) solve each (at most two).
+fn inverse_diagonal_range(d: &Discretisation) -> Option<(f64, f64)> {
+    let factor = crate::tridiag::Ldlt::factor(&d.step_matrix).ok()?;
+    d.constrained_locals()
+        .iter()
+        .map(|&j| factor.column_of_inverse(j)[j])
+        .fold(None, |acc, v| match acc {
+            None => Some((v, v)),
+            Some((lo, hi)) => Some((v.min(lo), v.max(hi))),
+        })
+}
+
+/// Whether the penalty runs of this case are in (PP)'s asymptotic regime.
+pub fn penalty_asymptotic(result: &CaseResult) -> bool {
+    result
+        .schur
+        .is_some_and(|(s, _)| PENALTY_DEFAULT_EPSILON <= PENALTY_ASYMPTOTIC * s)
+}
+
+/// After a step of every live run: the distance of each to the exact run (index 0), while
+/// both are alive (`observe` has just copied each run's `u^n` into `l.u`).
+fn compare_with_exact(live: &mut [Live]) {
+    let (exact, others) = live.split_first_mut().expect("exact first");
+    if exact.sim.is_none() {
+        return;
+    }
+    for l in others.iter_mut().filter(|l| l.sim.is_some()) {
+        let d =
+            l.u.iter()
+                .zip(&exact.u)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        if let Some(dist) = l.out.distance.as_mut() {
+            *dist = dist.max(d);
+        }
+    }
+}
+
+/// The checks of one run, each as (what, value, tolerance); a run passes when every value is
+/// within its tolerance (NaN fails).
+pub fn checks(result: &CaseResult, run: &SolverRun) -> Vec<(&'static str, f64, f64)> {
+    let kappa = result.kappa.unwrap_or(f64::INFINITY);
+    let exact = &result.runs[0];
+    let scale = run.max_displacement + result.max_gap;
+    let steps = run.steps_done.max(1);
+    let mut v = Vec::new();
+    let id_tol = match run.solver {
+        "osqp" => osqp_identity_tolerance(kappa, result.nodes),
+        _ => identity_tolerance(kappa, result.nodes),
+    };
+    v.push(("identity residual", run.max_identity_residual, id_tol));
+    // The drift is the sum of the per-step residuals, each within the identity tolerance.
+    v.push(("energy drift", run.energy_drift, steps as f64 * id_tol));
+    let violation_tol = match run.solver {
+        "osqp" => {
+            AUDIT_MARGIN * OSQP_DEFAULT_EPS * (1.0 + scale) + violation_tolerance(kappa, scale)
+        }
+        "exact" => violation_tolerance(kappa, scale),
+        // (PP) penetrates by ε r by design; `z_j = z⁰_j + Σ S_jk r_k` is rounded to ulps of
+        // `|z⁰_j| <= |z_j| + S_jj r` (as in the audit's penalty-law floor).
+        _ => {
+            let s_max = result.schur.map_or(0.0, |(_, hi)| hi);
+            let eps_r = epsilon_of(run.solver) * run.max_reaction;
+            eps_r
+                + ROUNDOFF_ULPS * f64::EPSILON * (eps_r + s_max * run.max_reaction)
+                + violation_tolerance(kappa, scale)
+        }
+    };
+    v.push(("violation", run.max_violation, violation_tol));
+    if let Some(d) = run.distance {
+        let s = exact.max_displacement.max(run.max_displacement);
+        let base = roundoff_distance(kappa, steps, s);
+        let coarse = result
+            .runs
+            .iter()
+            .find(|r| r.solver == "penalty" && r.error.is_none());
+        let tol = match run.solver {
+            "osqp" => OSQP_AGREEMENT_REL * s + steps as f64 * OSQP_STEP_ABS + base,
+            PENALTY_SMALL if penalty_asymptotic(result) => coarse
+                .and_then(|r| r.distance)
+                .map_or(f64::INFINITY, |d| d / PENALTY_CONVERGENCE_FACTOR + base),
+            // Penalty at ε: reported; its convergence is checked by the ε/10 run.
+            _ => f64::INFINITY,
+        };
+        v.push(("distance to exact", d, tol));
+    }
+    if let Some(a) = run.audit_ratio {
+        v.push(("KKT audit at round-off", a, 1.0));
+    }
+    if let Some(d) = run.rigid_drift {
+        // Each step rounds u + z to an ulp of |u|: at most N ulps of the final |u| = t.
+        v.push((
+            "rigid drift |u - t|",
+            d,
+            rigid_drift_tolerance(steps, scale),
+        ));
+    }
+    v
+}
+
+/// `u^{n+1} = u^n + z` rounds once per step to half an ulp of `|u| <= t_N`; `N` steps.
+pub fn rigid_drift_tolerance(steps: usize, max_u: f64) -> f64 {
+    steps as f64 * f64::EPSILON * max_u
+}
+
+/// Why a run does not pass, or `None`. A completed run passes when it is finite and every
+/// check holds; a failed run passes when its error names the step (or is a set-up refusal)
+/// and the case allows it: the exact solver must complete unless the case overflows, and then
+/// it must fail.
+pub fn verdict(result: &CaseResult, run: &SolverRun) -> Option<String> {
+    let must_fail = result.case.exact_must_fail;
+    match &run.error {
+        Some(e) if !run.error_located => Some(format!("error without its step: {e}")),
+        Some(e) if run.solver == "exact" && !must_fail => Some(format!("exact failed: {e}")),
+        Some(_) => None,
+        None if must_fail => Some("completed although the data overflow".into()),
+        None if !run.all_finite => Some("non-finite displacement reported as success".into()),
+        None => {
+            let bad: Vec<String> = checks(result, run)
+                .into_iter()
+                // A NaN value or tolerance fails too.
+                .filter(|(_, v, t)| {
+                    matches!(v.partial_cmp(t), None | Some(std::cmp::Ordering::Greater))
+                })
+                .map(|(w, v, t)| format!("{w} {v:.1e} > {t:.1e}"))
+                .collect();
+            (!bad.is_empty()).then(|| bad.join("; "))
+        }
+    }
+}
+
+/// Runs every case, in parallel on rayon's pool, results in case order (deterministic).
+pub fn run_all(size: Size) -> Vec<CaseResult> {
+    cases(size).par_iter().map(run_case).collect()
+}
+
+fn sci(v: f64) -> String {
+    format!("{v:.1e}")
+}
+
+/// The Markdown table: one row per case and solver; each checked figure as `value / tolerance`.
+pub fn markdown(results: &[CaseResult]) -> String {
+    let mut md = String::from(
+        "| case | elements | α | Δt/Δx | steps | κ(C) | solver | outcome | identity residual / tol | \
+         penetration / tol | distance to exact / tol | energy drift / tol | exact: KKT audit ratio |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in results {
+        let c = &r.case;
+        for run in &r.runs {
+            let outcome = match (&run.error, verdict(r, run)) {
+                (_, Some(why)) => format!("**FAIL**: {why}"),
+                (Some(e), None) => e.clone(),
+                (None, None) => "ok".into(),
+            };
+            let checks = checks(r, run);
+            let cell = |name: &str| {
+                if run.error.is_some() {
+                    return "–".to_string();
+                }
+                checks
+                    .iter()
+                    .find(|(w, _, _)| *w == name)
+                    .map_or("–".into(), |(_, v, t)| match t.is_finite() {
+                        true => format!("{} / {}", sci(*v), sci(*t)),
+                        false => sci(*v),
+                    })
+            };
+            let pre =
+                run.solver.starts_with("penalty") && run.error.is_none() && !penalty_asymptotic(r);
+            let distance = if pre {
+                format!("{} (pre-asymptotic)", cell("distance to exact"))
+            } else if run.solver == "exact" {
+                run.rigid_drift.map_or("(reference)".into(), |_| {
+                    format!("u = t: {}", cell("rigid drift |u - t|"))
+                })
+            } else {
+                cell("distance to exact")
+            };
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                c.id(),
+                c.elements,
+                short(c.alpha),
+                short(c.ratio),
+                c.steps,
+                r.kappa.map_or("not SPD".into(), sci),
+                run.solver,
+                outcome.replace('|', "\\|"),
+                cell("identity residual"),
+                cell("violation"),
+                distance,
+                cell("energy drift"),
+                run.audit_ratio.map_or("–".into(), sci),
+            );
+        }
+    }
+    md
+}
