@@ -205,8 +205,8 @@ impl StepSolver for BlockPivotSolver {
             if count < best_count {
                 best_count = count;
                 patience = BLOCK_PATIENCE;
-            } else if patience > 0 {
-                patience -= 1;
+            } else {
+                patience = patience.saturating_sub(1);
             }
             if patience > 0 || count < best_count {
                 for &k in &self.infeasible {

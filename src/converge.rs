@@ -731,7 +731,7 @@ fn write_plot(
 /// Viscosities of the `α → 0` sweep: half-decades from 1e-1 down to 1e-6.
 pub const SWEEP_ALPHAS: [f64; 11] = [
     1e-1,
-    3.162_277_660_168_379_5e-2,
+    3.162_277_660_168_38e-2,
     1e-2,
     3.162_277_660_168_379_5e-3,
     1e-3,

@@ -451,7 +451,7 @@ impl Scene {
             .iter()
             .filter(|e| e.condition == Condition::Clamped)
             .count() as u64;
-        if elements < 1 || elements > MAX_ELEMENTS || elements + 1 <= clamped {
+        if !(1..=MAX_ELEMENTS).contains(&elements) || elements < clamped {
             return Err(SceneError::Invalid {
                 field: "mesh.elements".into(),
                 value: elements.to_string(),

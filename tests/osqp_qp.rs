@@ -12,8 +12,6 @@ use viscobar::scene::OSQP_DEFAULT_EPS;
 use viscobar::solver::StepSolver;
 use viscobar::tridiag::SymTridiag;
 
-/// Smallest diagonal-dominance margin of the generator: by Varah's bound (1975)
-
 fn norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }

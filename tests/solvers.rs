@@ -81,9 +81,7 @@ fn check_solver(method: Method) {
         let scene = with_method(name, method, &[]);
         if matches!(method, Method::Penalty) && scene.obstacle.is_some() {
             // Normal compliance is implemented for the two ends only: refused, not run.
-            let err = compare(name, &exact, &scene)
-                .err()
-                .expect("penalty refuses an obstacle");
+            let err = compare(name, &exact, &scene).expect_err("penalty refuses an obstacle");
             assert!(err.to_string().contains("penalty"), "{err}");
             continue;
         }
