@@ -1,8 +1,9 @@
-//! Peak resident memory of a long run (issue 7: J = 1e6 nodes-ish with 1e4 steps under
-//! 200 MB). Runs `viscobar run` on a free-free viscoelastic bar with J + 1 elements and the
-//! given number of steps, writing its outputs into `target/peak-memory/` (displacement.csv
-//! keeps t = 0 and the last step only), then prints the run's summary figures and the peak
-//! resident set size of this process (`VmHWM` in /proc/self/status):
+//! Peak resident memory of a long run (issue 7: J = 1e6 with 1e4 steps under 200 MB). Runs
+//! `run::run_to_dir` (what `viscobar run` does) on a free-free viscoelastic bar with J + 1
+//! elements and the given number of steps, writing its outputs into `target/peak-memory/`
+//! (displacement.csv keeps t = 0 and the last step only), then prints the run's summary figures and the peak
+//! resident set size of this process (`VmHWM` in /proc/self/status). With `100000 2000` it
+//! gives `run`'s end-to-end ns_per_node_step at J = 1e5, to compare with the step bench:
 //!
 //!     cargo run --release --example peak_memory -- [ELEMENTS] [STEPS]   # default 1000000 10000
 
@@ -16,7 +17,9 @@ fn vm_hwm_kib() -> Option<u64> {
 
 fn main() {
     let mut args = std::env::args().skip(1);
-    let elements: u64 = args.next().map_or(1_000_000, |s| s.parse().expect("ELEMENTS"));
+    let elements: u64 = args
+        .next()
+        .map_or(1_000_000, |s| s.parse().expect("ELEMENTS"));
     let steps: u64 = args.next().map_or(10_000, |s| s.parse().expect("STEPS"));
     let dt = 1.0 / elements as f64;
     let scene = viscobar::Scene::from_toml(
@@ -38,10 +41,20 @@ fn main() {
         "elements {elements}, steps {}, nodes {}: wall {:.1} s, {:.2} ns per node-step",
         summary.steps, summary.nodes, summary.wall_time_s, summary.ns_per_node_step
     );
+    let s = summary.time_shares;
+    println!(
+        "time shares of the steps: solver {:.2}, rhs {:.2}, update {:.2}, diagnostics {:.2} \
+         ({} sampled steps; stepping {:.2} of the wall time)",
+        s.solver, s.rhs, s.update, s.diagnostics, s.sampled_steps, s.stepping
+    );
     println!(
         "peak RSS (VmHWM) {:.1} MB (before the run {:.1} MB); target 200 MB: {}",
         peak as f64 * 1024.0 / 1e6,
         before.unwrap_or(0) as f64 * 1024.0 / 1e6,
-        if peak as f64 * 1024.0 <= 200e6 { "met" } else { "not met" }
+        if peak as f64 * 1024.0 <= 200e6 {
+            "met"
+        } else {
+            "not met"
+        }
     );
 }

@@ -24,13 +24,31 @@ fn thinning_leaves_the_trajectory_unchanged_and_measured_steps_close_the_identit
         let mut measured = 0;
         for _ in 1..steps {
             let (ra, rb) = (a.step().unwrap(), b.step().unwrap());
-            assert!(ra.measured, "{name}: step {} not measured by default", ra.step);
-            assert_eq!(rb.measured, rb.step % 7 == 0 || rb.step == steps, "{name}: {}", rb.step);
-            assert_eq!(a.displacement(), b.displacement(), "{name}: step {}", ra.step);
+            assert!(
+                ra.measured,
+                "{name}: step {} not measured by default",
+                ra.step
+            );
+            assert_eq!(
+                rb.measured,
+                rb.step % 7 == 0 || rb.step == steps,
+                "{name}: {}",
+                rb.step
+            );
+            assert_eq!(
+                a.displacement(),
+                b.displacement(),
+                "{name}: step {}",
+                ra.step
+            );
             assert_eq!((ra.gap, ra.reaction), (rb.gap, rb.reaction), "{name}");
             if rb.measured {
                 measured += 1;
-                assert!(rb.identity_residual <= IDENTITY_TOL, "{name}: step {}", rb.step);
+                assert!(
+                    rb.identity_residual <= IDENTITY_TOL,
+                    "{name}: step {}",
+                    rb.step
+                );
                 assert!(
                     (ra.energy - rb.energy).abs() <= ENERGY_ROUNDOFF_TOL * ra.energy.max(1.0),
                     "{name}: step {}: {} vs {}",
@@ -42,7 +60,10 @@ fn thinning_leaves_the_trajectory_unchanged_and_measured_steps_close_the_identit
                 assert_eq!(rb.energy, 0.0);
             }
         }
-        assert!(measured >= (steps - 1) / 7, "{name}: {measured} measured steps");
+        assert!(
+            measured >= (steps - 1) / 7,
+            "{name}: {measured} measured steps"
+        );
     }
 }
 

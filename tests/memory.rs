@@ -63,6 +63,9 @@ fn peak_heap_is_linear_in_nodes_and_independent_of_steps() {
         let long = peak_heap(&scene, 1000);
         let bound = viscobar::scene::BYTES_PER_NODE as usize * nodes;
         assert!(long <= bound, "{name}: peak {long} B > {bound} B");
-        assert_eq!(short, long, "{name}: the peak grows with the number of steps");
+        assert_eq!(
+            short, long,
+            "{name}: the peak grows with the number of steps"
+        );
     }
 }
