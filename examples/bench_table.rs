@@ -1,11 +1,18 @@
-//! Prints the last criterion measurements of `benches/step.rs` as a Markdown table (median
-//! time per step, ns per node-step, and the ratio to the unconstrained step at equal J), read
-//! from `target/criterion/step/*/*/new/estimates.json`. Run after `cargo bench --bench step`:
+//! Prints the last criterion measurements of `benches/step.rs` and `benches/scenes.rs` as
+//! Markdown (median time per step or per run, ns per node-step, and for steps the ratio to the
+//! unconstrained step at equal J), read from `target/criterion/{step,scenes}/*/…/new/
+//! estimates.json`, followed by issue 7's targets, each marked met or not met. Run after
+//! `cargo bench --bench step` and `cargo bench --bench scenes`:
 //!
 //!     cargo run --release --example bench_table
 
 use std::collections::BTreeMap;
 use std::path::Path;
+
+/// Issue 7's targets.
+const BARE_NS_PER_NODE_TARGET: f64 = 2.0;
+const DIAGNOSTICS_OVERHEAD_TARGET: f64 = 0.5;
+const EXACT_RATIO_TARGET: f64 = 1.15;
 
 fn median_ns(path: &Path) -> Option<f64> {
     let text = std::fs::read_to_string(path).ok()?;
@@ -13,17 +20,10 @@ fn median_ns(path: &Path) -> Option<f64> {
     v["median"]["point_estimate"].as_f64()
 }
 
-fn main() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/criterion/step");
-    let mut rows: BTreeMap<(u64, String), f64> = BTreeMap::new();
-    let Ok(labels) = std::fs::read_dir(&root) else {
-        eprintln!(
-            "no measurements in {}: run `cargo bench --bench step` first",
-            root.display()
-        );
-        std::process::exit(1);
-    };
-    for label in labels.flatten() {
+/// `(size, label) -> median ns` of a group laid out as `group/label/size/new`.
+fn step_rows(root: &Path) -> BTreeMap<(u64, String), f64> {
+    let mut rows = BTreeMap::new();
+    for label in std::fs::read_dir(root).into_iter().flatten().flatten() {
         let name = label.file_name().to_string_lossy().into_owned();
         for size in std::fs::read_dir(label.path())
             .into_iter()
@@ -38,18 +38,86 @@ fn main() {
             }
         }
     }
+    rows
+}
+
+fn verdict(ok: bool) -> &'static str {
+    if ok { "met" } else { "not met" }
+}
+
+fn main() {
+    let target = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/criterion");
+    let rows = step_rows(&target.join("step"));
+    if rows.is_empty() {
+        eprintln!("no measurements in target/criterion/step: run `cargo bench --bench step` first");
+        std::process::exit(1);
+    }
+    let get = |j: u64, name: &str| rows.get(&(j, name.to_string())).copied();
     println!("| elements | step | median per step | ns per node-step | / unconstrained |");
     println!("|---|---|---|---|---|");
     for ((j, name), t) in &rows {
-        let base = rows
-            .get(&(*j, "unconstrained".to_string()))
-            .copied()
-            .unwrap_or(f64::NAN);
+        let base = get(*j, "unconstrained").unwrap_or(f64::NAN);
         println!(
             "| {j} | {name} | {:.1} µs | {:.2} | {:.3} |",
             t / 1e3,
             t / (*j + 1) as f64,
             t / base
         );
+    }
+    let scenes = target.join("scenes");
+    let mut scene_rows = Vec::new();
+    for entry in std::fs::read_dir(&scenes).into_iter().flatten().flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if let Some(t) = median_ns(&entry.path().join("new/estimates.json")) {
+            scene_rows.push((name, t));
+        }
+    }
+    scene_rows.sort_by(|a, b| a.0.cmp(&b.0));
+    if !scene_rows.is_empty() {
+        println!();
+        println!("| scene (default size, end to end) | median per run | ns per node-step |");
+        println!("|---|---|---|");
+        for (name, t) in &scene_rows {
+            let (_, scene) = viscobar::scene::load(name, &[]).expect("talk scene");
+            let node_steps = (scene.elements() + 1) as f64 * scene.steps() as f64;
+            println!("| {name} | {:.1} ms | {:.2} |", t / 1e6, t / node_steps);
+        }
+    }
+    println!();
+    println!("Targets (issue 7):");
+    let sizes: Vec<u64> = rows.keys().map(|k| k.0).collect();
+    if let Some(bare) = get(100_000, "unconstrained-bare") {
+        let per_node = bare / 100_001.0;
+        println!(
+            "- unconstrained step without diagnostics at J = 1e5: {per_node:.2} ns per node-step \
+             (target <= {BARE_NS_PER_NODE_TARGET}): {}",
+            verdict(per_node <= BARE_NS_PER_NODE_TARGET)
+        );
+    }
+    let mut seen = std::collections::BTreeSet::new();
+    for j in sizes.iter().copied().filter(|j| seen.insert(*j)) {
+        let (Some(bare), Some(full)) = (get(j, "unconstrained-bare"), get(j, "unconstrained"))
+        else {
+            continue;
+        };
+        let over = full / bare - 1.0;
+        println!(
+            "- diagnostics at J = {j}: +{:.0} % over the bare step (target <= {:.0} %): {}",
+            100.0 * over,
+            100.0 * DIAGNOSTICS_OVERHEAD_TARGET,
+            verdict(over <= DIAGNOSTICS_OVERHEAD_TARGET)
+        );
+        let Some(base) = get(j, "unconstrained") else {
+            continue;
+        };
+        for name in ["exact-one-end", "exact-two-ends"] {
+            if let Some(t) = get(j, name) {
+                println!(
+                    "- {name} at J = {j}: {:.3}x unconstrained (target <= {EXACT_RATIO_TARGET}): {}",
+                    t / base,
+                    verdict(t / base <= EXACT_RATIO_TARGET)
+                );
+            }
+        }
     }
 }

@@ -25,6 +25,8 @@ pub struct Summary {
     pub final_time: f64,
     pub wall_time_s: f64,
     pub ns_per_node_step: f64,
+    /// Shares of the stepping time per phase, estimated on a sample of the steps.
+    pub time_shares: TimeShares,
     /// `E^{1/2}`.
     pub energy_initial: f64,
     /// `E^{N−1/2}`.
@@ -49,6 +51,44 @@ pub struct Summary {
     /// Steps where OSQP's "solved inaccurate" was accepted (`accept_inaccurate`; osqp only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub inaccurate_steps: Option<u64>,
+}
+
+/// Where the time of the steps goes, as fractions of the timed phases of the sampled steps
+/// (one in [`crate::simulation::TIMING_SAMPLE_EVERY`], see [`crate::simulation::PhaseTimes`]):
+/// `rhs` (load and right-hand side), `solver` (the step solver, including its copy of the
+/// right-hand side), `update` (`u += z`), `diagnostics` (energy balance and contact state).
+/// `stepping` is the sampled phases' share of the wall time (the rest is set-up, start-up and
+/// writing the outputs), extrapolated from the sample.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct TimeShares {
+    pub solver: f64,
+    pub rhs: f64,
+    pub update: f64,
+    pub diagnostics: f64,
+    pub stepping: f64,
+    pub sampled_steps: u64,
+}
+
+impl TimeShares {
+    fn new(sim: &Simulation, wall_time_s: f64) -> Self {
+        let p = sim.phase_times();
+        let total = p.total_ns() as f64;
+        let share = |x: u64| if total > 0.0 { x as f64 / total } else { 0.0 };
+        let steps = sim.step_index().saturating_sub(1) as f64;
+        let per_step = total / p.sampled_steps.max(1) as f64;
+        Self {
+            solver: share(p.solve_ns),
+            rhs: share(p.rhs_ns),
+            update: share(p.update_ns),
+            diagnostics: share(p.diagnostics_ns),
+            stepping: if wall_time_s > 0.0 {
+                per_step * steps / (wall_time_s * 1e9)
+            } else {
+                0.0
+            },
+            sampled_steps: p.sampled_steps,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, Default, Serialize)]
@@ -117,12 +157,16 @@ impl Tracker {
         t
     }
 
-    /// Takes the record of the next step.
+    /// Takes the record of the next step. With thinned diagnostics, the energy statistics
+    /// cover the measured steps: a rise is then over the steps since the last measured one
+    /// (the identity telescopes, so without load that rise is still ≤ 0 up to round-off).
     pub fn observe(&mut self, r: &StepRecord) {
-        self.max_rise = self.max_rise.max(r.energy - self.energy_prev);
-        self.energy_prev = r.energy;
-        self.energy_final = r.energy;
-        self.max_residual = self.max_residual.max(r.identity_residual);
+        if r.measured {
+            self.max_rise = self.max_rise.max(r.energy - self.energy_prev);
+            self.energy_prev = r.energy;
+            self.energy_final = r.energy;
+            self.max_residual = self.max_residual.max(r.identity_residual);
+        }
         self.iterations_sum += u64::from(r.iterations);
         self.iterations_max = self.iterations_max.max(r.iterations);
         self.records += 1;
@@ -162,6 +206,7 @@ impl Tracker {
             final_time: sim.time(),
             wall_time_s,
             ns_per_node_step: wall_time_s * 1e9 / (steps as f64 * disc.nodes as f64),
+            time_shares: TimeShares::new(sim, wall_time_s),
             energy_initial: self.energy_initial,
             energy_final: self.energy_final,
             max_energy_rise: (self.unforced && self.records > 0)
@@ -332,17 +377,22 @@ fn write_history_row(
     k: usize,
     obstacle: bool,
 ) -> std::io::Result<()> {
-    write!(
-        w,
-        "{},{},{},{},{},{},{}",
-        r.step,
-        r.time,
-        r.energy,
-        r.work,
-        r.viscous_dissipation,
-        r.contact_dissipation,
-        r.identity_residual
-    )?;
+    if r.measured {
+        write!(
+            w,
+            "{},{},{},{},{},{},{}",
+            r.step,
+            r.time,
+            r.energy,
+            r.work,
+            r.viscous_dissipation,
+            r.contact_dissipation,
+            r.identity_residual
+        )?;
+    } else {
+        // Not measured ([output] diagnostics_every): empty cells, not zeros.
+        write!(w, "{},{},,,,,", r.step, r.time)?;
+    }
     for j in 0..k {
         write!(w, ",{},{}", r.gap[j], r.reaction[j])?;
     }

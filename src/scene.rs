@@ -293,11 +293,18 @@ pub struct OutputSpec {
     /// Keep every `every`-th step in `displacement.csv` (the last step is always kept).
     #[serde(default = "one")]
     pub every: u64,
+    /// Measure the energy balance (an extra pass over the bar) at every `diagnostics_every`-th
+    /// step and at the last; the contact state is recorded at every step regardless.
+    #[serde(default = "one")]
+    pub diagnostics_every: u64,
 }
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        Self { every: 1 }
+        Self {
+            every: 1,
+            diagnostics_every: 1,
+        }
     }
 }
 
@@ -489,6 +496,13 @@ impl Scene {
             return Err(invalid(
                 "output.every",
                 self.output.every as f64,
+                "must be >= 1",
+            ));
+        }
+        if self.output.diagnostics_every < 1 {
+            return Err(invalid(
+                "output.diagnostics_every",
+                self.output.diagnostics_every as f64,
                 "must be >= 1",
             ));
         }

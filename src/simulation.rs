@@ -29,7 +29,8 @@ use crate::osqp_solver::{OsqpSettings, OsqpSolver};
 use crate::penalty::PenaltySolver;
 use crate::scene::{Condition, PENALTY_DEFAULT_EPSILON, Scene, Side, SolverMethod};
 use crate::solver::{SolveInfo, SolverReport, StepSolver};
-use crate::tridiag::{Ldlt, SymTridiag, dot};
+use crate::tridiag::{Interior, Ldlt, SymTridiag, Uniform, dot};
+use std::time::Instant;
 
 /// A constrained node: `u[node] >= -gap`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -184,6 +185,55 @@ pub fn make_solver(scene: &Scene, disc: &Discretisation) -> Result<Box<dyn StepS
     }
 }
 
+/// The clock is read in one step out of this many (timer reads cost ~25 ns each, five a
+/// step: sampling keeps that below 1 % of a 100-node step).
+pub const TIMING_SAMPLE_EVERY: usize = 32;
+
+/// Wall time per phase of [`Simulation::step`], summed over the sampled steps (one in
+/// [`TIMING_SAMPLE_EVERY`], starting with the first): `rhs` (load vector and right-hand
+/// side), `solve` (bounds and the step solver), `update` (`u += z`, and on a measured step
+/// after an unmeasured one the recomputation of `E^{n−1/2}`), `diagnostics` (the energy
+/// balance pass, contact state, record). Shares of a run are ratios of these sums.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct PhaseTimes {
+    pub sampled_steps: u64,
+    pub rhs_ns: u64,
+    pub solve_ns: u64,
+    pub update_ns: u64,
+    pub diagnostics_ns: u64,
+}
+
+impl PhaseTimes {
+    /// Whether step `n → n + 1` is timed (and counts it).
+    fn samples(&mut self, n: usize) -> bool {
+        let sampled = n % TIMING_SAMPLE_EVERY == 1;
+        self.sampled_steps += u64::from(sampled);
+        sampled
+    }
+
+    /// The sum of the four phases.
+    pub fn total_ns(&self) -> u64 {
+        self.rhs_ns + self.solve_ns + self.update_ns + self.diagnostics_ns
+    }
+}
+
+/// The time of the last lap, when this step is sampled.
+struct PhaseClock(Option<Instant>);
+
+impl PhaseClock {
+    fn start(sampled: bool) -> Self {
+        Self(sampled.then(Instant::now))
+    }
+
+    /// Adds the time since the last lap to `into`.
+    fn lap(self, into: &mut u64) -> Self {
+        let Some(then) = self.0 else { return self };
+        let now = Instant::now();
+        *into += u64::try_from((now - then).as_nanos()).unwrap_or(u64::MAX);
+        Self(Some(now))
+    }
+}
+
 /// The diagnostics of one step, `u^n → u^{n+1}`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepRecord {
@@ -191,6 +241,9 @@ pub struct StepRecord {
     pub step: usize,
     /// `t_{n+1}`.
     pub time: f64,
+    /// Whether the energy balance was measured at this step (`[output] diagnostics_every`);
+    /// when not, `energy` … `identity_residual` are 0 and mean nothing.
+    pub measured: bool,
     /// `E^{n+1/2}`.
     pub energy: f64,
     /// `½ F^n·(u^{n+1} − u^{n−1})`.
@@ -245,11 +298,9 @@ pub struct Simulation {
     /// `n`: the state held is `u^n`.
     n: usize,
     u: Vec<f64>,
-    /// `w = u^n − u^{n−1}` and `M w`.
+    /// `w = u^n − u^{n−1}`.
     w: Vec<f64>,
-    mw: Vec<f64>,
     z: Vec<f64>,
-    mz: Vec<f64>,
     rhs: Vec<f64>,
     force: Vec<f64>,
     lower: Vec<f64>,
@@ -258,9 +309,16 @@ pub struct Simulation {
     /// `1/Δt²` and `½ − α/(2Δt)`.
     inv_dt2: f64,
     c_w: f64,
-    /// `|u^n|²_R` and `E^{n−1/2}`.
+    /// `|u^n|²_R` and `E^{n−1/2}`, valid when `measured` (the last step was measured).
     potential: f64,
     energy: f64,
+    measured: bool,
+    /// Measure the energy balance at steps `k·diagnostics_every` and at `last_step`.
+    diagnostics_every: usize,
+    last_step: usize,
+    timing: PhaseTimes,
+    /// Interior coefficients of `M` and `R` as numbers, when the mesh is uniform.
+    uniform: Option<(Uniform, Uniform)>,
     initial_u: Vec<f64>,
     initial_v: Vec<f64>,
     first_record: StepRecord,
@@ -375,9 +433,7 @@ impl Simulation {
             n: 0,
             u: u0_full[range.clone()].to_vec(),
             w: vec![0.0; n],
-            mw: vec![0.0; n],
             z: vec![0.0; n],
-            mz: vec![0.0; n],
             rhs: vec![0.0; n],
             force,
             lower: vec![0.0; k],
@@ -387,6 +443,11 @@ impl Simulation {
             c_w: 0.5 - alpha / (2.0 * dt),
             potential: 0.0,
             energy: 0.0,
+            measured: true,
+            diagnostics_every: scene.output.diagnostics_every as usize,
+            last_step: scene.steps(),
+            timing: PhaseTimes::default(),
+            uniform: disc.mass.uniform().zip(disc.stiffness.uniform()),
             initial_u: u0_full,
             initial_v: v0_full,
             first_record: StepRecord::default(),
@@ -427,19 +488,18 @@ impl Simulation {
         for (ui, zi) in self.u.iter_mut().zip(&self.z) {
             *ui += zi;
         }
-        self.disc.mass.mul_into(&self.z, &mut self.mz);
+        let mz = self.disc.mass.mul(&self.z);
         self.potential = self.disc.stiffness.quad(&self.u);
-        self.energy =
-            0.5 * dot(&self.z, &self.mz) * self.inv_dt2 + 0.25 * (self.potential + potential0);
+        self.energy = 0.5 * dot(&self.z, &mz) * self.inv_dt2 + 0.25 * (self.potential + potential0);
         if !self.energy.is_finite() {
             return Err(self.failure(1, crate::solver::StepFailure::NonFinite));
         }
         std::mem::swap(&mut self.w, &mut self.z);
-        std::mem::swap(&mut self.mw, &mut self.mz);
         self.n = 1;
         let mut record = StepRecord {
             step: 1,
             time: dt,
+            measured: true,
             energy: self.energy,
             iterations: info.iterations,
             ..Default::default()
@@ -488,26 +548,50 @@ impl Simulation {
     /// `C z = F^n + M w/Δt² + (½ − α/(2Δt)) R w − R u^n + r`, which is algebraically the talk's
     /// `C u^{n+1} = F̃^n + r` but never forms the O(|u|/Δt²) terms that cancel there, so the
     /// round-off in `z` is relative to the increment, not to the displacement.
+    ///
+    /// The energy balance (an extra read-only pass) is measured every `[output]
+    /// diagnostics_every`-th step and at the last step; other steps report the contact state
+    /// only (`measured = false`). A measured step whose predecessor was not measured recomputes
+    /// `E^{n−1/2}` from `u^n` and `w` first, so every measured identity is a one-step identity.
     pub fn step(&mut self) -> Result<StepRecord, RunError> {
         let n = self.n;
+        let clock = PhaseClock::start(self.timing.samples(n));
         self.update_force(n)?;
         let has_load = !matches!(self.load, LoadTerm::None);
         let (inv_dt2, c_w) = (self.inv_dt2, self.c_w);
-        let force = if has_load {
-            Some(&self.force[..])
-        } else {
-            None
-        };
-        rhs_into(
-            &self.disc.stiffness,
-            c_w,
-            inv_dt2,
-            &self.u,
-            &self.w,
-            &self.mw,
-            force,
-            &mut self.rhs,
-        );
+        let (mass, stiffness) = (&self.disc.mass, &self.disc.stiffness);
+        let (u, w, force) = (&self.u[..], &self.w[..], &self.force[..]);
+        match (has_load, self.uniform) {
+            (true, Some(k)) => {
+                rhs_into::<true, _>(mass, stiffness, k, c_w, inv_dt2, u, w, force, &mut self.rhs)
+            }
+            (false, Some(k)) => {
+                rhs_into::<false, _>(mass, stiffness, k, c_w, inv_dt2, u, w, force, &mut self.rhs)
+            }
+            (true, None) => rhs_into::<true, _>(
+                mass,
+                stiffness,
+                (mass.rows(), stiffness.rows()),
+                c_w,
+                inv_dt2,
+                u,
+                w,
+                force,
+                &mut self.rhs,
+            ),
+            (false, None) => rhs_into::<false, _>(
+                mass,
+                stiffness,
+                (mass.rows(), stiffness.rows()),
+                c_w,
+                inv_dt2,
+                u,
+                w,
+                force,
+                &mut self.rhs,
+            ),
+        }
+        let clock = clock.lap(&mut self.timing.rhs_ns);
         for (j, c) in self.disc.constraints.iter().enumerate() {
             self.lower[j] = -c.gap - self.u[self.locals[j]];
         }
@@ -515,22 +599,60 @@ impl Simulation {
             .solver
             .solve(&self.rhs, &self.lower, &mut self.z, &mut self.reactions)
             .map_err(|failure| self.failure(n + 1, failure))?;
-        let sums = update_and_measure(
-            &self.disc.mass,
-            &self.disc.stiffness,
-            &mut self.u,
-            &self.z,
-            &self.w,
-            &mut self.mz,
-            force,
-            self.disc.alpha > 0.0,
-        );
-        let (kinetic, potential, viscous, work) =
-            (sums.kinetic, sums.potential, sums.viscous, sums.work);
+        let clock = clock.lap(&mut self.timing.solve_ns);
+        let measure = (n + 1).is_multiple_of(self.diagnostics_every) || n + 1 == self.last_step;
+        if measure && !self.measured {
+            // E^{n−1/2} from u^n and w (u^{n−1} = u^n − w).
+            let (mass, stiffness) = (&self.disc.mass, &self.disc.stiffness);
+            self.potential = stiffness.quad(&self.u);
+            self.energy = 0.5 * mass.quad(&self.w) * inv_dt2
+                + 0.25 * (self.potential + potential_of_difference(stiffness, &self.u, &self.w));
+        }
+        advance(&mut self.u, &self.z);
+        let clock = clock.lap(&mut self.timing.update_ns);
         let dt = self.disc.dt;
-        let energy = 0.5 * kinetic * inv_dt2 + 0.25 * (potential + self.potential);
-        let viscous = self.disc.alpha / (4.0 * dt) * viscous;
-        let work = 0.5 * work;
+        let mut record = StepRecord {
+            step: n + 1,
+            time: (n + 1) as f64 * dt,
+            measured: measure,
+            iterations: info.iterations,
+            ..Default::default()
+        };
+        if measure {
+            self.measure_into(&mut record, has_load)?;
+        }
+        self.measured = measure;
+        self.fill_contact(&mut record);
+        std::mem::swap(&mut self.w, &mut self.z);
+        self.n = n + 1;
+        clock.lap(&mut self.timing.diagnostics_ns);
+        Ok(record)
+    }
+
+    /// The energy balance of the step just taken (`u = u^{n+1}`, `z` its increment, `w` the
+    /// previous one) into `record`; `self.energy`, `self.potential` move on to `n + 1`.
+    fn measure_into(&mut self, record: &mut StepRecord, has_load: bool) -> Result<(), RunError> {
+        let (mass, stiffness) = (&self.disc.mass, &self.disc.stiffness);
+        let (u, z, w, f) = (&self.u[..], &self.z[..], &self.w[..], &self.force[..]);
+        let sums = match (has_load, self.uniform) {
+            (true, Some(k)) => measure::<true, _>(mass, stiffness, k, u, z, w, f),
+            (false, Some(k)) => measure::<false, _>(mass, stiffness, k, u, z, w, f),
+            (true, None) => {
+                measure::<true, _>(mass, stiffness, (mass.rows(), stiffness.rows()), u, z, w, f)
+            }
+            (false, None) => {
+                measure::<false, _>(mass, stiffness, (mass.rows(), stiffness.rows()), u, z, w, f)
+            }
+        };
+        let dt = self.disc.dt;
+        let energy = 0.5 * sums.kinetic * self.inv_dt2 + 0.25 * (sums.potential + self.potential);
+        // The viscous sum is computed regardless; it only counts when α > 0.
+        let viscous = if self.disc.alpha > 0.0 {
+            self.disc.alpha / (4.0 * dt) * sums.viscous
+        } else {
+            0.0
+        };
+        let work = 0.5 * sums.work;
         let mut contact = 0.0;
         for (j, &l) in self.locals.iter().enumerate() {
             contact -= 0.5 * self.reactions[j] * (self.z[l] + self.w[l]);
@@ -540,30 +662,26 @@ impl Simulation {
             .into_iter()
             .fold(0.0, f64::max);
         if !(energy.is_finite() && residual.is_finite()) {
-            return Err(self.failure(n + 1, crate::solver::StepFailure::NonFinite));
+            return Err(self.failure(record.step, crate::solver::StepFailure::NonFinite));
         }
-        let mut record = StepRecord {
-            step: n + 1,
-            time: (n + 1) as f64 * dt,
-            energy,
-            work,
-            viscous_dissipation: viscous,
-            contact_dissipation: contact,
-            identity_residual: if scale > 0.0 {
-                residual.abs() / scale
-            } else {
-                0.0
-            },
-            iterations: info.iterations,
-            ..Default::default()
+        record.energy = energy;
+        record.work = work;
+        record.viscous_dissipation = viscous;
+        record.contact_dissipation = contact;
+        record.identity_residual = if scale > 0.0 {
+            residual.abs() / scale
+        } else {
+            0.0
         };
-        self.fill_contact(&mut record);
-        self.potential = potential;
+        self.potential = sums.potential;
         self.energy = energy;
-        std::mem::swap(&mut self.w, &mut self.z);
-        std::mem::swap(&mut self.mw, &mut self.mz);
-        self.n = n + 1;
-        Ok(record)
+        Ok(())
+    }
+
+    /// Wall time spent in each phase of the steps taken so far, measured on a sample of the
+    /// steps (see [`PhaseTimes`]).
+    pub fn phase_times(&self) -> PhaseTimes {
+        self.timing
     }
 
     fn fill_contact(&self, record: &mut StepRecord) {
@@ -670,40 +788,64 @@ impl Simulation {
 /// `x = 1` evaluate to exactly 0, but `sin(pi*x)` at `x = 1` gives 1.2e-16).
 pub const CLAMPED_START_TOL: f64 = 1e-12;
 
-/// `b = F + M w/Δt² + R ((½ − α/(2Δt)) w − u)` in one pass (`M w` is carried over from the
-/// previous step), the stiffness product in difference form.
+/// Row `i` of `A x` in difference form, `s_i x_i + A_i,i−1 (x_{i−1} − x_i) + A_i,i+1 (x_{i+1} −
+/// x_i)`, in the order of [`SymTridiag::mul_into`]; for the end rows (any `i`, with branches).
+fn row_of(a: &SymTridiag, x: impl Fn(usize) -> f64, i: usize, n: usize) -> f64 {
+    let mut r = a.row_sums()[i] * x(i);
+    if i > 0 {
+        r += a.off[i - 1] * (x(i - 1) - x(i));
+    }
+    if i + 1 < n {
+        r += a.off[i] * (x(i + 1) - x(i));
+    }
+    r
+}
+
+/// The same row for an interior `i` (both neighbours exist), without branches.
+#[inline(always)]
+fn inner_row_of(a: impl Interior, x: impl Fn(usize) -> f64, i: usize) -> f64 {
+    let xi = x(i);
+    a.s(i) * xi + a.e(i - 1) * (x(i - 1) - xi) + a.e(i) * (x(i + 1) - xi)
+}
+
+/// `b = F + M w/Δt² + R ((½ − α/(2Δt)) w − u)` in one pass, both products in difference form.
+/// The interior loop has no branch, so it vectorises; `LOAD = false` skips the force.
 #[allow(clippy::too_many_arguments)]
-fn rhs_into(
+#[inline(never)]
+fn rhs_into<const LOAD: bool, K: Interior>(
+    mass: &SymTridiag,
     stiffness: &SymTridiag,
+    (mi, ri): (K, K),
     c_w: f64,
     inv_dt2: f64,
     u: &[f64],
     w: &[f64],
-    mw: &[f64],
-    force: Option<&[f64]>,
+    force: &[f64],
     rhs: &mut [f64],
 ) {
     let n = rhs.len();
+    let (u, w) = (&u[..n], &w[..n]);
+    let force = if LOAD { &force[..n] } else { &[][..] };
     let y = |i: usize| c_w * w[i] - u[i];
-    let (s, e) = (stiffness.row_sums(), &stiffness.off[..]);
-    if n == 1 {
-        rhs[0] = s[0] * y(0) + mw[0] * inv_dt2 + force.map_or(0.0, |f| f[0]);
-        return;
+    let wi = |i: usize| w[i];
+    let finish = |i: usize, ry: f64, mw: f64| {
+        let b = ry + mw * inv_dt2;
+        if LOAD { b + force[i] } else { b }
+    };
+    for i in [0, n.saturating_sub(1)].into_iter().take(n.min(2)) {
+        rhs[i] = finish(i, row_of(stiffness, y, i, n), row_of(mass, wi, i, n));
     }
-    let mut y_prev = 0.0;
-    let mut y_here = y(0);
-    for i in 0..n {
-        let y_next = if i + 1 < n { y(i + 1) } else { 0.0 };
-        let mut r = s[i] * y_here;
-        if i > 0 {
-            r += e[i - 1] * (y_prev - y_here);
-        }
-        if i + 1 < n {
-            r += e[i] * (y_next - y_here);
-        }
-        rhs[i] = r + mw[i] * inv_dt2 + force.map_or(0.0, |f| f[i]);
-        y_prev = y_here;
-        y_here = y_next;
+    #[allow(clippy::needless_range_loop)] // a stencil: rows i − 1, i, i + 1
+    for i in 1..n.saturating_sub(1) {
+        rhs[i] = finish(i, inner_row_of(ri, y, i), inner_row_of(mi, wi, i));
+    }
+}
+
+/// `u += z`.
+#[inline(never)]
+fn advance(u: &mut [f64], z: &[f64]) {
+    for (ui, zi) in u.iter_mut().zip(z) {
+        *ui += zi;
     }
 }
 
@@ -714,56 +856,94 @@ struct StepSums {
     kinetic: f64,
     /// `|u^{n+1}|²_R`.
     potential: f64,
-    /// `|z + w|²_R` (left 0 when `α = 0`).
+    /// `|z + w|²_R`.
     viscous: f64,
     /// `F·(z + w)`.
     work: f64,
 }
 
-/// `u += z`, `M z`, and the energy sums, in one pass; the R-norms in difference form so that
-/// rigid motion adds no round-off (see [`SymTridiag::quad`]).
+/// The energy sums of a step, after `u += z` (so `u = u^{n+1}`), in one read-only pass; with
+/// `w` the previous increment and `z` this one: `zᵀMz`, `|u|²_R`, `|z + w|²_R`, `F·(z + w)`.
+/// Quadratic forms in difference form, `xᵀAx = Σ s_i x_i² − Σ A_i,i+1 (x_{i+1} − x_i)²`, so
+/// rigid motion adds no round-off (see [`SymTridiag::quad`]); interior terms weighted as
+/// [`Interior`] says.
+#[inline(never)]
 #[allow(clippy::too_many_arguments)]
-fn update_and_measure(
+fn measure<const LOAD: bool, K: Interior>(
     mass: &SymTridiag,
     stiffness: &SymTridiag,
-    u: &mut [f64],
+    (mi, ri): (K, K),
+    u: &[f64],
     z: &[f64],
     w: &[f64],
-    mz: &mut [f64],
-    force: Option<&[f64]>,
-    viscous: bool,
+    force: &[f64],
 ) -> StepSums {
     let n = u.len();
-    let (sm, em) = (mass.row_sums(), &mass.off[..]);
-    let (sr, er) = (stiffness.row_sums(), &stiffness.off[..]);
-    let mut sums = StepSums::default();
-    for i in 0..n {
-        let zi = z[i];
-        let ui = u[i] + zi;
-        u[i] = ui;
-        let mut m = sm[i] * zi;
-        if i > 0 {
-            m += em[i - 1] * (z[i - 1] - zi);
-        }
-        let di = zi + w[i];
-        sums.potential += sr[i] * ui * ui;
-        if viscous {
-            sums.viscous += sr[i] * di * di;
-        }
-        if i + 1 < n {
-            m += em[i] * (z[i + 1] - zi);
-            let du = (u[i + 1] + z[i + 1]) - ui;
-            sums.potential -= er[i] * du * du;
-            if viscous {
-                let dd = (z[i + 1] + w[i + 1]) - di;
-                sums.viscous -= er[i] * dd * dd;
-            }
-        }
-        mz[i] = m;
-        sums.kinetic += zi * m;
-        if let Some(f) = force {
-            sums.work += f[i] * di;
+    if n == 0 {
+        return StepSums::default();
+    }
+    let (z, w) = (&z[..n], &w[..n]);
+    let force = if LOAD { &force[..n] } else { &[][..] };
+    let d = |i: usize| z[i] + w[i];
+    // Quantities: node and edge parts of zᵀMz, |u|²_R, |d|²_R, then F·d, over the interior
+    // nodes i with their elements (i, i+1), weighted. One accumulator each: seven independent
+    // addition chains keep the adders busy (more lanes measured slower here), and the order
+    // is fixed, so the sums are deterministic.
+    let mut acc = [0.0f64; 7];
+    for i in 1..n.saturating_sub(1) {
+        let (zi, ui, di) = (z[i], u[i], d(i));
+        let (dz, du, dd) = (z[i + 1] - zi, u[i + 1] - ui, d(i + 1) - di);
+        acc[0] += mi.ws(i) * zi * zi;
+        acc[1] += mi.we(i) * dz * dz;
+        acc[2] += ri.ws(i) * ui * ui;
+        acc[3] += ri.we(i) * du * du;
+        acc[4] += ri.ws(i) * di * di;
+        acc[5] += ri.we(i) * dd * dd;
+        if LOAD {
+            acc[6] += force[i] * di;
         }
     }
+    let sum = |q: usize| acc[q];
+    let form = |k: K, node: usize, edge: usize| k.scale_s() * sum(node) - k.scale_e() * sum(edge);
+    let mut sums = StepSums {
+        kinetic: form(mi, 0, 1),
+        potential: form(ri, 2, 3),
+        viscous: form(ri, 4, 5),
+        work: sum(6),
+    };
+    // End nodes with their own row sums; the element (0, 1).
+    let (sm, sr) = (mass.row_sums(), stiffness.row_sums());
+    for i in [0, n - 1].into_iter().take(n.min(2)) {
+        let (zi, ui, di) = (z[i], u[i], d(i));
+        sums.kinetic += sm[i] * zi * zi;
+        sums.potential += sr[i] * ui * ui;
+        sums.viscous += sr[i] * di * di;
+        if LOAD {
+            sums.work += force[i] * di;
+        }
+    }
+    if n > 1 {
+        let (em, er) = (mass.off[0], stiffness.off[0]);
+        let (dz, du, dd) = (z[1] - z[0], u[1] - u[0], d(1) - d(0));
+        sums.kinetic -= em * dz * dz;
+        sums.potential -= er * du * du;
+        sums.viscous -= er * dd * dd;
+    }
     sums
+}
+
+/// `|u − w|²_R` in difference form (`u^{n−1} = u^n − w` for a step whose predecessor was not
+/// measured; not on the per-step path).
+fn potential_of_difference(stiffness: &SymTridiag, u: &[f64], w: &[f64]) -> f64 {
+    let v = |i: usize| u[i] - w[i];
+    let n = u.len();
+    let mut q = 0.0;
+    for i in 0..n {
+        q += stiffness.row_sums()[i] * v(i) * v(i);
+    }
+    for i in 0..n.saturating_sub(1) {
+        let d = v(i + 1) - v(i);
+        q -= stiffness.off[i] * d * d;
+    }
+    q
 }

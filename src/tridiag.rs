@@ -135,6 +135,109 @@ impl SymTridiag {
     }
 }
 
+/// The interior rows (`1..n−1`) of a symmetric tridiagonal matrix as the per-step kernels read
+/// them: the row sum `s_i` and the off-diagonals `e_{i−1}`, `e_i`. [`Rows`] reads them from the
+/// matrix; [`Uniform`] holds the two numbers of a uniform mesh, so the kernels stream no
+/// coefficient vectors (same values, same bits).
+///
+/// Quadratic forms over the interior are accumulated as `Σ ws_i x_i²` and `Σ we_i (Δx_i)²` and
+/// scaled at the end: per row (`ws = s`, `we = e`, scales 1) or, on a uniform mesh, as plain
+/// sums scaled once by `s` and `e` (half the multiplications).
+pub trait Interior: Copy {
+    fn s(self, i: usize) -> f64;
+    /// `A_{i,i+1}`.
+    fn e(self, i: usize) -> f64;
+    /// Weights inside the sums, and the factors applied to the finished sums.
+    fn ws(self, i: usize) -> f64;
+    fn we(self, i: usize) -> f64;
+    fn scale_s(self) -> f64;
+    fn scale_e(self) -> f64;
+}
+
+/// Interior coefficients read row by row.
+#[derive(Clone, Copy, Debug)]
+pub struct Rows<'a> {
+    s: &'a [f64],
+    e: &'a [f64],
+}
+
+/// Interior coefficients that are the same on every interior row.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Uniform {
+    s: f64,
+    e: f64,
+}
+
+impl Interior for Rows<'_> {
+    #[inline(always)]
+    fn s(self, i: usize) -> f64 {
+        self.s[i]
+    }
+    #[inline(always)]
+    fn e(self, i: usize) -> f64 {
+        self.e[i]
+    }
+    #[inline(always)]
+    fn ws(self, i: usize) -> f64 {
+        self.s[i]
+    }
+    #[inline(always)]
+    fn we(self, i: usize) -> f64 {
+        self.e[i]
+    }
+    fn scale_s(self) -> f64 {
+        1.0
+    }
+    fn scale_e(self) -> f64 {
+        1.0
+    }
+}
+
+impl Interior for Uniform {
+    #[inline(always)]
+    fn s(self, _: usize) -> f64 {
+        self.s
+    }
+    #[inline(always)]
+    fn e(self, _: usize) -> f64 {
+        self.e
+    }
+    #[inline(always)]
+    fn ws(self, _: usize) -> f64 {
+        1.0
+    }
+    #[inline(always)]
+    fn we(self, _: usize) -> f64 {
+        1.0
+    }
+    fn scale_s(self) -> f64 {
+        self.s
+    }
+    fn scale_e(self) -> f64 {
+        self.e
+    }
+}
+
+impl SymTridiag {
+    /// The interior coefficients, row by row.
+    pub fn rows(&self) -> Rows<'_> {
+        Rows {
+            s: &self.row_sums,
+            e: &self.off,
+        }
+    }
+
+    /// The interior coefficients as two numbers, when every interior row sum and every
+    /// off-diagonal entry are bitwise equal (the uniform mesh).
+    pub fn uniform(&self) -> Option<Uniform> {
+        let n = self.dim();
+        let e = *self.off.first()?;
+        let s = if n > 2 { self.row_sums[1] } else { 0.0 };
+        let same = |v: &[f64], x: f64| v.iter().all(|y| y.to_bits() == x.to_bits());
+        (same(&self.off, e) && same(&self.row_sums[1..n - 1], s)).then_some(Uniform { s, e })
+    }
+}
+
 /// `xᵀ y`.
 pub fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
@@ -144,19 +247,22 @@ pub fn dot(x: &[f64], y: &[f64]) -> f64 {
 /// ends"): `L D Lᵀ` from the top for rows `0..m`, `U D Uᵀ` from the bottom for rows `m+1..n`,
 /// joined at the twist row `m = n/2`. Computed once per run. A solve runs the two elimination
 /// chains (top-down and bottom-up) interleaved in one loop, so the processor overlaps two
-/// dependent multiply-subtract chains instead of waiting on one: about half the latency of the
-/// plain `L D Lᵀ` sweep, with the same number of operations and no fused multiply-add (results
-/// do not depend on target-cpu flags).
+/// dependent chains instead of waiting on one: about half the latency of the plain `L D Lᵀ`
+/// sweep, with the same number of operations and no fused multiply-add (results do not depend
+/// on target-cpu flags).
+///
+/// Each link of either chain is one multiply and one subtract: the inward sweep stores
+/// `y_i / d_i` beside the chain (off the critical path), so the outward sweep is
+/// `x_i = y_i/d_i − l_i x_{i±1}` with the same multipliers `l_i = e_i/d_i`.
 #[derive(Clone, Debug)]
 pub struct Ldlt {
-    /// Multipliers: `l[i] = e_i / d_i` for `i < m` (top chain) and `l[i] = e_{i−1} / d_i` for
-    /// `i > m` (bottom chain); unused at `m`.
-    l: Vec<f64>,
-    /// `1 / d_i`, with `d_m = γ_m` the twist pivot.
-    inv_d: Vec<f64>,
-    /// Off-diagonal of `A`, needed by the outward sweeps.
-    off: Vec<f64>,
-    twist: usize,
+    /// `(l_i, 1/d_i)` in the order the inward sweep visits the rows: `top[i]` for rows
+    /// `i = 0..m` (`l_i = e_i/d_i`), `bottom[k]` for rows `j = n−1−k > m` (`l_j = e_{j−1}/d_j`).
+    top: Vec<[f64; 2]>,
+    bottom: Vec<[f64; 2]>,
+    /// `1/γ_m`, the twist pivot.
+    inv_twist: f64,
+    n: usize,
 }
 
 /// The matrix was not numerically positive definite: pivot `index` came out as `pivot`.
@@ -171,8 +277,6 @@ impl Ldlt {
     pub fn factor(a: &SymTridiag) -> Result<Self, NotPositiveDefinite> {
         let n = a.dim();
         let twist = n / 2;
-        let mut l = vec![0.0; n];
-        let mut inv_d = vec![0.0; n];
         let check = |index: usize, pivot: f64| {
             if pivot > 0.0 && pivot.is_finite() {
                 Ok(pivot)
@@ -181,99 +285,109 @@ impl Ldlt {
             }
         };
         let (d, e) = (&a.diag, &a.off);
-        let mut top = 0.0;
+        let mut top = Vec::with_capacity(twist);
+        let mut l_prev = 0.0;
         for i in 0..twist {
             let p = if i == 0 {
                 d[0]
             } else {
-                d[i] - e[i - 1] * l[i - 1]
+                d[i] - e[i - 1] * l_prev
             };
-            top = check(i, p)?;
-            inv_d[i] = 1.0 / top;
-            l[i] = e[i] / top;
+            let p = check(i, p)?;
+            l_prev = e[i] / p;
+            top.push([l_prev, 1.0 / p]);
         }
-        let mut bottom = 0.0;
+        let mut bottom = Vec::with_capacity(n.saturating_sub(twist + 1));
+        let mut l_next = 0.0;
         for i in (twist + 1..n).rev() {
             let p = if i == n - 1 {
                 d[i]
             } else {
-                d[i] - e[i] * l[i + 1]
+                d[i] - e[i] * l_next
             };
-            bottom = check(i, p)?;
-            inv_d[i] = 1.0 / bottom;
-            l[i] = e[i - 1] / bottom;
+            let p = check(i, p)?;
+            l_next = e[i - 1] / p;
+            bottom.push([l_next, 1.0 / p]);
         }
+        let mut inv_twist = 0.0;
         if n > 0 {
             let mut g = d[twist];
             if twist > 0 {
-                g -= e[twist - 1] * l[twist - 1];
+                g -= e[twist - 1] * l_prev;
             }
             if twist + 1 < n {
-                g -= e[twist] * l[twist + 1];
+                g -= e[twist] * l_next;
             }
-            inv_d[twist] = 1.0 / check(twist, g)?;
+            inv_twist = 1.0 / check(twist, g)?;
         }
-        let _ = (top, bottom);
         Ok(Self {
-            l,
-            inv_d,
-            off: e.clone(),
-            twist,
+            top,
+            bottom,
+            inv_twist,
+            n,
         })
     }
 
     pub fn dim(&self) -> usize {
-        self.inv_d.len()
+        self.n
     }
 
     /// Overwrites `b` with `A⁻¹ b`: the two chains eliminate towards the twist row together,
     /// then substitute outwards together.
     pub fn solve_in_place(&self, b: &mut [f64]) {
         let n = self.dim();
-        debug_assert_eq!(b.len(), n);
+        assert_eq!(b.len(), n, "right-hand side length");
         if n == 0 {
             return;
         }
-        let m = self.twist;
-        let (l, inv_d, e) = (&self.l[..n], &self.inv_d[..n], &self.off[..]);
-        // Inward: top rows 1..m (each uses the row above), bottom rows n−2..m+1 (the row below).
-        let top_len = m; // rows 0..m
-        let bottom_len = n - 1 - m; // rows m+1..n
-        let common = top_len.min(bottom_len);
-        for k in 1..common {
-            let (i, j) = (k, n - 1 - k);
-            b[i] -= l[i - 1] * b[i - 1];
-            b[j] -= l[j + 1] * b[j + 1];
+        let m = self.top.len();
+        let (upper, rest) = b.split_at_mut(m);
+        let (mid, lower) = rest.split_at_mut(1);
+        // Inward: y_i = b_i − l_{i−1} y_{i−1} (top), y_j = b_j − l_{j+1} y_{j+1} (bottom);
+        // b keeps y/d.
+        let (mut yt, mut yb) = (0.0, 0.0);
+        let (mut lt, mut lb) = (0.0, 0.0);
+        // `take`: a bare `zip` would consume one element of the longer chain and drop it.
+        let common = self.top.len().min(self.bottom.len());
+        let mut top = upper.iter_mut().zip(&self.top);
+        let mut bottom = lower.iter_mut().rev().zip(&self.bottom);
+        for ((bt, ft), (bb, fb)) in top.by_ref().take(common).zip(bottom.by_ref().take(common)) {
+            yt = *bt - lt * yt;
+            yb = *bb - lb * yb;
+            *bt = yt * ft[1];
+            *bb = yb * fb[1];
+            (lt, lb) = (ft[0], fb[0]);
         }
-        for i in common.max(1)..top_len {
-            b[i] -= l[i - 1] * b[i - 1];
+        for (bt, ft) in top {
+            yt = *bt - lt * yt;
+            *bt = yt * ft[1];
+            lt = ft[0];
         }
-        for k in common.max(1)..bottom_len {
-            let j = n - 1 - k;
-            b[j] -= l[j + 1] * b[j + 1];
+        for (bb, fb) in bottom {
+            yb = *bb - lb * yb;
+            *bb = yb * fb[1];
+            lb = fb[0];
         }
-        // Twist row.
-        let mut xm = b[m];
-        if m > 0 {
-            xm -= l[m - 1] * b[m - 1];
+        // Twist row: the products are 0 when a side is empty (l = 0, y = 0).
+        let xm = (mid[0] - lt * yt - lb * yb) * self.inv_twist;
+        mid[0] = xm;
+        // Outward: x_i = y_i/d_i − l_i x_{i+1} (top), x_j = y_j/d_j − l_j x_{j−1} (bottom).
+        let (mut xt, mut xb) = (xm, xm);
+        let mut top = upper.iter_mut().rev().zip(self.top.iter().rev());
+        let mut bottom = lower.iter_mut().zip(self.bottom.iter().rev());
+        for ((bt, ft), (bb, fb)) in top.by_ref().take(common).zip(bottom.by_ref().take(common)) {
+            xt = *bt - ft[0] * xt;
+            xb = *bb - fb[0] * xb;
+            *bt = xt;
+            *bb = xb;
         }
-        if m + 1 < n {
-            xm -= l[m + 1] * b[m + 1];
+        for (bt, ft) in top {
+            xt = *bt - ft[0] * xt;
+            *bt = xt;
         }
-        b[m] = xm * inv_d[m];
-        // Outward: x_i = (y_i − e_i x_{i+1}) / d_i above, (y_j − e_{j−1} x_{j−1}) / d_j below.
-        for k in 1..=common {
-            let (i, j) = (m - k, m + k);
-            b[i] = (b[i] - e[i] * b[i + 1]) * inv_d[i];
-            b[j] = (b[j] - e[j - 1] * b[j - 1]) * inv_d[j];
-        }
-        for k in common + 1..=top_len {
-            let i = m - k;
-            b[i] = (b[i] - e[i] * b[i + 1]) * inv_d[i];
-        }
-        for k in common + 1..=bottom_len {
-            let j = m + k;
-            b[j] = (b[j] - e[j - 1] * b[j - 1]) * inv_d[j];
+        for (bb, fb) in bottom {
+            xb = *bb - fb[0] * xb;
+            *bb = xb;
         }
     }
 

@@ -176,6 +176,11 @@ const CASES: &[(&str, Edit, &str)] = &[
         Edit::Set(&["output.every=0"]),
         "output.every",
     ),
+    (
+        "zero diagnostics stride",
+        Edit::Set(&["output.diagnostics_every=0"]),
+        "output.diagnostics_every",
+    ),
 ];
 
 #[test]

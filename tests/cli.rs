@@ -84,7 +84,7 @@ fn scenes_and_show_list_the_builtins() {
 
 /// Summary fields that measure the machine, not the numerics: the only content allowed to
 /// differ between two runs.
-const TIMING_FIELDS: [&str; 2] = ["wall_time_s", "ns_per_node_step"];
+const TIMING_FIELDS: [&str; 3] = ["wall_time_s", "ns_per_node_step", "time_shares"];
 
 #[test]
 fn two_runs_give_byte_identical_outputs() {

@@ -1,0 +1,71 @@
+//! Memory is O(J), not O(J × steps): a counting allocator records the peak heap of this thread
+//! while a run is set up and stepped. The peak must stay within the scene validator's own
+//! estimate `scene::BYTES_PER_NODE` per node, and must not grow with the number of steps.
+//! (Peak resident memory of the full J = 1e6, 1e4-step run is measured by
+//! `cargo run --release --example peak_memory`, see benches/README.md.)
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+struct Counting;
+
+thread_local! {
+    static LIVE: Cell<usize> = const { Cell::new(0) };
+    static PEAK: Cell<usize> = const { Cell::new(0) };
+}
+
+fn track(delta: isize) {
+    // `try_with`: the thread-locals may already be gone while a thread shuts down.
+    let _ = LIVE.try_with(|live| {
+        let now = live.get().saturating_add_signed(delta);
+        live.set(now);
+        let _ = PEAK.try_with(|p| p.set(p.get().max(now)));
+    });
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        track(layout.size() as isize);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        track(-(layout.size() as isize));
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        track(new_size as isize - layout.size() as isize);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// Peak heap above the starting level while `steps` steps of `scene` run with the tracker.
+fn peak_heap(scene: &viscobar::Scene, steps: usize) -> usize {
+    let base = LIVE.with(Cell::get);
+    PEAK.with(|p| p.set(base));
+    let mut sim = viscobar::Simulation::new(scene).unwrap();
+    let mut tracker = viscobar::run::Tracker::new(&sim, scene.load.density.is_none());
+    for _ in 0..steps {
+        tracker.observe(&sim.step().unwrap());
+    }
+    drop((sim, tracker));
+    PEAK.with(Cell::get) - base
+}
+
+#[test]
+fn peak_heap_is_linear_in_nodes_and_independent_of_steps() {
+    for name in ["both-ends-forced", "distributed", "modal"] {
+        let (_, scene) = viscobar::scene::load(name, &["mesh.elements=4000".into()]).unwrap();
+        let nodes = scene.elements() + 1;
+        let short = peak_heap(&scene, 10);
+        let long = peak_heap(&scene, 1000);
+        let bound = viscobar::scene::BYTES_PER_NODE as usize * nodes;
+        assert!(long <= bound, "{name}: peak {long} B > {bound} B");
+        assert_eq!(
+            short, long,
+            "{name}: the peak grows with the number of steps"
+        );
+    }
+}
