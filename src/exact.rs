@@ -36,6 +36,7 @@ pub const RESOLVE_CANCELLATION: f64 = 8.0;
 #[derive(Clone, Debug)]
 pub(crate) struct Column {
     pub(crate) node: usize,
+    /// The entries in `support` only (the column decays geometrically away from `node`).
     values: Vec<f64>,
     /// Entries outside `support` are below `f64::MIN_POSITIVE` in magnitude and are dropped:
     /// adding `r · c` with such `c` cannot change a displacement that is not itself subnormal.
@@ -49,9 +50,11 @@ pub struct ExactSolver {
     columns: Vec<Column>,
     /// `S = (C⁻¹)_{jk}` on the constrained nodes.
     schur: [[f64; 2]; 2],
-    /// `C`, and the factorisation of `C` with the rows and columns of active set `mask`
-    /// replaced by identity ones, at index `mask − 1`.
-    c: SymTridiag,
+    /// Row `i` of `C` at each constrained node `i`: `C_i,i−1`, `C_i,i+1` (0 where absent) and
+    /// the row sum (all the direct solve reads of `C`).
+    rows: [[f64; 3]; 2],
+    /// The factorisation of `C` with the rows and columns of active set `mask` replaced by
+    /// identity ones, at index `mask − 1` (halves shared with `factor` where equal).
     reduced: Vec<Ldlt>,
     /// Steps recomputed by the direct solve (cancellation beyond [`RESOLVE_CANCELLATION`]).
     resolved: u64,
@@ -67,28 +70,30 @@ impl ExactSolver {
         let factor = Ldlt::factor(c)?;
         let columns = inverse_columns(&factor, nodes);
         let schur = schur_complement(&columns);
-        let reduced = (1u8..(1 << nodes.len()))
-            .map(|mask| {
-                let (mut diag, mut off) = (c.diag.clone(), c.off.clone());
-                for (j, &node) in nodes.iter().enumerate() {
-                    if mask & (1 << j) != 0 {
-                        diag[node] = 1.0;
-                        if node > 0 {
-                            off[node - 1] = 0.0;
-                        }
-                        if node < off.len() {
-                            off[node] = 0.0;
-                        }
-                    }
-                }
-                Ldlt::factor(&SymTridiag::new(diag, off))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        let mut reduced: Vec<Ldlt> = Vec::new();
+        for mask in 1u8..(1 << nodes.len()) {
+            let active: Vec<usize> = (nodes.iter().enumerate())
+                .filter(|&(j, _)| mask & (1 << j) != 0)
+                .map(|(_, &node)| node)
+                .collect();
+            let mut f = Ldlt::factor_with_identity_rows(c, &active)?;
+            // End nodes change one half only: store the other once.
+            for other in std::iter::once(&factor).chain(&reduced) {
+                f.share_halves(other);
+            }
+            reduced.push(f);
+        }
+        let mut rows = [[0.0; 3]; 2];
+        for (row, &i) in rows.iter_mut().zip(nodes) {
+            let left = if i > 0 { c.off[i - 1] } else { 0.0 };
+            let right = if i + 1 < c.dim() { c.off[i] } else { 0.0 };
+            *row = [left, right, c.row_sums()[i]];
+        }
         Ok(Self {
             factor,
             columns,
             schur,
-            c: c.clone(),
+            rows,
             reduced,
             resolved: 0,
         })
@@ -122,30 +127,29 @@ impl ExactSolver {
             if mask & (1 << j) == 0 {
                 continue;
             }
-            let i = col.node;
+            let (i, [left, right, _]) = (col.node, self.rows[j]);
             z[i] = lower[j];
             if i > 0 && !active(i - 1) {
-                z[i - 1] -= self.c.off[i - 1] * lower[j];
+                z[i - 1] -= left * lower[j];
             }
             if i + 1 < n && !active(i + 1) {
-                z[i + 1] -= self.c.off[i] * lower[j];
+                z[i + 1] -= right * lower[j];
             }
         }
         self.reduced[mask as usize - 1].solve_in_place(z);
-        let s = self.c.row_sums();
         for (j, col) in self.columns.iter().enumerate() {
             reactions[j] = 0.0;
             if mask & (1 << j) == 0 {
                 continue;
             }
-            let i = col.node;
+            let (i, [left, right, sum]) = (col.node, self.rows[j]);
             // Row i of C z in difference form (exact for a rigid z where s_i = 0).
-            let mut cz = s[i] * z[i];
+            let mut cz = sum * z[i];
             if i > 0 {
-                cz += self.c.off[i - 1] * (z[i - 1] - z[i]);
+                cz += left * (z[i - 1] - z[i]);
             }
             if i + 1 < n {
-                cz += self.c.off[i] * (z[i + 1] - z[i]);
+                cz += right * (z[i + 1] - z[i]);
             }
             reactions[j] = (cz - rhs[i]).max(0.0);
         }
@@ -267,7 +271,7 @@ pub(crate) fn inverse_columns(factor: &Ldlt, nodes: &[usize]) -> Vec<Column> {
             let end = values.iter().rposition(|v| *v != 0.0).map_or(0, |e| e + 1);
             Column {
                 node,
-                values,
+                values: values.get(start..end).unwrap_or_default().to_vec(),
                 support: start..end,
             }
         })
@@ -280,7 +284,7 @@ pub(crate) fn schur_complement(columns: &[Column]) -> [[f64; 2]; 2] {
     let mut schur = [[0.0; 2]; 2];
     for (a, ca) in columns.iter().enumerate() {
         for (b, cb) in columns.iter().enumerate() {
-            schur[a][b] = ca.values[cb.node];
+            schur[a][b] = ca.value(cb.node);
         }
     }
     if columns.len() == 2 {
@@ -292,12 +296,21 @@ pub(crate) fn schur_complement(columns: &[Column]) -> [[f64; 2]; 2] {
 }
 
 impl Column {
+    /// `(C⁻¹)_{i, node}` (0 outside the support).
+    fn value(&self, i: usize) -> f64 {
+        if self.support.contains(&i) {
+            self.values[i - self.support.start]
+        } else {
+            0.0
+        }
+    }
+
     /// `z += r · C⁻¹ e_j` over the column's numerical support; returns `max|z|` over the
     /// support before and after.
     pub(crate) fn add_scaled(&self, r: f64, z: &mut [f64]) -> (f64, f64) {
         let range = self.support.clone();
         let (mut before, mut after) = (0.0f64, 0.0f64);
-        for (zi, ci) in z[range.clone()].iter_mut().zip(&self.values[range]) {
+        for (zi, ci) in z[range].iter_mut().zip(&self.values) {
             before = before.max(zi.abs());
             *zi += r * ci;
             after = after.max(zi.abs());

@@ -259,7 +259,7 @@ pub fn sample_run(name: &str, scene: &Scene, sampling: Sampling) -> Result<Sampl
     let mut u = Vec::with_capacity(nodes.len() * steps_sampled.len());
     let mut energy = Vec::with_capacity(steps_sampled.len());
     let keep = |full: &[f64], u: &mut Vec<f64>| u.extend(nodes.iter().map(|&i| full[i]));
-    keep(sim.initial_state().0, &mut u);
+    keep(&sim.initial_state().0, &mut u);
     energy.push(None);
     let mut next = 1; // index into steps_sampled of the next step to keep
     let mut observe = |sim: &Simulation, r: &StepRecord, u: &mut Vec<f64>, energy: &mut Vec<_>| {

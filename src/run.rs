@@ -320,14 +320,12 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
         .map_err(io(&hist_path))?;
 
     let nodes = sim.discretisation().nodes;
-    let xs: Vec<f64> = (0..nodes).map(|i| sim.discretisation().x(i)).collect();
+    let disc = sim.discretisation();
     writeln!(disp, "t,x,u,v").map_err(io(&disp_path))?;
-    {
-        let (u0, v0) = sim.initial_state();
-        write_profile(&mut disp, 0.0, &xs, u0, v0).map_err(io(&disp_path))?;
-    }
     let mut u = vec![0.0; nodes];
     let mut v = vec![0.0; nodes];
+    sim.initial_state_into(&mut u, &mut v);
+    write_profile(&mut disp, 0.0, disc, &u, &v).map_err(io(&disp_path))?;
     let steps = scene.steps();
     let every = scene.output.every as usize;
     let bar = (progress && steps as f64 * nodes as f64 > 2e8).then(|| {
@@ -342,7 +340,8 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
     if keep(1) {
         sim.displacement_into(&mut u);
         sim.velocity_into(&mut v);
-        write_profile(&mut disp, sim.time(), &xs, &u, &v).map_err(io(&disp_path))?;
+        write_profile(&mut disp, sim.time(), sim.discretisation(), &u, &v)
+            .map_err(io(&disp_path))?;
     }
     for _ in 1..steps {
         let r = sim.step()?;
@@ -351,7 +350,8 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
         if keep(r.step) {
             sim.displacement_into(&mut u);
             sim.velocity_into(&mut v);
-            write_profile(&mut disp, sim.time(), &xs, &u, &v).map_err(io(&disp_path))?;
+            write_profile(&mut disp, sim.time(), sim.discretisation(), &u, &v)
+                .map_err(io(&disp_path))?;
         }
         if let Some(b) = &bar {
             if r.step % 1024 == 0 {
@@ -410,15 +410,16 @@ fn write_history_row(
     writeln!(w, ",{}", r.iterations)
 }
 
+/// One row a node; `x` is computed, not stored (J doubles fewer).
 fn write_profile(
     w: &mut impl Write,
     t: f64,
-    xs: &[f64],
+    disc: &crate::simulation::Discretisation,
     u: &[f64],
     v: &[f64],
 ) -> std::io::Result<()> {
-    for i in 0..xs.len() {
-        writeln!(w, "{t},{},{},{}", xs[i], u[i], v[i])?;
+    for i in 0..u.len() {
+        writeln!(w, "{t},{},{},{}", disc.x(i), u[i], v[i])?;
     }
     Ok(())
 }

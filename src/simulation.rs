@@ -53,8 +53,9 @@ pub struct Discretisation {
     pub alpha: f64,
     /// Global index of the first unknown (1 when the left end is clamped).
     pub first: usize,
-    /// Mass matrix on all nodes (for the load vector).
-    pub mass_full: SymTridiag,
+    /// Which matrices (the full-mesh mass matrix of a load is rebuilt from it when needed,
+    /// rather than kept: J doubles ×3 that most runs never read).
+    pub variant: matrices::MatrixVariant,
     /// Mass and stiffness on the unknowns.
     pub mass: SymTridiag,
     pub stiffness: SymTridiag,
@@ -69,12 +70,11 @@ impl Discretisation {
         let dt = scene.time.step;
         let alpha = scene.bar.viscosity;
         let variant = scene.bar.matrices;
-        let mass_full = matrices::mass(variant, nodes, dx);
-        let stiffness_full = matrices::stiffness(variant, nodes, dx);
         let first = usize::from(scene.left.condition == Condition::Clamped);
         let last = nodes - 1 - usize::from(scene.right.condition == Condition::Clamped);
-        let mass = mass_full.sub(first, last);
-        let stiffness = stiffness_full.sub(first, last);
+        // In place: no second copy of the full-mesh matrices at set-up.
+        let mass = matrices::mass(variant, nodes, dx).into_sub(first, last);
+        let stiffness = matrices::stiffness(variant, nodes, dx).into_sub(first, last);
         let step_matrix =
             SymTridiag::combine(1.0 / (dt * dt), &mass, 0.5 + alpha / (2.0 * dt), &stiffness);
         let node_of = |side: Side| if side == Side::Left { 0 } else { nodes - 1 };
@@ -120,7 +120,7 @@ impl Discretisation {
             dt,
             alpha,
             first,
-            mass_full,
+            variant,
             mass,
             stiffness,
             step_matrix,
@@ -281,9 +281,10 @@ enum LoadTerm {
         expr: Expression,
         m_one: Vec<f64>,
     },
-    /// General `l(x, t)`: nodal values every step.
+    /// General `l(x, t)`: nodal values every step, times the full-mesh mass matrix.
     General {
         expr: Expression,
+        mass_full: SymTridiag,
         nodal: Vec<f64>,
         full: Vec<f64>,
     },
@@ -319,8 +320,8 @@ pub struct Simulation {
     timing: PhaseTimes,
     /// Interior coefficients of `M` and `R` as numbers, when the mesh is uniform.
     uniform: Option<(Uniform, Uniform)>,
-    initial_u: Vec<f64>,
-    initial_v: Vec<f64>,
+    /// `u_0` and `u_1`, evaluated again on request rather than kept (2 × J doubles).
+    initial: InitialData,
     first_record: StepRecord,
 }
 
@@ -347,43 +348,18 @@ impl Simulation {
         let n = disc.unknowns();
         let dt = disc.dt;
         let alpha = disc.alpha;
-        let u0_expr =
-            Expression::parse("initial.displacement", &scene.initial.displacement, false)?;
-        let v0_expr = Expression::parse("initial.velocity", &scene.initial.velocity, false)?;
+        let initial = InitialData {
+            displacement: Expression::parse(
+                "initial.displacement",
+                &scene.initial.displacement,
+                false,
+            )?,
+            velocity: Expression::parse("initial.velocity", &scene.initial.velocity, false)?,
+            clamped: [&scene.left, &scene.right].map(|end| end.condition == Condition::Clamped),
+        };
         let mut u0_full = vec![0.0; nodes];
         let mut v0_full = vec![0.0; nodes];
-        for i in 0..nodes {
-            u0_full[i] = u0_expr.eval(disc.x(i), 0.0)?;
-            v0_full[i] = v0_expr.eval(disc.x(i), 0.0)?;
-        }
-        // Clamped nodes must start at rest at u = 0.
-        for (side, end, node) in [
-            (Side::Left, &scene.left, 0),
-            (Side::Right, &scene.right, nodes - 1),
-        ] {
-            if end.condition != Condition::Clamped {
-                continue;
-            }
-            for (field, value) in [
-                ("initial.displacement", u0_full[node]),
-                ("initial.velocity", v0_full[node]),
-            ] {
-                if value.abs() > CLAMPED_START_TOL {
-                    return Err(SceneError::Invalid {
-                        field: field.into(),
-                        value: value.to_string(),
-                        allowed: format!(
-                            "must vanish at the clamped {} end (x = {})",
-                            side.name(),
-                            disc.x(node)
-                        ),
-                    }
-                    .into());
-                }
-                u0_full[node] = 0.0;
-                v0_full[node] = 0.0;
-            }
-        }
+        initial.eval_into(&disc, &mut u0_full, &mut v0_full)?;
         for c in &disc.constraints {
             if u0_full[c.node] < -c.gap {
                 return Err(SceneError::Inadmissible {
@@ -410,15 +386,16 @@ impl Simulation {
                     let nodal = (0..nodes)
                         .map(|i| expr.eval(disc.x(i), 0.0))
                         .collect::<Result<Vec<_>, _>>()?;
-                    force.copy_from_slice(&disc.mass_full.mul(&nodal)[range.clone()]);
+                    load_rows_into(&disc, |i| nodal[i], &mut force);
                     LoadTerm::Constant
                 } else if !expr.depends_on_x() {
-                    let ones = vec![1.0; nodes];
-                    let m_one = disc.mass_full.mul(&ones)[disc.first..disc.first + n].to_vec();
+                    let mut m_one = vec![0.0; n];
+                    load_rows_into(&disc, |_| 1.0, &mut m_one);
                     LoadTerm::TimeOnly { expr, m_one }
                 } else {
                     LoadTerm::General {
                         expr,
+                        mass_full: matrices::mass(disc.variant, nodes, disc.dx),
                         nodal: vec![0.0; nodes],
                         full: vec![0.0; nodes],
                     }
@@ -427,11 +404,18 @@ impl Simulation {
         };
         let locals = disc.constrained_locals();
         let k = locals.len();
+        // u^0 and u_1 on the unknowns, in the storage of the full-mesh vectors.
+        let restrict = |mut v: Vec<f64>| {
+            v.truncate(range.end);
+            v.drain(..range.start);
+            v
+        };
+        let (u, v0) = (restrict(u0_full), restrict(v0_full));
         let mut sim = Self {
             solver,
             load,
             n: 0,
-            u: u0_full[range.clone()].to_vec(),
+            u,
             w: vec![0.0; n],
             z: vec![0.0; n],
             rhs: vec![0.0; n],
@@ -448,30 +432,31 @@ impl Simulation {
             last_step: scene.steps(),
             timing: PhaseTimes::default(),
             uniform: disc.mass.uniform().zip(disc.stiffness.uniform()),
-            initial_u: u0_full,
-            initial_v: v0_full,
+            initial,
             first_record: StepRecord::default(),
             disc,
         };
-        let v0 = sim.initial_v[range].to_vec();
         sim.start_up(&v0)?;
         Ok(sim)
     }
 
+    /// The start-up step; `z`, `w` and `rhs` serve as its work space (no J-sized temporaries).
     fn start_up(&mut self, v0: &[f64]) -> Result<(), RunError> {
         let dt = self.disc.dt;
         self.update_force(0)?;
-        // a = M⁻¹ (F^0 − R u^0 − α R u_1)
-        let mut acc = self.disc.stiffness.mul(&self.u);
-        let rv = self.disc.stiffness.mul(v0);
+        // a = M⁻¹ (F^0 − R u^0 − α R u_1), in z.
+        let (acc, rv) = (&mut self.z, &mut self.rhs);
+        self.disc.stiffness.mul_into(&self.u, acc);
+        self.disc.stiffness.mul_into(v0, rv);
         for i in 0..acc.len() {
             acc[i] = self.force[i] - acc[i] - self.disc.alpha * rv[i];
         }
-        Ldlt::factor(&self.disc.mass)?.solve_in_place(&mut acc);
-        let z_taylor: Vec<f64> = (0..acc.len())
-            .map(|i| dt * v0[i] + 0.5 * dt * dt * acc[i])
-            .collect();
-        self.disc.step_matrix.mul_into(&z_taylor, &mut self.rhs);
+        Ldlt::factor(&self.disc.mass)?.solve_in_place(acc);
+        // The Taylor increment, in w (w becomes the increment z after the step).
+        for i in 0..acc.len() {
+            self.w[i] = dt * v0[i] + 0.5 * dt * dt * acc[i];
+        }
+        self.disc.step_matrix.mul_into(&self.w, &mut self.rhs);
         for (j, c) in self.disc.constraints.iter().enumerate() {
             self.lower[j] = -c.gap - self.u[self.locals[j]];
         }
@@ -488,9 +473,10 @@ impl Simulation {
         for (ui, zi) in self.u.iter_mut().zip(&self.z) {
             *ui += zi;
         }
-        let mz = self.disc.mass.mul(&self.z);
+        let mz = &mut self.rhs;
+        self.disc.mass.mul_into(&self.z, mz);
         self.potential = self.disc.stiffness.quad(&self.u);
-        self.energy = 0.5 * dot(&self.z, &mz) * self.inv_dt2 + 0.25 * (self.potential + potential0);
+        self.energy = 0.5 * dot(&self.z, mz) * self.inv_dt2 + 0.25 * (self.potential + potential0);
         if !self.energy.is_finite() {
             return Err(self.failure(1, crate::solver::StepFailure::NonFinite));
         }
@@ -530,11 +516,16 @@ impl Simulation {
                     *fi = f * mi;
                 }
             }
-            LoadTerm::General { expr, nodal, full } => {
+            LoadTerm::General {
+                expr,
+                mass_full,
+                nodal,
+                full,
+            } => {
                 for (i, v) in nodal.iter_mut().enumerate() {
                     *v = expr.eval(i as f64 * self.disc.dx, t)?;
                 }
-                self.disc.mass_full.mul_into(nodal, full);
+                mass_full.mul_into(nodal, full);
                 let n = self.force.len();
                 self.force.copy_from_slice(&full[first..first + n]);
             }
@@ -778,9 +769,80 @@ impl Simulation {
         out
     }
 
-    /// Initial displacement and velocity at the nodes.
-    pub fn initial_state(&self) -> (&[f64], &[f64]) {
-        (&self.initial_u, &self.initial_v)
+    /// Initial displacement and velocity at all nodes (evaluated again: not kept in memory).
+    pub fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
+        let mut u = vec![0.0; self.disc.nodes];
+        let mut v = vec![0.0; self.disc.nodes];
+        self.initial_state_into(&mut u, &mut v);
+        (u, v)
+    }
+
+    /// [`Simulation::initial_state`] into `u` and `v` (all nodes).
+    pub fn initial_state_into(&self, u: &mut [f64], v: &mut [f64]) {
+        self.initial
+            .eval_into(&self.disc, u, v)
+            .expect("the same evaluation succeeded at set-up");
+    }
+}
+
+/// The initial data of a scene.
+struct InitialData {
+    displacement: Expression,
+    velocity: Expression,
+    /// Left and right end clamped.
+    clamped: [bool; 2],
+}
+
+impl InitialData {
+    /// `u_0`, `u_1` at all nodes; at a clamped node they must vanish (up to
+    /// [`CLAMPED_START_TOL`]) and are set to 0.
+    fn eval_into(
+        &self,
+        disc: &Discretisation,
+        u: &mut [f64],
+        v: &mut [f64],
+    ) -> Result<(), SceneError> {
+        let nodes = disc.nodes;
+        for i in 0..nodes {
+            u[i] = self.displacement.eval(disc.x(i), 0.0)?;
+            v[i] = self.velocity.eval(disc.x(i), 0.0)?;
+        }
+        for (side, clamped, node) in [
+            (Side::Left, self.clamped[0], 0),
+            (Side::Right, self.clamped[1], nodes - 1),
+        ] {
+            if !clamped {
+                continue;
+            }
+            for (field, value) in [
+                ("initial.displacement", u[node]),
+                ("initial.velocity", v[node]),
+            ] {
+                if value.abs() > CLAMPED_START_TOL {
+                    return Err(SceneError::Invalid {
+                        field: field.into(),
+                        value: value.to_string(),
+                        allowed: format!(
+                            "must vanish at the clamped {} end (x = {})",
+                            side.name(),
+                            disc.x(node)
+                        ),
+                    });
+                }
+            }
+            u[node] = 0.0;
+            v[node] = 0.0;
+        }
+        Ok(())
+    }
+}
+
+/// `(M_full x)_i` at the unknowns `i`, row by row (the same arithmetic as
+/// [`SymTridiag::mul_into`]), without keeping the full-mesh mass matrix beyond this call.
+fn load_rows_into(disc: &Discretisation, x: impl Fn(usize) -> f64, out: &mut [f64]) {
+    let mass_full = matrices::mass(disc.variant, disc.nodes, disc.dx);
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = row_of(&mass_full, &x, disc.first + k, disc.nodes);
     }
 }
 

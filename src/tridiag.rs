@@ -55,6 +55,17 @@ impl SymTridiag {
         )
     }
 
+    /// [`SymTridiag::sub`], reusing this matrix's storage.
+    pub fn into_sub(self, first: usize, last: usize) -> SymTridiag {
+        let (mut diag, mut off) = (self.diag, self.off);
+        drop(self.row_sums);
+        diag.truncate(last + 1);
+        diag.drain(..first);
+        off.truncate(last);
+        off.drain(..first);
+        SymTridiag::new(diag, off)
+    }
+
     /// `y = A x`, without allocating, in difference form
     /// `(Ax)_i = s_i x_i + A_i,i−1 (x_{i−1} − x_i) + A_i,i+1 (x_{i+1} − x_i)`: for the stiffness
     /// matrix (`s = 0`) the round-off is relative to the differences of `x`, so a rigid offset
@@ -243,6 +254,8 @@ pub fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
 }
 
+use std::sync::Arc;
+
 /// A twisted factorisation of a symmetric positive definite tridiagonal matrix ("burn at both
 /// ends"): `L D Lᵀ` from the top for rows `0..m`, `U D Uᵀ` from the bottom for rows `m+1..n`,
 /// joined at the twist row `m = n/2`. Computed once per run. A solve runs the two elimination
@@ -258,8 +271,10 @@ pub fn dot(x: &[f64], y: &[f64]) -> f64 {
 pub struct Ldlt {
     /// `(l_i, 1/d_i)` in the order the inward sweep visits the rows: `top[i]` for rows
     /// `i = 0..m` (`l_i = e_i/d_i`), `bottom[k]` for rows `j = n−1−k > m` (`l_j = e_{j−1}/d_j`).
-    top: Vec<[f64; 2]>,
-    bottom: Vec<[f64; 2]>,
+    /// Shared (see [`Ldlt::share_halves`]): a half is stored once however many factorisations
+    /// have it bitwise.
+    top: Arc<Vec<[f64; 2]>>,
+    bottom: Arc<Vec<[f64; 2]>>,
     /// `1/γ_m`, the twist pivot.
     inv_twist: f64,
     n: usize,
@@ -275,7 +290,53 @@ pub struct NotPositiveDefinite {
 
 impl Ldlt {
     pub fn factor(a: &SymTridiag) -> Result<Self, NotPositiveDefinite> {
-        let n = a.dim();
+        Self::factor_by(a.dim(), |i| a.diag[i], |i| a.off[i])
+    }
+
+    /// The factorisation of `a` with the rows and columns of `nodes` replaced by identity ones
+    /// (the same entries the factorisation of that modified matrix reads, without copying it).
+    pub fn factor_with_identity_rows(
+        a: &SymTridiag,
+        nodes: &[usize],
+    ) -> Result<Self, NotPositiveDefinite> {
+        let identity = |i: usize| nodes.contains(&i);
+        Self::factor_by(
+            a.dim(),
+            |i| if identity(i) { 1.0 } else { a.diag[i] },
+            |i| {
+                if identity(i) || identity(i + 1) {
+                    0.0
+                } else {
+                    a.off[i]
+                }
+            },
+        )
+    }
+
+    /// Makes each half that is bitwise equal to a half of `other` share its storage (a
+    /// factorisation with identity rows at one end differs from the plain one in one half).
+    pub fn share_halves(&mut self, other: &Ldlt) {
+        let same = |a: &[[f64; 2]], b: &[[f64; 2]]| {
+            a.len() == b.len()
+                && a.iter().zip(b).all(|(x, y)| {
+                    x[0].to_bits() == y[0].to_bits() && x[1].to_bits() == y[1].to_bits()
+                })
+        };
+        for mine in [&mut self.top, &mut self.bottom] {
+            for theirs in [&other.top, &other.bottom] {
+                if !Arc::ptr_eq(mine, theirs) && same(mine, theirs) {
+                    *mine = Arc::clone(theirs);
+                }
+            }
+        }
+    }
+
+    /// The factorisation of the matrix with diagonal `d(i)` and off-diagonal `e(i) = A_i,i+1`.
+    fn factor_by(
+        n: usize,
+        d: impl Fn(usize) -> f64,
+        e: impl Fn(usize) -> f64,
+    ) -> Result<Self, NotPositiveDefinite> {
         let twist = n / 2;
         let check = |index: usize, pivot: f64| {
             if pivot > 0.0 && pivot.is_finite() {
@@ -284,45 +345,44 @@ impl Ldlt {
                 Err(NotPositiveDefinite { index, pivot })
             }
         };
-        let (d, e) = (&a.diag, &a.off);
         let mut top = Vec::with_capacity(twist);
         let mut l_prev = 0.0;
         for i in 0..twist {
             let p = if i == 0 {
-                d[0]
+                d(0)
             } else {
-                d[i] - e[i - 1] * l_prev
+                d(i) - e(i - 1) * l_prev
             };
             let p = check(i, p)?;
-            l_prev = e[i] / p;
+            l_prev = e(i) / p;
             top.push([l_prev, 1.0 / p]);
         }
         let mut bottom = Vec::with_capacity(n.saturating_sub(twist + 1));
         let mut l_next = 0.0;
         for i in (twist + 1..n).rev() {
             let p = if i == n - 1 {
-                d[i]
+                d(i)
             } else {
-                d[i] - e[i] * l_next
+                d(i) - e(i) * l_next
             };
             let p = check(i, p)?;
-            l_next = e[i - 1] / p;
+            l_next = e(i - 1) / p;
             bottom.push([l_next, 1.0 / p]);
         }
         let mut inv_twist = 0.0;
         if n > 0 {
-            let mut g = d[twist];
+            let mut g = d(twist);
             if twist > 0 {
-                g -= e[twist - 1] * l_prev;
+                g -= e(twist - 1) * l_prev;
             }
             if twist + 1 < n {
-                g -= e[twist] * l_next;
+                g -= e(twist) * l_next;
             }
             inv_twist = 1.0 / check(twist, g)?;
         }
         Ok(Self {
-            top,
-            bottom,
+            top: Arc::new(top),
+            bottom: Arc::new(bottom),
             inv_twist,
             n,
         })
@@ -340,7 +400,8 @@ impl Ldlt {
         if n == 0 {
             return;
         }
-        let m = self.top.len();
+        let (top_f, bottom_f) = (&self.top[..], &self.bottom[..]);
+        let m = top_f.len();
         let (upper, rest) = b.split_at_mut(m);
         let (mid, lower) = rest.split_at_mut(1);
         // Inward: y_i = b_i − l_{i−1} y_{i−1} (top), y_j = b_j − l_{j+1} y_{j+1} (bottom);
@@ -348,9 +409,9 @@ impl Ldlt {
         let (mut yt, mut yb) = (0.0, 0.0);
         let (mut lt, mut lb) = (0.0, 0.0);
         // `take`: a bare `zip` would consume one element of the longer chain and drop it.
-        let common = self.top.len().min(self.bottom.len());
-        let mut top = upper.iter_mut().zip(&self.top);
-        let mut bottom = lower.iter_mut().rev().zip(&self.bottom);
+        let common = top_f.len().min(bottom_f.len());
+        let mut top = upper.iter_mut().zip(top_f);
+        let mut bottom = lower.iter_mut().rev().zip(bottom_f);
         for ((bt, ft), (bb, fb)) in top.by_ref().take(common).zip(bottom.by_ref().take(common)) {
             yt = *bt - lt * yt;
             yb = *bb - lb * yb;
@@ -373,8 +434,8 @@ impl Ldlt {
         mid[0] = xm;
         // Outward: x_i = y_i/d_i − l_i x_{i+1} (top), x_j = y_j/d_j − l_j x_{j−1} (bottom).
         let (mut xt, mut xb) = (xm, xm);
-        let mut top = upper.iter_mut().rev().zip(self.top.iter().rev());
-        let mut bottom = lower.iter_mut().zip(self.bottom.iter().rev());
+        let mut top = upper.iter_mut().rev().zip(top_f.iter().rev());
+        let mut bottom = lower.iter_mut().zip(bottom_f.iter().rev());
         for ((bt, ft), (bb, fb)) in top.by_ref().take(common).zip(bottom.by_ref().take(common)) {
             xt = *bt - ft[0] * xt;
             xb = *bb - fb[0] * xb;
