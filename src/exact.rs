@@ -16,7 +16,7 @@
 //! the rigid flight `≈ Δt v`, `z` a tiny deflection), `z = z⁰ + Σ r_j c_j` cancels
 //! `max|z⁰| / max|z|` digits and its error, about `ε max|z⁰|`, can reach `z` itself (found by
 //! the stiff case matrix, `src/stiff.rs`: an error as large as `z` at `α = 1e6`, `Δt = 1e4 Δx`). When that
-//! ratio exceeds [`RESOLVE_CANCELLATION`], the step is recomputed on the chosen active set `A`
+//! ratio (against `max(|z|, |u^n|)`) exceeds [`RESOLVE_CANCELLATION`], the step is recomputed on the chosen active set `A`
 //! by a backward-stable direct solve, `z_A = lo_A`, `C_FF z_F = b_F − C_FA lo_A`, with the
 //! reactions `r_A = (Cz − b)_A`; the reduced matrices of the three non-empty active sets are
 //! factorised once per run.
@@ -24,11 +24,14 @@
 use crate::solver::{SolveInfo, StepFailure, StepSolver};
 use crate::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
 
-/// Largest cancellation `max|z⁰| / max|z|` over the columns' support accepted from the
-/// superposition `z⁰ + Σ r_j c_j`: its rounding error is about `ε max|z⁰|`, i.e. this many ulps
-/// of `|z|`, against the few ulps of a direct solve; beyond it the step is solved directly
-/// (the audit's round-off floor, `audit::ROUNDOFF_ULPS = 32`, leaves room for 8 and the
-/// solve's own ulps).
+/// Largest cancellation `max|z⁰| / max(|z|, |u^n|)` over the columns' support accepted from
+/// the superposition `z⁰ + Σ r_j c_j`: its rounding error is about `ε max|z⁰|`, i.e. this many
+/// ulps of `|z|` or of the state `u^n` it is added to, against the few ulps of a direct solve;
+/// beyond it the step is solved directly (the audit's round-off floor,
+/// `audit::ROUNDOFF_ULPS = 32`, leaves room for 8 and the solve's own ulps). Measured against
+/// `|u^n|` too because an error below a few ulps of `u^n` is lost in `u^n + z` anyway, while
+/// a bar settling on an obstacle (`z ≈ 0` at the contact, `z⁰` one step of free fall) would
+/// otherwise pay for a second solve on every step.
 pub const RESOLVE_CANCELLATION: f64 = 8.0;
 
 /// Column `C⁻¹ e_j`, truncated to where it is a normal floating-point number. Shared with the
@@ -58,6 +61,8 @@ pub struct ExactSolver {
     reduced: Vec<Ldlt>,
     /// Steps recomputed by the direct solve (cancellation beyond [`RESOLVE_CANCELLATION`]).
     resolved: u64,
+    /// `max|u^n|` of the state `z` is added to ([`StepSolver::set_state_scale`]; 0 if not given).
+    state_scale: f64,
 }
 
 impl ExactSolver {
@@ -96,6 +101,7 @@ impl ExactSolver {
             rows,
             reduced,
             resolved: 0,
+            state_scale: 0.0,
         })
     }
 
@@ -192,6 +198,10 @@ impl StepSolver for ExactSolver {
         "exact"
     }
 
+    fn set_state_scale(&mut self, max_abs_u: f64) {
+        self.state_scale = max_abs_u;
+    }
+
     fn solve(
         &mut self,
         rhs: &[f64],
@@ -228,10 +238,21 @@ impl StepSolver for ExactSolver {
         let (mask, r, _) = best;
         // max|z⁰| before and max|z| after the superposition, over the columns' support.
         let (mut before, mut after) = (0.0f64, 0.0f64);
+        for (j, rj) in reactions[..k].iter_mut().enumerate() {
+            *rj = if mask & (1 << j) != 0 { r[j] } else { 0.0 };
+        }
+        let fused = k == 2
+            && reactions[0] != 0.0
+            && reactions[1] != 0.0
+            && self.columns[0].support == self.columns[1].support;
+        if fused {
+            // Both columns over the same support (a stiff C): one pass, same bits as two.
+            (before, after) =
+                self.columns[0].add_scaled_pair(reactions[0], &self.columns[1], reactions[1], z);
+        }
         for (j, col) in self.columns.iter().enumerate() {
             let active = mask & (1 << j) != 0;
-            reactions[j] = if active { r[j] } else { 0.0 };
-            if active && r[j] != 0.0 {
+            if active && r[j] != 0.0 && !fused {
                 let (b, a) = col.add_scaled(r[j], z);
                 before = before.max(b);
                 // A second pass overwrites the first one's values where the supports overlap
@@ -245,7 +266,7 @@ impl StepSolver for ExactSolver {
                 z[col.node] = lower[j];
             }
         }
-        if before > RESOLVE_CANCELLATION * after {
+        if before > RESOLVE_CANCELLATION * after.max(self.state_scale) {
             self.resolved += 1;
             self.solve_on_active_set(mask, rhs, lower, z, reactions);
         }
@@ -305,18 +326,67 @@ impl Column {
         }
     }
 
+    /// `z += r · c + r2 · c2` (evaluated as `(z + r·c) + r2·c2`, the bits of two
+    /// [`Column::add_scaled`] passes) for two columns with the same support, in one pass;
+    /// returns `max|z|` over the support before and after.
+    pub(crate) fn add_scaled_pair(
+        &self,
+        r: f64,
+        other: &Column,
+        r2: f64,
+        z: &mut [f64],
+    ) -> (f64, f64) {
+        debug_assert_eq!(self.support, other.support);
+        let (mut before, mut after) = ([0.0f64; 4], [0.0f64; 4]);
+        let zs = &mut z[self.support.clone()];
+        let mut zc = zs.chunks_exact_mut(4);
+        let (mut ac, mut bc) = (self.values.chunks_exact(4), other.values.chunks_exact(4));
+        for ((z4, a4), b4) in (&mut zc).zip(&mut ac).zip(&mut bc) {
+            for k in 0..4 {
+                before[k] = before[k].max(z4[k].abs());
+                z4[k] = (z4[k] + r * a4[k]) + r2 * b4[k];
+                after[k] = after[k].max(z4[k].abs());
+            }
+        }
+        let rest = zc.into_remainder();
+        for ((zi, ai), bi) in rest.iter_mut().zip(ac.remainder()).zip(bc.remainder()) {
+            before[0] = before[0].max(zi.abs());
+            *zi = (*zi + r * ai) + r2 * bi;
+            after[0] = after[0].max(zi.abs());
+        }
+        (max4(before), max4(after))
+    }
+
     /// `z += r · C⁻¹ e_j` over the column's numerical support; returns `max|z|` over the
     /// support before and after.
     pub(crate) fn add_scaled(&self, r: f64, z: &mut [f64]) -> (f64, f64) {
-        let range = self.support.clone();
-        let (mut before, mut after) = (0.0f64, 0.0f64);
-        for (zi, ci) in z[range].iter_mut().zip(&self.values) {
-            before = before.max(zi.abs());
-            *zi += r * ci;
-            after = after.max(zi.abs());
+        // Four running maxima each: one chain of dependent `max`es would be latency-bound
+        // (the column spans the whole bar when C is stiff); the maxima are exact, so the
+        // order does not change the result.
+        let (mut before, mut after) = ([0.0f64; 4], [0.0f64; 4]);
+        let (mut zc, mut cc) = (
+            z[self.support.clone()].chunks_exact_mut(4),
+            self.values.chunks_exact(4),
+        );
+        for (z4, c4) in (&mut zc).zip(&mut cc) {
+            for k in 0..4 {
+                before[k] = before[k].max(z4[k].abs());
+                z4[k] += r * c4[k];
+                after[k] = after[k].max(z4[k].abs());
+            }
         }
-        (before, after)
+        for (zi, ci) in zc.into_remainder().iter_mut().zip(cc.remainder()) {
+            before[0] = before[0].max(zi.abs());
+            *zi += r * ci;
+            after[0] = after[0].max(zi.abs());
+        }
+        (max4(before), max4(after))
     }
+}
+
+/// The largest of four running maxima.
+fn max4(m: [f64; 4]) -> f64 {
+    m[0].max(m[1]).max(m[2].max(m[3]))
 }
 
 #[cfg(test)]
@@ -362,5 +432,33 @@ mod tests {
         for (a, p) in z.iter().zip(&z_pivot) {
             assert!((a - p).abs() <= tol, "{a:e} vs {p:e}");
         }
+    }
+
+    /// The same step added to a state of size 1e3 (> 500 / 8): the superposition's error,
+    /// about `ε · 500`, is below 8 ulps of that state, so no second solve; with the state at
+    /// 10 it is not, and the step is solved again.
+    #[test]
+    fn cancellation_is_weighed_against_the_state_it_is_added_to() {
+        let (elements, alpha) = (20usize, 1e6);
+        let dx = 1.0 / elements as f64;
+        let dt = 1e4 * dx;
+        let nodes = elements + 1;
+        let m = mass(MatrixVariant::Consistent, nodes, dx);
+        let r = stiffness(MatrixVariant::Consistent, nodes, dx);
+        let c = SymTridiag::combine(1.0 / (dt * dt), &m, 0.5 + alpha / (2.0 * dt), &r);
+        let b = c.mul(&vec![-500.0; nodes]);
+        let ends = [0, nodes - 1];
+        let (mut z, mut reactions) = (vec![0.0; nodes], [0.0; 2]);
+        let mut solver = ExactSolver::new(&c, &ends).unwrap();
+        solver.set_state_scale(1e3);
+        solver
+            .solve(&b, &[0.0, 0.0], &mut z, &mut reactions)
+            .unwrap();
+        assert_eq!(solver.resolved_steps(), 0);
+        solver.set_state_scale(10.0);
+        solver
+            .solve(&b, &[0.0, 0.0], &mut z, &mut reactions)
+            .unwrap();
+        assert_eq!(solver.resolved_steps(), 1);
     }
 }

@@ -299,6 +299,8 @@ pub struct Simulation {
     /// `n`: the state held is `u^n`.
     n: usize,
     u: Vec<f64>,
+    /// `max_i |u^n_i|`, handed to the step solver (see [`StepSolver::set_state_scale`]).
+    u_scale: f64,
     /// `w = u^n − u^{n−1}`.
     w: Vec<f64>,
     z: Vec<f64>,
@@ -416,6 +418,7 @@ impl Simulation {
             load,
             n: 0,
             u,
+            u_scale: 0.0,
             w: vec![0.0; n],
             z: vec![0.0; n],
             rhs: vec![0.0; n],
@@ -460,6 +463,8 @@ impl Simulation {
         for (j, c) in self.disc.constraints.iter().enumerate() {
             self.lower[j] = -c.gap - self.u[self.locals[j]];
         }
+        self.solver
+            .set_state_scale(self.u.iter().fold(0.0f64, |m, v| m.max(v.abs())));
         let info = self
             .solver
             .solve(&self.rhs, &self.lower, &mut self.z, &mut self.reactions)
@@ -470,9 +475,7 @@ impl Simulation {
                 failure,
             })?;
         let potential0 = self.disc.stiffness.quad(&self.u);
-        for (ui, zi) in self.u.iter_mut().zip(&self.z) {
-            *ui += zi;
-        }
+        self.u_scale = advance(&mut self.u, &self.z);
         let mz = &mut self.rhs;
         self.disc.mass.mul_into(&self.z, mz);
         self.potential = self.disc.stiffness.quad(&self.u);
@@ -586,6 +589,7 @@ impl Simulation {
         for (j, c) in self.disc.constraints.iter().enumerate() {
             self.lower[j] = -c.gap - self.u[self.locals[j]];
         }
+        self.solver.set_state_scale(self.u_scale);
         let info: SolveInfo = self
             .solver
             .solve(&self.rhs, &self.lower, &mut self.z, &mut self.reactions)
@@ -599,7 +603,7 @@ impl Simulation {
             self.energy = 0.5 * mass.quad(&self.w) * inv_dt2
                 + 0.25 * (self.potential + potential_of_difference(stiffness, &self.u, &self.w));
         }
-        advance(&mut self.u, &self.z);
+        self.u_scale = advance(&mut self.u, &self.z);
         let clock = clock.lap(&mut self.timing.update_ns);
         let dt = self.disc.dt;
         let mut record = StepRecord {
@@ -903,12 +907,23 @@ fn rhs_into<const LOAD: bool, K: Interior>(
     }
 }
 
-/// `u += z`.
+/// `u += z`, returning the new `max_i |u_i|` (four running maxima, so the loop vectorises;
+/// the maximum is exact, so the order does not change the bits).
 #[inline(never)]
-fn advance(u: &mut [f64], z: &[f64]) {
-    for (ui, zi) in u.iter_mut().zip(z) {
-        *ui += zi;
+fn advance(u: &mut [f64], z: &[f64]) -> f64 {
+    let mut m = [0.0f64; 4];
+    let (mut uc, mut zc) = (u.chunks_exact_mut(4), z.chunks_exact(4));
+    for (u4, z4) in (&mut uc).zip(&mut zc) {
+        for k in 0..4 {
+            u4[k] += z4[k];
+            m[k] = m[k].max(u4[k].abs());
+        }
     }
+    for (ui, zi) in uc.into_remainder().iter_mut().zip(zc.remainder()) {
+        *ui += zi;
+        m[0] = m[0].max(ui.abs());
+    }
+    m[0].max(m[1]).max(m[2].max(m[3]))
 }
 
 /// The sums of the energy balance of one step.

@@ -62,6 +62,10 @@ pub trait StepSolver {
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure>;
 
+    /// `max_i |u^n_i|`, the state the next answer `z` is added to, given before each solve
+    /// (the exact end solver weighs its cancellation error against it). Default: ignored.
+    fn set_state_scale(&mut self, _max_abs_u: f64) {}
+
     /// Statistics over all solves so far; `None` for solvers that keep none.
     fn report(&self) -> Option<SolverReport> {
         None
