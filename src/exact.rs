@@ -395,13 +395,9 @@ mod tests {
     use crate::audit::{KktAudit, Law};
     use crate::matrices::{MatrixVariant, mass, stiffness};
 
-    /// Regression (found by the stiff case matrix): a free-free bar of 20 elements at
-    /// `α = 1e6`, `Δt = 1e4 Δx`, flying rigidly at `Δt v = −500` per step onto obstacles at gap 0
-    /// under both ends. The superposition `z⁰ + Σ r_j c_j` cancelled 500 down to about 1e-7
-    /// and returned an answer off by about itself. The answer must now pass the KKT audit at its round-off
-    /// floors in displacement and equal the block-pivoting solver's direct solve.
-    #[test]
-    fn stiff_impact_stopping_a_rigid_flight_is_solved_to_round_off() {
+    /// `C` of a free-free bar of 20 elements at `α = 1e6`, `Δt = 1e4 Δx`, and the `b` of a
+    /// rigid flight at `Δt v = −500` per step.
+    fn rigid_flight() -> (SymTridiag, Vec<f64>) {
         let (elements, alpha) = (20usize, 1e6);
         let dx = 1.0 / elements as f64;
         let dt = 1e4 * dx;
@@ -410,6 +406,18 @@ mod tests {
         let r = stiffness(MatrixVariant::Consistent, nodes, dx);
         let c = SymTridiag::combine(1.0 / (dt * dt), &m, 0.5 + alpha / (2.0 * dt), &r);
         let b = c.mul(&vec![-500.0; nodes]);
+        (c, b)
+    }
+
+    /// Regression (found by the stiff case matrix): a free-free bar of 20 elements at
+    /// `α = 1e6`, `Δt = 1e4 Δx`, flying rigidly at `Δt v = −500` per step onto obstacles at gap 0
+    /// under both ends. The superposition `z⁰ + Σ r_j c_j` cancelled 500 down to about 1e-7
+    /// and returned an answer off by about itself. The answer must now pass the KKT audit at its round-off
+    /// floors in displacement and equal the block-pivoting solver's direct solve.
+    #[test]
+    fn stiff_impact_stopping_a_rigid_flight_is_solved_to_round_off() {
+        let (c, b) = rigid_flight();
+        let nodes = c.dim();
         let ends = [0, nodes - 1];
         let lower = [0.0, 0.0];
         let (mut z, mut reactions) = (vec![0.0; nodes], [0.0; 2]);
@@ -439,14 +447,8 @@ mod tests {
     /// 10 it is not, and the step is solved again.
     #[test]
     fn cancellation_is_weighed_against_the_state_it_is_added_to() {
-        let (elements, alpha) = (20usize, 1e6);
-        let dx = 1.0 / elements as f64;
-        let dt = 1e4 * dx;
-        let nodes = elements + 1;
-        let m = mass(MatrixVariant::Consistent, nodes, dx);
-        let r = stiffness(MatrixVariant::Consistent, nodes, dx);
-        let c = SymTridiag::combine(1.0 / (dt * dt), &m, 0.5 + alpha / (2.0 * dt), &r);
-        let b = c.mul(&vec![-500.0; nodes]);
+        let (c, b) = rigid_flight();
+        let nodes = c.dim();
         let ends = [0, nodes - 1];
         let (mut z, mut reactions) = (vec![0.0; nodes], [0.0; 2]);
         let mut solver = ExactSolver::new(&c, &ends).unwrap();
