@@ -32,6 +32,33 @@ use crate::solver::{SolveInfo, SolverReport, StepSolver};
 use crate::tridiag::{Interior, Ldlt, SymTridiag, Uniform, dot};
 use std::time::Instant;
 
+/// Calls `$body` with `$load` as a `const bool` and the interior coefficients of `M` and `R`
+/// as numbers (uniform mesh) or as rows: the four monomorphised kernels of a step.
+macro_rules! monomorphise {
+    ($load:expr, $uniform:expr, $mass:expr, $stiffness:expr, |$l:ident, $k:ident| $body:expr) => {
+        match ($load, $uniform) {
+            (true, Some($k)) => {
+                const $l: bool = true;
+                $body
+            }
+            (false, Some($k)) => {
+                const $l: bool = false;
+                $body
+            }
+            (true, None) => {
+                const $l: bool = true;
+                let $k = ($mass.rows(), $stiffness.rows());
+                $body
+            }
+            (false, None) => {
+                const $l: bool = false;
+                let $k = ($mass.rows(), $stiffness.rows());
+                $body
+            }
+        }
+    };
+}
+
 /// A constrained node: `u[node] >= -gap`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Constraint {
@@ -555,36 +582,10 @@ impl Simulation {
         let (inv_dt2, c_w) = (self.inv_dt2, self.c_w);
         let (mass, stiffness) = (&self.disc.mass, &self.disc.stiffness);
         let (u, w, force) = (&self.u[..], &self.w[..], &self.force[..]);
-        match (has_load, self.uniform) {
-            (true, Some(k)) => {
-                rhs_into::<true, _>(mass, stiffness, k, c_w, inv_dt2, u, w, force, &mut self.rhs)
-            }
-            (false, Some(k)) => {
-                rhs_into::<false, _>(mass, stiffness, k, c_w, inv_dt2, u, w, force, &mut self.rhs)
-            }
-            (true, None) => rhs_into::<true, _>(
-                mass,
-                stiffness,
-                (mass.rows(), stiffness.rows()),
-                c_w,
-                inv_dt2,
-                u,
-                w,
-                force,
-                &mut self.rhs,
-            ),
-            (false, None) => rhs_into::<false, _>(
-                mass,
-                stiffness,
-                (mass.rows(), stiffness.rows()),
-                c_w,
-                inv_dt2,
-                u,
-                w,
-                force,
-                &mut self.rhs,
-            ),
-        }
+        let rhs = &mut self.rhs;
+        monomorphise!(has_load, self.uniform, mass, stiffness, |LOAD, k| {
+            rhs_into::<LOAD, _>(mass, stiffness, k, c_w, inv_dt2, u, w, force, rhs)
+        });
         let clock = clock.lap(&mut self.timing.rhs_ns);
         for (j, c) in self.disc.constraints.iter().enumerate() {
             self.lower[j] = -c.gap - self.u[self.locals[j]];
@@ -629,16 +630,9 @@ impl Simulation {
     fn measure_into(&mut self, record: &mut StepRecord, has_load: bool) -> Result<(), RunError> {
         let (mass, stiffness) = (&self.disc.mass, &self.disc.stiffness);
         let (u, z, w, f) = (&self.u[..], &self.z[..], &self.w[..], &self.force[..]);
-        let sums = match (has_load, self.uniform) {
-            (true, Some(k)) => measure::<true, _>(mass, stiffness, k, u, z, w, f),
-            (false, Some(k)) => measure::<false, _>(mass, stiffness, k, u, z, w, f),
-            (true, None) => {
-                measure::<true, _>(mass, stiffness, (mass.rows(), stiffness.rows()), u, z, w, f)
-            }
-            (false, None) => {
-                measure::<false, _>(mass, stiffness, (mass.rows(), stiffness.rows()), u, z, w, f)
-            }
-        };
+        let sums = monomorphise!(has_load, self.uniform, mass, stiffness, |LOAD, k| {
+            measure::<LOAD, _>(mass, stiffness, k, u, z, w, f)
+        });
         let dt = self.disc.dt;
         let energy = 0.5 * sums.kinetic * self.inv_dt2 + 0.25 * (sums.potential + self.potential);
         // The viscous sum is computed regardless; it only counts when α > 0.
