@@ -4,6 +4,8 @@
 //! matrix-vector product, quadratic forms and a factorisation computed once per run and reused
 //! for every step.
 
+use std::sync::Arc;
+
 /// A symmetric tridiagonal matrix: `diag[i] = A[i][i]`, `off[i] = A[i][i+1] = A[i+1][i]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SymTridiag {
@@ -253,8 +255,6 @@ impl SymTridiag {
 pub fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
 }
-
-use std::sync::Arc;
 
 /// A twisted factorisation of a symmetric positive definite tridiagonal matrix ("burn at both
 /// ends"): `L D Lᵀ` from the top for rows `0..m`, `U D Uᵀ` from the bottom for rows `m+1..n`,
