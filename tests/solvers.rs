@@ -183,7 +183,10 @@ fn check_solver(method: Method) {
                     "{name}: penetration {penetration:e}, ε r_max {:e}",
                     PENALTY_DEFAULT_EPSILON * max_reaction
                 );
-                let episodes = summary.contact_intervals.values().map(Vec::len).max();
+                // Episodes of the exact run: the penalty run's own count could grow with brief
+                // spurious contacts and loosen its own bound.
+                let (_, exact_summary, _) = run_in_memory(name, &exact).unwrap();
+                let episodes = exact_summary.contact_intervals.values().map(Vec::len).max();
                 let episodes = episodes.unwrap_or(0).max(1) as f64;
                 assert!(
                     agreement.max_difference <= PENALTY_AGREEMENT_FACTOR * episodes * penetration,
