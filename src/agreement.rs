@@ -51,6 +51,17 @@ fn max_distance(a: &[f64], b: &[f64]) -> f64 {
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
 }
 
+/// The audit report of an OSQP or penalty run (both always audit).
+fn audit_of<'a>(
+    name: &str,
+    s: &'a crate::run::Summary,
+) -> Result<&'a crate::audit::AuditReport, RunError> {
+    s.audit.as_ref().ok_or_else(|| RunError::SolverSetup {
+        solver: s.solver.clone(),
+        reason: format!("{name}: the run kept no audit report"),
+    })
+}
+
 fn agreement_tables(md: &mut String) -> Result<(), RunError> {
     let _ = writeln!(
         md,
@@ -64,7 +75,7 @@ fn agreement_tables(md: &mut String) -> Result<(), RunError> {
         let osqp = load(name, &with_method("osqp", &[]))?;
         let c = compare(name, &exact, &osqp)?;
         let s = &c.summary;
-        let Some(a) = s.audit.as_ref() else { continue };
+        let a = audit_of(name, s)?;
         let _ = writeln!(
             md,
             "| {name} | {} | {:.2e} | {:.3} | {:.1e} | {:.1} / {} | {:.1e} / {:.1e} / {:.1e} |",
@@ -94,7 +105,7 @@ fn agreement_tables(md: &mut String) -> Result<(), RunError> {
         let pen = load(name, &with_method("penalty", &[]))?;
         let c = compare(name, &exact, &pen)?;
         let s = &c.summary;
-        let Some(a) = s.audit.as_ref() else { continue };
+        let a = audit_of(name, s)?;
         let ratio = if s.max_violation > 0.0 {
             format!("{:.2}", c.agreement.max_difference / s.max_violation)
         } else {

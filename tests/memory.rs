@@ -55,11 +55,10 @@ fn peak_heap(scene: &viscobar::Scene, steps: usize) -> usize {
     PEAK.with(Cell::get) - base
 }
 
-/// Peak heap per node of each scene, in doubles: what the run holds (measured 27.0, 36.2 and
-/// 19.0 doubles a node) plus one. Tighter than `BYTES_PER_NODE` (64 doubles, the validator's
-/// conservative estimate) so that a buffer added back is noticed: before the full-mesh
-/// matrices, the initial data, the start-up temporaries and the exact solver's copies were
-/// dropped these runs held 39.0, 43.2 and 29.0.
+/// Peak heap per node of each scene, in doubles: what the run holds plus one (the test prints
+/// the measured figure: `cargo test --release --test memory -- --nocapture`). Tighter than `BYTES_PER_NODE` (64 doubles, the validator's
+/// conservative estimate) so that a buffer added back (a full-mesh matrix, the initial data,
+/// a start-up temporary, a copy of C) is noticed.
 const DOUBLES_PER_NODE: [(&str, usize); 3] =
     [("both-ends-forced", 28), ("distributed", 37), ("modal", 20)];
 
@@ -73,6 +72,10 @@ fn peak_heap_is_linear_in_nodes_and_independent_of_steps() {
         let bound = viscobar::scene::BYTES_PER_NODE as usize * nodes;
         assert!(long <= bound, "{name}: peak {long} B > {bound} B");
         let tight = doubles * 8 * nodes;
+        println!(
+            "{name}: peak heap {:.1} doubles a node",
+            long as f64 / (8 * nodes) as f64
+        );
         assert!(
             long <= tight,
             "{name}: peak {long} B > {doubles} doubles a node ({tight} B)"
