@@ -47,10 +47,22 @@ impl Modal {
     }
 }
 
+/// Step used to differentiate the modal amplitude for the energy: central differences,
+/// truncation ~h² and round-off ~1e-16/h, both below 1e-9 relative.
+const AMPLITUDE_DIFF_STEP: f64 = 1e-5;
+
 impl ClosedForm for Modal {
     fn displacement(&self, x: f64, t: f64) -> f64 {
         let w = self.k as f64 * std::f64::consts::PI / self.length;
         self.amplitude(t) * (w * x).cos()
+    }
+    /// `u = A cos(wx)`: `E = ¼ L (A'² + w² A²)`.
+    fn energy(&self, t: f64) -> Option<f64> {
+        let w = self.k as f64 * std::f64::consts::PI / self.length;
+        let h = AMPLITUDE_DIFF_STEP;
+        let da = (self.amplitude(t + h) - self.amplitude(t - h)) / (2.0 * h);
+        let a = self.amplitude(t);
+        Some(0.25 * self.length * (da * da + w * w * a * a))
     }
 }
 
@@ -77,6 +89,10 @@ impl ClosedForm for Impact {
     fn displacement(&self, x: f64, t: f64) -> f64 {
         let (v0, t1, l) = (self.speed, self.contact_start(), self.length);
         (-v0 * t.min(t1 + x)).max(v0 * (t - 2.0 * t1 - 2.0 * l))
+    }
+    /// Elastic, and the obstacle does no work (`u(0)` is fixed while in contact): `½ v0² L`.
+    fn energy(&self, _t: f64) -> Option<f64> {
+        Some(0.5 * self.speed * self.speed * self.length)
     }
     fn contact_intervals(&self, t_end: f64) -> Option<Vec<[f64; 2]>> {
         Some(clip(&[[self.contact_start(), self.contact_end()]], t_end))
@@ -273,6 +289,10 @@ impl ClosedForm for ClampedImpact {
         } else {
             s.min(1.0 - x) / 2.0
         }
+    }
+    /// Released at rest from `(1 − x)/2`: `½ ∫ u_x² = 1/8`, conserved.
+    fn energy(&self, _t: f64) -> Option<f64> {
+        Some(0.125)
     }
 }
 

@@ -7,7 +7,7 @@
 //! files do not depend on the scheduling. Wall times do: they are the only non-deterministic
 //! column.
 
-use crate::closed_form::{self, ClosedForm, Impact, Modal};
+use crate::closed_form::{self, ClosedForm, Impact};
 use crate::error::RunError;
 use crate::run::{Tracker, write_atomically};
 use crate::scene::{Scene, SolverMethod, SolverSpec};
@@ -29,9 +29,6 @@ pub const DEFAULT_LEVELS: u32 = 4;
 pub const REFERENCE_EXTRA_LEVELS: u32 = 2;
 /// Most reference time samples kept (memory: nodes of the finest level × this × 8 bytes).
 pub const REFERENCE_MAX_SAMPLES: usize = 512;
-/// Step used to differentiate the modal amplitude for the exact energy: central differences,
-/// truncation ~h² and round-off ~1e-16/h, both below 1e-9 relative.
-const AMPLITUDE_DIFF_STEP: f64 = 1e-5;
 
 /// Why `viscobar converge` failed.
 #[derive(Debug, thiserror::Error)]
@@ -187,46 +184,6 @@ pub struct Row {
     pub wall_time_s: f64,
 }
 
-/// The exact energy of a closed form, where known.
-fn exact_energy(name: &str, scene: &Scene) -> Option<Box<dyn Fn(f64) -> f64>> {
-    let exact = closed_form::for_scene(name, scene)?;
-    drop(exact);
-    match name {
-        "modal" => {
-            let m = Modal {
-                length: scene.bar.length,
-                alpha: scene.bar.viscosity,
-                k: 2,
-            };
-            let w = m.k as f64 * std::f64::consts::PI / m.length;
-            // u = A cos(wx): E = ¼ L (A'² + w² A²).
-            Some(Box::new(move |t| {
-                let h = AMPLITUDE_DIFF_STEP;
-                let da = (m.amplitude(t + h) - m.amplitude(t - h)) / (2.0 * h);
-                let a = m.amplitude(t);
-                0.25 * m.length * (da * da + w * w * a * a)
-            }))
-        }
-        // Elastic, no work by the obstacle (u(0) is fixed while in contact): ½ v0² L.
-        "impact" => {
-            let v0 = impact_of(scene)?.speed;
-            let e = 0.5 * v0 * v0 * scene.bar.length;
-            Some(Box::new(move |_| e))
-        }
-        // Released at rest from (1 − x)/2: ½ ∫ u_x² = 1/8, conserved.
-        "clamped-impact" => Some(Box::new(|_| 0.125)),
-        // −g∫u: the total energy including gravity's potential is zero.
-        "falling-bar" => {
-            let fb = closed_form::for_scene(name, scene)?;
-            fb.energy(0.0)?;
-            Some(Box::new(move |t| {
-                fb.energy(t).expect("FallingBar has an energy")
-            }))
-        }
-        _ => None,
-    }
-}
-
 fn impact_of(scene: &Scene) -> Option<Impact> {
     let v = crate::expr::Expression::parse("initial.velocity", &scene.initial.velocity, false)
         .ok()?
@@ -268,10 +225,8 @@ fn measure(
         Reference::ClosedForm { name } => closed_form::for_scene(name, scene),
         Reference::Run(_) => None,
     };
-    let energy = match reference {
-        Reference::ClosedForm { name } => exact_energy(name, scene),
-        Reference::Run(_) => None,
-    };
+    // Compared only where the closed form states its energy.
+    let energy = closed.as_deref().filter(|c| c.energy(0.0).is_some());
     let mut sim = Simulation::new(scene)?;
     let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
     let nodes = sim.discretisation().nodes;
@@ -321,19 +276,17 @@ fn measure(
         let r = sim.step()?;
         wall += start.elapsed().as_secs_f64();
         tracker.observe(&r);
-        if let Some(f) = &energy {
-            // E^{n+1/2} lives at t_{n+1} − Δt/2.
-            en = en.max((r.energy - f(r.time - 0.5 * dt)).abs());
+        // E^{n+1/2} lives at t_{n+1} − Δt/2.
+        if let Some(exact) = energy.and_then(|c| c.energy(r.time - 0.5 * dt)) {
+            en = en.max((r.energy - exact).abs());
         }
         observe(&sim, n, &mut u, &mut e);
     }
-    let contact_time_error = match (
-        &closed,
-        closed
-            .as_ref()
-            .and_then(|c| c.contact_intervals(sim.time())),
-    ) {
-        (Some(_), Some(exact)) => {
+    let contact_time_error = match closed
+        .as_ref()
+        .and_then(|c| c.contact_intervals(sim.time()))
+    {
+        Some(exact) => {
             let summary = tracker.finish(scene_name, &sim, wall);
             let discrete = summary
                 .contact_intervals
