@@ -157,7 +157,9 @@ impl ExactSolver {
             if i + 1 < n {
                 cz += right * (z[i + 1] - z[i]);
             }
-            reactions[j] = (cz - rhs[i]).max(0.0);
+            // Round-off below zero clamped; a NaN kept, for the caller's finiteness check.
+            let rj = cz - rhs[i];
+            reactions[j] = if rj < 0.0 { 0.0 } else { rj };
         }
     }
 
@@ -241,24 +243,32 @@ impl StepSolver for ExactSolver {
         for (j, rj) in reactions[..k].iter_mut().enumerate() {
             *rj = if mask & (1 << j) != 0 { r[j] } else { 0.0 };
         }
-        let fused = k == 2
-            && reactions[0] != 0.0
-            && reactions[1] != 0.0
-            && self.columns[0].support == self.columns[1].support;
-        if fused {
+        let both = k == 2 && reactions[0] != 0.0 && reactions[1] != 0.0;
+        let (s0, s1) = (
+            &self.columns[0].support,
+            self.columns.get(1).map_or(0..0, |c| c.support.clone()),
+        );
+        let max_abs = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if both && *s0 == s1 {
             // Both columns over the same support (a stiff C): one pass, same bits as two.
             (before, after) =
                 self.columns[0].add_scaled_pair(reactions[0], &self.columns[1], reactions[1], z);
-        }
-        for (j, col) in self.columns.iter().enumerate() {
-            let active = mask & (1 << j) != 0;
-            if active && r[j] != 0.0 && !fused {
-                let (b, a) = col.add_scaled(r[j], z);
-                before = before.max(b);
-                // A second pass overwrites the first one's values where the supports overlap
-                // (everywhere for a stiff C): then only its own maximum is final.
-                let overlap = j > 0 && self.columns[0].support.end > col.support.start;
-                after = if overlap { a } else { after.max(a) };
+        } else if both && s0.start.max(s1.start) < s0.end.min(s1.end) {
+            // Partly overlapping supports: measure z⁰ and z over the union (rare: not the
+            // stiff case, whose supports are the whole bar, nor the short-column case).
+            let union = s0.start.min(s1.start)..s0.end.max(s1.end);
+            before = max_abs(&z[union.clone()]);
+            self.columns[0].add_scaled(reactions[0], z);
+            self.columns[1].add_scaled(reactions[1], z);
+            after = max_abs(&z[union]);
+        } else {
+            // Disjoint supports (or one active column): each pass sees z⁰ and final values.
+            for (j, col) in self.columns.iter().enumerate() {
+                if reactions[j] != 0.0 {
+                    let (b, a) = col.add_scaled(reactions[j], z);
+                    before = before.max(b);
+                    after = after.max(a);
+                }
             }
         }
         for (j, col) in self.columns.iter().enumerate() {
@@ -269,6 +279,9 @@ impl StepSolver for ExactSolver {
         if before > RESOLVE_CANCELLATION * after.max(self.state_scale) {
             self.resolved += 1;
             self.solve_on_active_set(mask, rhs, lower, z, reactions);
+            if !z.iter().all(|v| v.is_finite()) {
+                return Err(StepFailure::NonFinite);
+            }
         }
         if !reactions[..k].iter().all(|v| v.is_finite()) {
             return Err(StepFailure::NonFinite);
