@@ -70,7 +70,7 @@ fn settle_and_bench(
 
 fn bench_step(c: &mut Criterion) {
     let mut group = c.benchmark_group("step");
-    for elements in [100u64, 1_000, 10_000, 100_000] {
+    for elements in [100u64, 1_000, 10_000, 100_000, 1_000_000] {
         group.throughput(Throughput::Elements(elements + 1));
         let bare = ["output.diagnostics_every=1000000000"];
         settle_and_bench(

@@ -5,6 +5,10 @@
 //! `cargo bench --bench step` and `cargo bench --bench scenes`:
 //!
 //!     cargo run --release --example bench_table
+//!
+//! A measurement more than [`STALE_AFTER_S`] older than the newest one of its group is
+//! marked `(stale)` and left out of the targets: criterion keeps the last result of every
+//! bench ever run, so a partial run would otherwise mix in rows measured on older code.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -14,14 +18,39 @@ const BARE_NS_PER_NODE_TARGET: f64 = 2.0;
 const DIAGNOSTICS_OVERHEAD_TARGET: f64 = 0.5;
 const EXACT_RATIO_TARGET: f64 = 1.15;
 
-fn median_ns(path: &Path) -> Option<f64> {
+/// Rows measured this long before the newest row of their group are stale.
+const STALE_AFTER_S: u64 = 3600;
+
+/// Median and modification time (s since the epoch) of an `estimates.json`.
+fn median_ns(path: &Path) -> Option<(f64, u64)> {
     let text = std::fs::read_to_string(path).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
-    v["median"]["point_estimate"].as_f64()
+    let modified = std::fs::metadata(path).ok()?.modified().ok()?;
+    let age = modified
+        .duration_since(std::time::UNIX_EPOCH)
+        .ok()?
+        .as_secs();
+    Some((v["median"]["point_estimate"].as_f64()?, age))
 }
 
-/// `(size, label) -> median ns` of a group laid out as `group/label/size/new`.
-fn step_rows(root: &Path) -> BTreeMap<(u64, String), f64> {
+/// Drops the modification times, keeping rows measured within [`STALE_AFTER_S`] of the
+/// newest; returns the fresh rows and the names of the stale ones.
+fn fresh<K: Ord + Clone>(rows: BTreeMap<K, (f64, u64)>) -> (BTreeMap<K, f64>, Vec<K>) {
+    let newest = rows.values().map(|r| r.1).max().unwrap_or(0);
+    let mut stale = Vec::new();
+    let mut kept = BTreeMap::new();
+    for (k, (t, at)) in rows {
+        if at + STALE_AFTER_S < newest {
+            stale.push(k);
+        } else {
+            kept.insert(k, t);
+        }
+    }
+    (kept, stale)
+}
+
+/// `(size, label) -> (median ns, time)` of a group laid out as `group/label/size/new`.
+fn step_rows(root: &Path) -> BTreeMap<(u64, String), (f64, u64)> {
     let mut rows = BTreeMap::new();
     for label in std::fs::read_dir(root).into_iter().flatten().flatten() {
         let name = label.file_name().to_string_lossy().into_owned();
@@ -47,7 +76,7 @@ fn verdict(ok: bool) -> &'static str {
 
 fn main() {
     let target = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/criterion");
-    let rows = step_rows(&target.join("step"));
+    let (rows, stale) = fresh(step_rows(&target.join("step")));
     if rows.is_empty() {
         eprintln!("no measurements in target/criterion/step: run `cargo bench --bench step` first");
         std::process::exit(1);
@@ -64,15 +93,18 @@ fn main() {
             t / base
         );
     }
+    for (j, name) in &stale {
+        println!("| {j} | {name} (stale) | | | |");
+    }
     let scenes = target.join("scenes");
-    let mut scene_rows = Vec::new();
+    let mut all_scenes = BTreeMap::new();
     for entry in std::fs::read_dir(&scenes).into_iter().flatten().flatten() {
         let name = entry.file_name().to_string_lossy().into_owned();
         if let Some(t) = median_ns(&entry.path().join("new/estimates.json")) {
-            scene_rows.push((name, t));
+            all_scenes.insert(name, t);
         }
     }
-    scene_rows.sort_by(|a, b| a.0.cmp(&b.0));
+    let (scene_rows, _) = fresh(all_scenes);
     if !scene_rows.is_empty() {
         println!();
         println!("| scene (default size, end to end) | median per run | ns per node-step |");

@@ -55,9 +55,9 @@ fn main() {
     );
     let s = summary.time_shares;
     println!(
-        "time shares of the steps: solver {:.2}, rhs {:.2}, update {:.2}, diagnostics {:.2} \
+        "time shares of the steps: solver {:.2}, rhs {:.2}, diagnostics {:.2} \
          ({} sampled steps; stepping {:.2} of the wall time)",
-        s.solver, s.rhs, s.update, s.diagnostics, s.sampled_steps, s.stepping
+        s.solver, s.rhs, s.diagnostics, s.sampled_steps, s.stepping
     );
     println!(
         "peak RSS (VmHWM) {:.1} MB (before the run {:.1} MB); target 200 MB: {}",

@@ -22,7 +22,7 @@
 //! factorised once per run.
 
 use crate::solver::{SolveInfo, StepFailure, StepSolver};
-use crate::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
+use crate::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag, add_in_place, max4};
 
 /// Largest cancellation `max|z⁰| / max(|z|, |u^n|)` over the columns' support accepted from
 /// the superposition `z⁰ + Σ r_j c_j`: its rounding error is about `ε max|z⁰|`, i.e. this many
@@ -44,6 +44,8 @@ pub(crate) struct Column {
     /// Entries outside `support` are below `f64::MIN_POSITIVE` in magnitude and are dropped:
     /// adding `r · c` with such `c` cannot change a displacement that is not itself subnormal.
     support: std::ops::Range<usize>,
+    /// `max_i |c_i|`.
+    max_abs: f64,
 }
 
 /// Exact enumeration for zero, one or two constrained nodes.
@@ -61,6 +63,8 @@ pub struct ExactSolver {
     reduced: Vec<Ldlt>,
     /// Steps recomputed by the direct solve (cancellation beyond [`RESOLVE_CANCELLATION`]).
     resolved: u64,
+    /// Steps whose superposition and `u += z` were one pass ([`ExactSolver::superpose_and_add`]).
+    merged: u64,
     /// `max|u^n|` of the state `z` is added to ([`StepSolver::set_state_scale`]; 0 if not given).
     state_scale: f64,
 }
@@ -101,6 +105,7 @@ impl ExactSolver {
             rows,
             reduced,
             resolved: 0,
+            merged: 0,
             state_scale: 0.0,
         })
     }
@@ -109,6 +114,12 @@ impl ExactSolver {
     /// recomputed by the direct solve.
     pub fn resolved_steps(&self) -> u64 {
         self.resolved
+    }
+
+    /// Steps so far whose superposition and `u += z` were one pass (through
+    /// [`StepSolver::solve_and_advance`]).
+    pub fn merged_steps(&self) -> u64 {
+        self.merged
     }
 
     /// The direct solve on active set `mask`: `z_A = lo_A`, `C_FF z_F = b_F − C_FA lo_A`,
@@ -213,11 +224,79 @@ impl StepSolver for ExactSolver {
     ) -> Result<SolveInfo, StepFailure> {
         z.copy_from_slice(rhs);
         self.factor.solve_in_place(z);
-        let k = self.columns.len();
-        if k == 0 {
+        if self.columns.is_empty() {
             // Non-finite values anywhere are caught by the stepper's energy check.
             return Ok(SolveInfo { iterations: 1 });
         }
+        let (tried, mask) = self.enumerate(lower, z, reactions)?;
+        if self.superpose(mask, lower, z, reactions)? {
+            self.resolve(mask, rhs, lower, z, reactions)?;
+        }
+        Ok(SolveInfo { iterations: tried })
+    }
+
+    /// As [`StepSolver::solve`] then `u += z`, with the same bits, but when the cancellation
+    /// test cannot fire (see [`ExactSolver::superpose_and_add`]) the superposition and the
+    /// addition are one pass over the bar instead of two.
+    fn solve_and_advance(
+        &mut self,
+        rhs: &[f64],
+        lower: &[f64],
+        u: &mut [f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<(SolveInfo, f64), StepFailure> {
+        z.copy_from_slice(rhs);
+        self.factor.solve_in_place(z);
+        if self.columns.is_empty() {
+            return Ok((SolveInfo { iterations: 1 }, add_in_place(u, z)));
+        }
+        let (tried, mask) = self.enumerate(lower, z, reactions)?;
+        let info = SolveInfo { iterations: tried };
+        if let Some(max_abs) = self.superpose_and_add(mask, lower, u, z, reactions) {
+            self.merged += 1;
+            return Ok((info, max_abs));
+        }
+        if self.superpose(mask, lower, z, reactions)? {
+            self.resolve(mask, rhs, lower, z, reactions)?;
+        }
+        Ok((info, add_in_place(u, z)))
+    }
+}
+
+impl ExactSolver {
+    /// The direct solve of a step whose superposition cancelled (counted).
+    fn resolve(
+        &mut self,
+        mask: u8,
+        rhs: &[f64],
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<(), StepFailure> {
+        self.resolved += 1;
+        self.solve_on_active_set(mask, rhs, lower, z, reactions);
+        if !z.iter().all(|v| v.is_finite()) {
+            return Err(StepFailure::NonFinite);
+        }
+        if !reactions[..self.columns.len()]
+            .iter()
+            .all(|v| v.is_finite())
+        {
+            return Err(StepFailure::NonFinite);
+        }
+        Ok(())
+    }
+
+    /// Given `z = z⁰`: the active set by enumeration (bit `j` of the mask: node `j` active)
+    /// and its reactions; returns the number of sets tried and the mask.
+    fn enumerate(
+        &self,
+        lower: &[f64],
+        z: &[f64],
+        reactions: &mut [f64],
+    ) -> Result<(u32, u8), StepFailure> {
+        let k = self.columns.len();
         let mut z0 = [0.0; 2];
         for (j, col) in self.columns.iter().enumerate() {
             z0[j] = z[col.node];
@@ -238,11 +317,27 @@ impl StepSolver for ExactSolver {
             }
         }
         let (mask, r, _) = best;
-        // max|z⁰| before and max|z| after the superposition, over the columns' support.
-        let (mut before, mut after) = (0.0f64, 0.0f64);
         for (j, rj) in reactions[..k].iter_mut().enumerate() {
             *rj = if mask & (1 << j) != 0 { r[j] } else { 0.0 };
         }
+        if !reactions[..k].iter().all(|v| v.is_finite()) {
+            return Err(StepFailure::NonFinite);
+        }
+        Ok((tried, mask))
+    }
+
+    /// `z = z⁰ + Σ r_j c_j`, `z_j = lo_j` on the active set; returns whether the superposition
+    /// cancelled beyond [`RESOLVE_CANCELLATION`] (then the step must be solved directly).
+    fn superpose(
+        &self,
+        mask: u8,
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &[f64],
+    ) -> Result<bool, StepFailure> {
+        let k = self.columns.len();
+        // max|z⁰| before and max|z| after the superposition, over the columns' support.
+        let (mut before, mut after) = (0.0f64, 0.0f64);
         let both = k == 2 && reactions[0] != 0.0 && reactions[1] != 0.0;
         let (s0, s1) = (
             &self.columns[0].support,
@@ -276,18 +371,134 @@ impl StepSolver for ExactSolver {
                 z[col.node] = lower[j];
             }
         }
-        if before > RESOLVE_CANCELLATION * after.max(self.state_scale) {
-            self.resolved += 1;
-            self.solve_on_active_set(mask, rhs, lower, z, reactions);
-            if !z.iter().all(|v| v.is_finite()) {
-                return Err(StepFailure::NonFinite);
+        Ok(before > RESOLVE_CANCELLATION * after.max(self.state_scale))
+    }
+
+    /// The superposition and `u += z` in one pass over the bar, when the cancellation test
+    /// cannot fire and the active nodes are end nodes (left out of the pass and set to
+    /// `lo_j` after). The test measures `max|z⁰| > 8 max(max|z|, s)` with `s = max|u^n|`;
+    /// since `|z⁰_i| <= |z_i| + Σ|r_j| max|c_j|` (up to a few ulps), a bound
+    /// `Σ|r_j| max|c_j| <= 6 s` rules it out, and the maxima it would track are skipped.
+    /// The bar is cut where the columns' supports start and end, and each piece adds the
+    /// columns it meets: the same arithmetic, so the same bits, as
+    /// [`ExactSolver::superpose`] followed by [`add_in_place`]. Returns `max|u^{n+1}|`, or
+    /// `None` (nothing done) when the conditions do not hold.
+    fn superpose_and_add(
+        &self,
+        mask: u8,
+        lower: &[f64],
+        u: &mut [f64],
+        z: &mut [f64],
+        reactions: &[f64],
+    ) -> Option<f64> {
+        let n = z.len();
+        let bound: f64 = (self.columns.iter().zip(reactions))
+            .map(|(col, r)| r.abs() * col.max_abs)
+            .sum();
+        // Negated so that a NaN bound takes the checked path.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        if !(bound <= (RESOLVE_CANCELLATION - 2.0) * self.state_scale) {
+            return None;
+        }
+        let active = |j: usize| mask & (1 << j) != 0;
+        let (mut first, mut end) = (0, n);
+        for (j, col) in self.columns.iter().enumerate() {
+            match col.node {
+                _ if !active(j) => {}
+                0 => first = 1,
+                node if node + 1 == n => end = n - 1,
+                _ => return None,
             }
         }
-        if !reactions[..k].iter().all(|v| v.is_finite()) {
-            return Err(StepFailure::NonFinite);
+        let first = first.min(end);
+        // Pieces of constant column set between consecutive cuts.
+        let mut cuts = [first, end, first, end, first, end];
+        for (k, col) in self.columns.iter().enumerate() {
+            let clamp = |i: usize| i.clamp(first, end);
+            cuts[2 + 2 * k] = clamp(col.support.start);
+            cuts[3 + 2 * k] = clamp(col.support.end);
         }
-        Ok(SolveInfo { iterations: tried })
+        cuts.sort_unstable();
+        let mut max_abs = 0.0f64;
+        for (a, b) in cuts.iter().zip(&cuts[1..]).map(|(&a, &b)| (a, b)) {
+            if a == b {
+                continue;
+            }
+            let mut terms = (self.columns.iter().zip(reactions))
+                .filter(|(col, r)| **r != 0.0 && col.support.contains(&a))
+                .map(|(col, &r)| {
+                    let s = col.support.start;
+                    (r, &col.values[a - s..b - s])
+                });
+            let (u, z) = (&mut u[a..b], &mut z[a..b]);
+            let m = match (terms.next(), terms.next()) {
+                (None, _) => add_in_place(u, z),
+                (Some((r, c)), None) => add_column(u, z, r, c),
+                (Some((r, c)), Some((r2, c2))) => add_pair(u, z, r, c, r2, c2),
+            };
+            max_abs = max_abs.max(m);
+        }
+        for (j, col) in self.columns.iter().enumerate() {
+            if active(j) {
+                z[col.node] = lower[j];
+                u[col.node] += lower[j];
+                max_abs = max_abs.max(u[col.node].abs());
+            }
+        }
+        Some(max_abs)
     }
+}
+
+/// `z += r a`, then `u += z`; returns `max|u|` (the bits of [`Column::add_scaled`] and
+/// [`add_in_place`]).
+fn add_column(u: &mut [f64], z: &mut [f64], r: f64, a: &[f64]) -> f64 {
+    let mut m = [0.0f64; 4];
+    let (mut uc, mut zc, mut ac) = (
+        u.chunks_exact_mut(4),
+        z.chunks_exact_mut(4),
+        a.chunks_exact(4),
+    );
+    for ((u4, z4), a4) in (&mut uc).zip(&mut zc).zip(&mut ac) {
+        for k in 0..4 {
+            z4[k] += r * a4[k];
+            u4[k] += z4[k];
+            m[k] = m[k].max(u4[k].abs());
+        }
+    }
+    let rest = uc
+        .into_remainder()
+        .iter_mut()
+        .zip(zc.into_remainder())
+        .zip(ac.remainder());
+    for ((ui, zi), ai) in rest {
+        *zi += r * ai;
+        *ui += *zi;
+        m[0] = m[0].max(ui.abs());
+    }
+    max4(m)
+}
+
+/// `z = (z + r a) + r2 b`, then `u += z`; returns `max|u|` (the bits of
+/// [`Column::add_scaled_pair`] and [`add_in_place`]).
+fn add_pair(u: &mut [f64], z: &mut [f64], r: f64, a: &[f64], r2: f64, b: &[f64]) -> f64 {
+    let mut m = [0.0f64; 4];
+    let (mut uc, mut zc) = (u.chunks_exact_mut(4), z.chunks_exact_mut(4));
+    let (mut ac, mut bc) = (a.chunks_exact(4), b.chunks_exact(4));
+    for (((u4, z4), a4), b4) in (&mut uc).zip(&mut zc).zip(&mut ac).zip(&mut bc) {
+        for k in 0..4 {
+            z4[k] = (z4[k] + r * a4[k]) + r2 * b4[k];
+            u4[k] += z4[k];
+            m[k] = m[k].max(u4[k].abs());
+        }
+    }
+    let rest = (uc.into_remainder().iter_mut().zip(zc.into_remainder()))
+        .zip(ac.remainder().iter().zip(bc.remainder()));
+    for ((ui, zi), (ai, bi)) in rest {
+        *zi = (*zi + r * ai) + r2 * bi;
+        *ui += *zi;
+        m[0] = m[0].max(ui.abs());
+    }
+    max4(m)
 }
 
 /// `C⁻¹ e_j` for each node, computed with `factor` (set-up only).
@@ -305,6 +516,7 @@ pub(crate) fn inverse_columns(factor: &Ldlt, nodes: &[usize]) -> Vec<Column> {
             let end = values.iter().rposition(|v| *v != 0.0).map_or(0, |e| e + 1);
             Column {
                 node,
+                max_abs: values.iter().fold(0.0f64, |m, v| m.max(v.abs())),
                 values: values.get(start..end).unwrap_or_default().to_vec(),
                 support: start..end,
             }
@@ -397,11 +609,6 @@ impl Column {
     }
 }
 
-/// The largest of four running maxima.
-fn max4(m: [f64; 4]) -> f64 {
-    m[0].max(m[1]).max(m[2].max(m[3]))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -452,6 +659,77 @@ mod tests {
         let tol = 64.0 * f64::EPSILON * z_max;
         for (a, p) in z.iter().zip(&z_pivot) {
             assert!((a - p).abs() <= tol, "{a:e} vs {p:e}");
+        }
+    }
+
+    /// `solve_and_advance` against `solve` then `u += z` (the two-pass path it replaces),
+    /// bit for bit, with one and with two bounds active, in a state large enough that the
+    /// cancellation test cannot fire (one merged pass): on the stiff bar (both columns span
+    /// the bar), a mild bar of 600 elements (the supports, about 450 nodes each, overlap in
+    /// part) and of 2000 elements (disjoint supports); and once with a small state, where
+    /// the two passes must remain.
+    #[test]
+    fn merged_superposition_and_update_has_the_bits_of_the_two_passes() {
+        let (stiff, b_stiff) = rigid_flight();
+        // Columns decay by about 5 a node here: below f64::MIN_POSITIVE after ~450 nodes.
+        let mild = |elements: usize| {
+            let dx = 1.0 / elements as f64;
+            let c = SymTridiag::combine(
+                1.0 / (dx * dx),
+                &mass(MatrixVariant::Consistent, elements + 1, dx),
+                0.5,
+                &stiffness(MatrixVariant::Consistent, elements + 1, dx),
+            );
+            let b = c.mul(&vec![-0.01; elements + 1]);
+            (c, b)
+        };
+        let ((overlap, b_overlap), (disjoint, b_disjoint)) = (mild(600), mild(2000));
+        let (large, small) = (1e6, 1e-3);
+        let cases = [
+            (&stiff, &b_stiff, [0.0, 0.0], large, 1),
+            (&stiff, &b_stiff, [0.0, -1e9], large, 1),
+            (&stiff, &b_stiff, [0.0, 0.0], small, 0),
+            (&overlap, &b_overlap, [0.0, 0.0], large, 1),
+            (&overlap, &b_overlap, [-1e9, 0.0], large, 1),
+            (&disjoint, &b_disjoint, [0.0, 0.0], large, 1),
+        ];
+        for (c, b, lower, state, merged) in cases {
+            let nodes = c.dim();
+            let ends = [0, nodes - 1];
+            let u0: Vec<f64> = (0..nodes).map(|i| state * (1.0 + i as f64)).collect();
+            let scale = u0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let mut two_pass = ExactSolver::new(c, &ends).unwrap();
+            two_pass.set_state_scale(scale);
+            let (s0, s1) = (&two_pass.columns[0].support, &two_pass.columns[1].support);
+            let shape = if s0 == s1 {
+                "same"
+            } else if s0.end > s1.start {
+                "overlap"
+            } else {
+                "disjoint"
+            };
+            let expected = match nodes {
+                601 => "overlap",
+                2001 => "disjoint",
+                _ => "same",
+            };
+            assert_eq!(shape, expected, "supports {s0:?}, {s1:?}");
+            let (mut z1, mut r1, mut u1) = (vec![0.0; nodes], [0.0; 2], u0.clone());
+            two_pass.solve(b, &lower, &mut z1, &mut r1).unwrap();
+            let m1 = add_in_place(&mut u1, &z1);
+            let mut one_pass = ExactSolver::new(c, &ends).unwrap();
+            one_pass.set_state_scale(scale);
+            let (mut z2, mut r2, mut u2) = (vec![0.0; nodes], [0.0; 2], u0.clone());
+            let (_, m2) = one_pass
+                .solve_and_advance(b, &lower, &mut u2, &mut z2, &mut r2)
+                .unwrap();
+            assert_eq!(one_pass.merged_steps(), merged, "lower {lower:?}");
+            assert!(r2.iter().any(|r| *r > 0.0), "a bound is active");
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&z1), bits(&z2));
+            assert_eq!(bits(&u1), bits(&u2));
+            assert_eq!(bits(&r1), bits(&r2));
+            assert_eq!(m1.to_bits(), m2.to_bits());
         }
     }
 

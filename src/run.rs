@@ -56,14 +56,13 @@ pub struct Summary {
 /// Where the time of the steps goes, as fractions of the timed phases of the sampled steps
 /// (one in [`crate::simulation::TIMING_SAMPLE_EVERY`], see [`crate::simulation::PhaseTimes`]):
 /// `rhs` (load and right-hand side), `solver` (the step solver, including its copy of the
-/// right-hand side), `update` (`u += z`), `diagnostics` (energy balance and contact state).
+/// right-hand side, and `u += z`), `diagnostics` (energy balance and contact state).
 /// `stepping` is the sampled phases' share of the wall time (the rest is set-up, start-up and
 /// writing the outputs), extrapolated from the sample.
 #[derive(Clone, Copy, Debug, Default, Serialize)]
 pub struct TimeShares {
     pub solver: f64,
     pub rhs: f64,
-    pub update: f64,
     pub diagnostics: f64,
     pub stepping: f64,
     pub sampled_steps: u64,
@@ -79,7 +78,6 @@ impl TimeShares {
         Self {
             solver: share(p.solve_ns),
             rhs: share(p.rhs_ns),
-            update: share(p.update_ns),
             diagnostics: share(p.diagnostics_ns),
             stepping: if wall_time_s > 0.0 {
                 per_step * steps / (wall_time_s * 1e9)

@@ -28,8 +28,8 @@ use crate::matrices;
 use crate::osqp_solver::{OsqpSettings, OsqpSolver};
 use crate::penalty::PenaltySolver;
 use crate::scene::{Condition, PENALTY_DEFAULT_EPSILON, Scene, Side, SolverMethod};
-use crate::solver::{SolveInfo, SolverReport, StepSolver};
-use crate::tridiag::{Interior, Ldlt, SymTridiag, Uniform, dot};
+use crate::solver::{SolverReport, StepSolver};
+use crate::tridiag::{Interior, Ldlt, SymTridiag, Uniform, add_in_place, dot};
 use std::time::Instant;
 
 /// Calls `$body` with `$load` as a `const bool` and the interior coefficients of `M` and `R`
@@ -212,21 +212,21 @@ pub fn make_solver(scene: &Scene, disc: &Discretisation) -> Result<Box<dyn StepS
     }
 }
 
-/// The clock is read in one step out of this many (timer reads cost ~25 ns each, five a
+/// The clock is read in one step out of this many (timer reads cost ~25 ns each, four a
 /// step: sampling keeps that below 1 % of a 100-node step).
 pub const TIMING_SAMPLE_EVERY: usize = 32;
 
 /// Wall time per phase of [`Simulation::step`], summed over the sampled steps (one in
 /// [`TIMING_SAMPLE_EVERY`], starting with the first): `rhs` (load vector and right-hand
-/// side), `solve` (bounds and the step solver), `update` (`u += z`, and on a measured step
-/// after an unmeasured one the recomputation of `E^{n−1/2}`), `diagnostics` (the energy
-/// balance pass, contact state, record). Shares of a run are ratios of these sums.
+/// side), `solve` (bounds, on a measured step after an unmeasured one the recomputation of
+/// `E^{n−1/2}`, the step solver and `u += z`, which the exact end solver merges with its own
+/// last pass), `diagnostics` (the energy balance pass, contact state, record). Shares of a
+/// run are ratios of these sums.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct PhaseTimes {
     pub sampled_steps: u64,
     pub rhs_ns: u64,
     pub solve_ns: u64,
-    pub update_ns: u64,
     pub diagnostics_ns: u64,
 }
 
@@ -238,9 +238,9 @@ impl PhaseTimes {
         sampled
     }
 
-    /// The sum of the four phases.
+    /// The sum of the three phases.
     pub fn total_ns(&self) -> u64 {
-        self.rhs_ns + self.solve_ns + self.update_ns + self.diagnostics_ns
+        self.rhs_ns + self.solve_ns + self.diagnostics_ns
     }
 }
 
@@ -502,7 +502,7 @@ impl Simulation {
                 failure,
             })?;
         let potential0 = self.disc.stiffness.quad(&self.u);
-        self.u_scale = advance(&mut self.u, &self.z);
+        self.u_scale = add_in_place(&mut self.u, &self.z);
         let mz = &mut self.rhs;
         self.disc.mass.mul_into(&self.z, mz);
         self.potential = self.disc.stiffness.quad(&self.u);
@@ -590,22 +590,27 @@ impl Simulation {
         for (j, c) in self.disc.constraints.iter().enumerate() {
             self.lower[j] = -c.gap - self.u[self.locals[j]];
         }
-        self.solver.set_state_scale(self.u_scale);
-        let info: SolveInfo = self
-            .solver
-            .solve(&self.rhs, &self.lower, &mut self.z, &mut self.reactions)
-            .map_err(|failure| self.failure(n + 1, failure))?;
-        let clock = clock.lap(&mut self.timing.solve_ns);
         let measure = (n + 1).is_multiple_of(self.diagnostics_every) || n + 1 == self.last_step;
         if measure && !self.measured {
-            // E^{n−1/2} from u^n and w (u^{n−1} = u^n − w).
+            // E^{n−1/2} from u^n and w (u^{n−1} = u^n − w), before u moves on.
             let (mass, stiffness) = (&self.disc.mass, &self.disc.stiffness);
             self.potential = stiffness.quad(&self.u);
             self.energy = 0.5 * mass.quad(&self.w) * inv_dt2
                 + 0.25 * (self.potential + potential_of_difference(stiffness, &self.u, &self.w));
         }
-        self.u_scale = advance(&mut self.u, &self.z);
-        let clock = clock.lap(&mut self.timing.update_ns);
+        self.solver.set_state_scale(self.u_scale);
+        let (info, u_scale) = self
+            .solver
+            .solve_and_advance(
+                &self.rhs,
+                &self.lower,
+                &mut self.u,
+                &mut self.z,
+                &mut self.reactions,
+            )
+            .map_err(|failure| self.failure(n + 1, failure))?;
+        self.u_scale = u_scale;
+        let clock = clock.lap(&mut self.timing.solve_ns);
         let dt = self.disc.dt;
         let mut record = StepRecord {
             step: n + 1,
@@ -899,25 +904,6 @@ fn rhs_into<const LOAD: bool, K: Interior>(
     for i in 1..n.saturating_sub(1) {
         rhs[i] = finish(i, inner_row_of(ri, y, i), inner_row_of(mi, wi, i));
     }
-}
-
-/// `u += z`, returning the new `max_i |u_i|` (four running maxima, so the loop vectorises;
-/// the maximum is exact, so the order does not change the bits).
-#[inline(never)]
-fn advance(u: &mut [f64], z: &[f64]) -> f64 {
-    let mut m = [0.0f64; 4];
-    let (mut uc, mut zc) = (u.chunks_exact_mut(4), z.chunks_exact(4));
-    for (u4, z4) in (&mut uc).zip(&mut zc) {
-        for k in 0..4 {
-            u4[k] += z4[k];
-            m[k] = m[k].max(u4[k].abs());
-        }
-    }
-    for (ui, zi) in uc.into_remainder().iter_mut().zip(zc.remainder()) {
-        *ui += zi;
-        m[0] = m[0].max(ui.abs());
-    }
-    m[0].max(m[1]).max(m[2].max(m[3]))
 }
 
 /// The sums of the energy balance of one step.

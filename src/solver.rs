@@ -66,6 +66,21 @@ pub trait StepSolver {
     /// (the exact end solver weighs its cancellation error against it). Default: ignored.
     fn set_state_scale(&mut self, _max_abs_u: f64) {}
 
+    /// [`StepSolver::solve`], then `u += z`; returns `max_i |u_i|` afterwards (the next
+    /// step's state scale). The default makes the two passes; the exact end solver merges its
+    /// superposition `z⁰ + Σ r_j c_j` with the addition when it may.
+    fn solve_and_advance(
+        &mut self,
+        rhs: &[f64],
+        lower: &[f64],
+        u: &mut [f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<(SolveInfo, f64), StepFailure> {
+        let info = self.solve(rhs, lower, z, reactions)?;
+        Ok((info, crate::tridiag::add_in_place(u, z)))
+    }
+
     /// Statistics over all solves so far; `None` for solvers that keep none.
     fn report(&self) -> Option<SolverReport> {
         None

@@ -251,6 +251,30 @@ impl SymTridiag {
     }
 }
 
+/// `u += z`, returning the new `max_i |u_i|` (four running maxima, so the loop vectorises;
+/// the maximum is exact, so the order does not change the bits).
+#[inline(never)]
+pub fn add_in_place(u: &mut [f64], z: &[f64]) -> f64 {
+    let mut m = [0.0f64; 4];
+    let (mut uc, mut zc) = (u.chunks_exact_mut(4), z.chunks_exact(4));
+    for (u4, z4) in (&mut uc).zip(&mut zc) {
+        for k in 0..4 {
+            u4[k] += z4[k];
+            m[k] = m[k].max(u4[k].abs());
+        }
+    }
+    for (ui, zi) in uc.into_remainder().iter_mut().zip(zc.remainder()) {
+        *ui += zi;
+        m[0] = m[0].max(ui.abs());
+    }
+    max4(m)
+}
+
+/// The largest of four running maxima.
+pub(crate) fn max4(m: [f64; 4]) -> f64 {
+    m[0].max(m[1]).max(m[2].max(m[3]))
+}
+
 /// `xᵀ y`.
 pub fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
