@@ -21,8 +21,12 @@ use crate::tridiag::SymTridiag;
 /// Number of eigenvalues of `a` strictly below `x` (Sturm count). A zero pivot is replaced by
 /// `−pivmin` (LAPACK `dlaebz`), the smallest perturbation that keeps the recurrence finite.
 pub fn count_below(a: &SymTridiag, x: f64) -> usize {
+    count_below_with(a, x, pivot_floor(a))
+}
+
+/// [`count_below`] with the pivot floor computed once by the caller (an O(n) pass of its own).
+fn count_below_with(a: &SymTridiag, x: f64, pivmin: f64) -> usize {
     let n = a.dim();
-    let pivmin = pivot_floor(a);
     let mut count = 0;
     let mut d = 1.0;
     for i in 0..n {
@@ -65,12 +69,13 @@ pub fn gershgorin(a: &SymTridiag) -> (f64, f64) {
 /// The `k`-th smallest eigenvalue (`k = 0` the smallest) by bisection inside `[lo, hi]`, which
 /// must contain it; stops when the midpoint no longer splits the interval (full precision).
 fn bisect(a: &SymTridiag, k: usize, mut lo: f64, mut hi: f64) -> f64 {
+    let pivmin = pivot_floor(a);
     loop {
         let mid = 0.5 * (lo + hi);
         if mid <= lo || mid >= hi {
             return mid;
         }
-        if count_below(a, mid) > k {
+        if count_below_with(a, mid, pivmin) > k {
             hi = mid;
         } else {
             lo = mid;
@@ -80,13 +85,23 @@ fn bisect(a: &SymTridiag, k: usize, mut lo: f64, mut hi: f64) -> f64 {
 
 /// The smallest and the largest eigenvalue of `a`. `a` must be non-empty with finite entries.
 pub fn extreme_eigenvalues(a: &SymTridiag) -> (f64, f64) {
+    let (lo, hi) = padded_gershgorin(a);
+    (bisect(a, 0, lo, hi), bisect(a, a.dim() - 1, lo, hi))
+}
+
+/// The largest eigenvalue of `a` (non-empty, finite entries).
+fn largest_eigenvalue(a: &SymTridiag) -> f64 {
+    let (lo, hi) = padded_gershgorin(a);
+    bisect(a, a.dim() - 1, lo, hi)
+}
+
+/// The Gershgorin interval widened by a few ulps: the Sturm count at the exact bound is itself
+/// rounded.
+fn padded_gershgorin(a: &SymTridiag) -> (f64, f64) {
     assert!(a.dim() > 0, "empty matrix has no eigenvalues");
     let (lo, hi) = gershgorin(a);
-    // Widen by a few ulps: the Sturm count at the exact Gershgorin bound is itself rounded.
     let pad = 4.0 * f64::EPSILON * lo.abs().max(hi.abs()).max(f64::MIN_POSITIVE);
-    let (lo, hi) = (lo - pad, hi + pad);
-    let n = a.dim();
-    (bisect(a, 0, lo, hi), bisect(a, n - 1, lo, hi))
+    (lo - pad, hi + pad)
 }
 
 /// The smallest eigenvalue of a matrix known to be positive definite: bisection on `[0, hi]`,
@@ -101,7 +116,7 @@ pub fn smallest_eigenvalue_spd(a: &SymTridiag) -> f64 {
 /// `κ₂(a) = λ_max / λ_min` for a symmetric positive definite `a`, or `None` when the computed
 /// smallest eigenvalue is not positive (numerically singular or indefinite).
 pub fn condition_number(a: &SymTridiag) -> Option<f64> {
-    let (_, hi) = extreme_eigenvalues(a);
+    let hi = largest_eigenvalue(a);
     let lo = smallest_eigenvalue_spd(a);
     (lo > 0.0).then(|| hi / lo)
 }
