@@ -431,8 +431,18 @@ fn solved_inaccurate_is_refused_unless_accepted_and_then_counted() {
 
 #[test]
 fn osqp_runs_are_bit_identical_in_process() {
+    runs_are_bit_identical_in_process(Method::Osqp);
+}
+
+/// The exact end solver, whose superposition and `u += z` share one pass when they may.
+#[test]
+fn exact_runs_are_bit_identical_in_process() {
+    runs_are_bit_identical_in_process(Method::Exact);
+}
+
+fn runs_are_bit_identical_in_process(method: Method) {
     // Up to t = 4: both ends in contact from t ≈ 3.03.
-    let scene = with_method("both-ends-forced", Method::Osqp, &["time.end=4"]);
+    let scene = with_method("both-ends-forced", method, &["time.end=4"]);
     let mut a = Simulation::new(&scene).unwrap();
     let mut b = Simulation::new(&scene).unwrap();
     let bits = |s: &Simulation| {
