@@ -334,7 +334,7 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
         );
         bar
     });
-    let keep = |n: usize| n % every == 0 || n == steps;
+    let keep = |n: usize| n.is_multiple_of(every) || n == steps;
     if keep(1) {
         sim.displacement_into(&mut u);
         sim.velocity_into(&mut v);
@@ -351,10 +351,10 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
             write_profile(&mut disp, sim.time(), sim.discretisation(), &u, &v)
                 .map_err(io(&disp_path))?;
         }
-        if let Some(b) = &bar {
-            if r.step % 1024 == 0 {
-                b.set_position(r.step as u64);
-            }
+        if let Some(b) = &bar
+            && r.step.is_multiple_of(1024)
+        {
+            b.set_position(r.step as u64);
         }
     }
     if let Some(b) = bar {
