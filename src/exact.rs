@@ -180,18 +180,7 @@ impl ExactSolver {
         let k = self.columns.len();
         let s = &self.schur;
         let d = [lower[0] - z0[0], if k > 1 { lower[1] - z0[1] } else { 0.0 }];
-        let r = match mask {
-            0 => [0.0, 0.0],
-            1 => [d[0] / s[0][0], 0.0],
-            2 => [0.0, d[1] / s[1][1]],
-            _ => {
-                let det = s[0][0] * s[1][1] - s[0][1] * s[1][0];
-                [
-                    (s[1][1] * d[0] - s[0][1] * d[1]) / det,
-                    (s[0][0] * d[1] - s[1][0] * d[0]) / det,
-                ]
-            }
-        };
+        let r = masked_solve(s, &d, mask);
         let mut violation: f64 = 0.0;
         for j in 0..k {
             if mask & (1 << j) != 0 {
@@ -222,16 +211,11 @@ impl StepSolver for ExactSolver {
         z: &mut [f64],
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
-        z.copy_from_slice(rhs);
-        self.factor.solve_in_place(z);
-        if self.columns.is_empty() {
+        let Some((tried, mask)) = self.active_set(rhs, lower, z, reactions)? else {
             // Non-finite values anywhere are caught by the stepper's energy check.
             return Ok(SolveInfo { iterations: 1 });
-        }
-        let (tried, mask) = self.enumerate(lower, z, reactions)?;
-        if self.superpose(mask, lower, z, reactions)? {
-            self.resolve(mask, rhs, lower, z, reactions)?;
-        }
+        };
+        self.superpose_or_resolve(mask, rhs, lower, z, reactions)?;
         Ok(SolveInfo { iterations: tried })
     }
 
@@ -246,25 +230,52 @@ impl StepSolver for ExactSolver {
         z: &mut [f64],
         reactions: &mut [f64],
     ) -> Result<(SolveInfo, f64), StepFailure> {
-        z.copy_from_slice(rhs);
-        self.factor.solve_in_place(z);
-        if self.columns.is_empty() {
+        let Some((tried, mask)) = self.active_set(rhs, lower, z, reactions)? else {
             return Ok((SolveInfo { iterations: 1 }, add_in_place(u, z)));
-        }
-        let (tried, mask) = self.enumerate(lower, z, reactions)?;
+        };
         let info = SolveInfo { iterations: tried };
         if let Some(max_abs) = self.superpose_and_add(mask, lower, u, z, reactions) {
             self.merged += 1;
             return Ok((info, max_abs));
         }
-        if self.superpose(mask, lower, z, reactions)? {
-            self.resolve(mask, rhs, lower, z, reactions)?;
-        }
+        self.superpose_or_resolve(mask, rhs, lower, z, reactions)?;
         Ok((info, add_in_place(u, z)))
     }
 }
 
 impl ExactSolver {
+    /// `z = z⁰ = C⁻¹ b`, then the active set by enumeration ([`ExactSolver::enumerate`]):
+    /// `(sets tried, mask)`, or `None` when no node is constrained.
+    fn active_set(
+        &self,
+        rhs: &[f64],
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<Option<(u32, u8)>, StepFailure> {
+        z.copy_from_slice(rhs);
+        self.factor.solve_in_place(z);
+        if self.columns.is_empty() {
+            return Ok(None);
+        }
+        self.enumerate(lower, z, reactions).map(Some)
+    }
+
+    /// [`ExactSolver::superpose`], and the direct solve when it cancelled.
+    fn superpose_or_resolve(
+        &mut self,
+        mask: u8,
+        rhs: &[f64],
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<(), StepFailure> {
+        if self.superpose(mask, lower, z, reactions)? {
+            self.resolve(mask, rhs, lower, z, reactions)?;
+        }
+        Ok(())
+    }
+
     /// The direct solve of a step whose superposition cancelled (counted).
     fn resolve(
         &mut self,
@@ -304,19 +315,7 @@ impl ExactSolver {
         if z0[..k].iter().any(|v| !v.is_finite()) {
             return Err(StepFailure::NonFinite);
         }
-        let mut best = (0u8, [0.0; 2], f64::INFINITY);
-        let mut tried = 0;
-        for mask in 0..(1u8 << k) {
-            tried += 1;
-            let (r, violation) = self.candidate(mask, &z0, lower);
-            if violation < best.2 {
-                best = (mask, r, violation);
-            }
-            if violation <= 0.0 {
-                break; // KKT holds exactly: no later set can beat it
-            }
-        }
-        let (mask, r, _) = best;
+        let (tried, mask, r) = least_violating(k, |mask| self.candidate(mask, &z0, lower));
         for (j, rj) in reactions[..k].iter_mut().enumerate() {
             *rj = if mask & (1 << j) != 0 { r[j] } else { 0.0 };
         }
@@ -499,6 +498,46 @@ fn add_pair(u: &mut [f64], z: &mut [f64], r: f64, a: &[f64], r2: f64, b: &[f64])
         m[0] = m[0].max(ui.abs());
     }
     max4(m)
+}
+
+/// The reactions of active set `mask` (bit `j`: node `j`) from `m r = d` restricted to it
+/// (zero off it), by Cramer's rule; shared with the penalty solver, whose `m` is `S + εI`.
+pub(crate) fn masked_solve(m: &[[f64; 2]; 2], d: &[f64; 2], mask: u8) -> [f64; 2] {
+    match mask {
+        0 => [0.0, 0.0],
+        1 => [d[0] / m[0][0], 0.0],
+        2 => [0.0, d[1] / m[1][1]],
+        _ => {
+            let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+            [
+                (m[1][1] * d[0] - m[0][1] * d[1]) / det,
+                (m[0][0] * d[1] - m[1][0] * d[0]) / det,
+            ]
+        }
+    }
+}
+
+/// The active sets of `k <= 2` nodes tried in the order ∅, {first}, {second}, {both}:
+/// `candidate(mask)` gives a set's reactions and violation; the first set with the least
+/// violation wins, and a set with none ends the search (the problem's solution is unique).
+/// Returns the number of sets tried, the winning mask and its reactions.
+pub(crate) fn least_violating(
+    k: usize,
+    candidate: impl Fn(u8) -> ([f64; 2], f64),
+) -> (u32, u8, [f64; 2]) {
+    let mut best = (0u8, [0.0; 2], f64::INFINITY);
+    let mut tried = 0;
+    for mask in 0..(1u8 << k) {
+        tried += 1;
+        let (r, violation) = candidate(mask);
+        if violation < best.2 {
+            best = (mask, r, violation);
+        }
+        if violation <= 0.0 {
+            break;
+        }
+    }
+    (tried, best.0, best.1)
 }
 
 /// `C⁻¹ e_j` for each node, computed with `factor` (set-up only).

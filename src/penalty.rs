@@ -31,7 +31,7 @@
 
 use crate::audit::{KktAudit, Law};
 use crate::error::{RunError, SceneError};
-use crate::exact::{Column, inverse_columns, schur_complement};
+use crate::exact::{Column, inverse_columns, least_violating, masked_solve, schur_complement};
 use crate::solver::{SolveInfo, SolverReport, StepFailure, StepSolver};
 use crate::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
 
@@ -111,18 +111,7 @@ impl PenaltySolver {
     fn candidate(&self, mask: u8, d: &[f64; 2]) -> ([f64; 2], f64) {
         let k = self.columns.len();
         let m = &self.matrix;
-        let r = match mask {
-            0 => [0.0, 0.0],
-            1 => [d[0] / m[0][0], 0.0],
-            2 => [0.0, d[1] / m[1][1]],
-            _ => {
-                let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-                [
-                    (m[1][1] * d[0] - m[0][1] * d[1]) / det,
-                    (m[0][0] * d[1] - m[1][0] * d[0]) / det,
-                ]
-            }
-        };
+        let r = masked_solve(m, d, mask);
         let mut violation: f64 = 0.0;
         for j in 0..k {
             if mask & (1 << j) != 0 {
@@ -159,19 +148,7 @@ impl StepSolver for PenaltySolver {
         if !d[..k].iter().all(|v| v.is_finite()) {
             return Err(StepFailure::NonFinite);
         }
-        let mut best = (0u8, [0.0; 2], f64::INFINITY);
-        let mut tried = 0;
-        for mask in 0..(1u8 << k) {
-            tried += 1;
-            let (r, violation) = self.candidate(mask, &d);
-            if violation < best.2 {
-                best = (mask, r, violation);
-            }
-            if violation <= 0.0 {
-                break; // the LCP holds exactly: this is the unique solution
-            }
-        }
-        let (mask, r, _) = best;
+        let (tried, mask, r) = least_violating(k, |mask| self.candidate(mask, &d));
         for (j, col) in self.columns.iter().enumerate() {
             let active = mask & (1 << j) != 0;
             reactions[j] = if active { r[j] } else { 0.0 };
