@@ -104,7 +104,7 @@ fn main() {
             all_scenes.insert(name, t);
         }
     }
-    let (scene_rows, _) = fresh(all_scenes);
+    let (scene_rows, stale_scenes) = fresh(all_scenes);
     if !scene_rows.is_empty() {
         println!();
         println!("| scene (default size, end to end) | median per run | ns per node-step |");
@@ -113,6 +113,9 @@ fn main() {
             let (_, scene) = viscobar::scene::load(name, &[]).expect("talk scene");
             let node_steps = (scene.elements() + 1) as f64 * scene.steps() as f64;
             println!("| {name} | {:.1} ms | {:.2} |", t / 1e6, t / node_steps);
+        }
+        for name in &stale_scenes {
+            println!("| {name} (stale) | | |");
         }
     }
     println!();
