@@ -105,8 +105,7 @@ impl BlockPivotSolver {
     fn solve_reduced(&mut self, rhs: &[f64], lower: &[f64], z: &mut [f64]) {
         let n = z.len();
         if !self.active.iter().any(|&a| a) {
-            z.copy_from_slice(rhs);
-            self.factor.solve_in_place(z);
+            self.factor.solve_into(rhs, z);
             return;
         }
         for i in 0..n {

@@ -314,8 +314,7 @@ fn inverse_norm_estimate(factor: &Ldlt) -> f64 {
     let mut w = vec![0.0; n];
     let mut estimate = 0.0;
     for _ in 0..5 {
-        y.copy_from_slice(&x);
-        factor.solve_in_place(&mut y);
+        factor.solve_into(&x, &mut y);
         estimate = y.iter().map(|v| v.abs()).sum::<f64>();
         for (wi, yi) in w.iter_mut().zip(&y) {
             *wi = if *yi >= 0.0 { 1.0 } else { -1.0 };

@@ -253,8 +253,7 @@ impl ExactSolver {
         z: &mut [f64],
         reactions: &mut [f64],
     ) -> Result<Option<(u32, u8)>, StepFailure> {
-        z.copy_from_slice(rhs);
-        self.factor.solve_in_place(z);
+        self.factor.solve_into(rhs, z);
         if self.columns.is_empty() {
             return Ok(None);
         }

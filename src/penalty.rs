@@ -138,8 +138,7 @@ impl StepSolver for PenaltySolver {
         z: &mut [f64],
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
-        z.copy_from_slice(rhs);
-        self.factor.solve_in_place(z);
+        self.factor.solve_into(rhs, z);
         let k = self.columns.len();
         let mut d = [0.0; 2];
         for (j, col) in self.columns.iter().enumerate() {

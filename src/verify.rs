@@ -29,6 +29,7 @@ pub const RIGID_STEPS: usize = 26_000;
 pub fn sections() -> Result<Vec<Section>, crate::converge::ConvergeError> {
     Ok(vec![
         matrices_section(),
+        solve_section(),
         scenes_section()?,
         Section {
             id: "solver-agreement",
@@ -73,6 +74,87 @@ fn matrices_section() -> Section {
     }
     Section {
         id: "matrices",
+        markdown: md,
+    }
+}
+
+/// The step matrices of the backward-error study of the solve: `(α, Δt/Δx)` from
+/// mass-dominated to the stiffest corner of the stiff case matrix.
+pub const SOLVE_STUDY_CASES: [(f64, f64); 6] = [
+    (0.0, 0.01),
+    (0.0, 1.0),
+    (0.1, 1.0),
+    (10.0, 1.0),
+    (1.0, 10.0),
+    (1e6, 1e4),
+];
+
+/// One solve of the backward-error study.
+#[derive(Clone, Copy, Debug)]
+pub struct SolveCase {
+    pub alpha: f64,
+    pub dt_over_dx: f64,
+    pub nodes: usize,
+    /// Normwise backward error of `Ldlt::solve_in_place`, in units of ε.
+    pub backward_error: f64,
+    /// Whether `solve_into` gave the same bits.
+    pub into_same_bits: bool,
+}
+
+/// Solves `C x = b` on a bar of length 1 with `C = M/Δt² + (½ + α/(2Δt)) R` (consistent
+/// matrices) for each case and node count, with a smooth `b`.
+pub fn solve_study(nodes: &[usize]) -> Vec<SolveCase> {
+    let mut out = Vec::new();
+    for &n in nodes {
+        for (alpha, ratio) in SOLVE_STUDY_CASES {
+            let dx = 1.0 / (n - 1) as f64;
+            let dt = ratio * dx;
+            let (m, r) = (
+                mass(MatrixVariant::Consistent, n, dx),
+                stiffness(MatrixVariant::Consistent, n, dx),
+            );
+            let c = crate::tridiag::SymTridiag::combine(
+                1.0 / (dt * dt),
+                &m,
+                0.5 + alpha / (2.0 * dt),
+                &r,
+            );
+            let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() + 0.1).collect();
+            let Ok(factor) = crate::tridiag::Ldlt::factor(&c) else {
+                continue;
+            };
+            let mut x = b.clone();
+            factor.solve_in_place(&mut x);
+            let mut y = vec![f64::NAN; n];
+            factor.solve_into(&b, &mut y);
+            out.push(SolveCase {
+                alpha,
+                dt_over_dx: ratio,
+                nodes: n,
+                backward_error: crate::tridiag::backward_error(&c, &x, &b),
+                into_same_bits: x.iter().zip(&y).all(|(p, q)| p.to_bits() == q.to_bits()),
+            });
+        }
+    }
+    out
+}
+
+/// Node counts of the study's table (even and odd: the reduction differs at the last node).
+pub const SOLVE_STUDY_NODES: [usize; 4] = [1000, 1001, 100_000, 100_001];
+
+fn solve_section() -> Section {
+    let mut md = String::from(
+        "| α | Δt/Δx | nodes | backward error / ε | `solve_into` same bits |\n|---|---|---|---|---|\n",
+    );
+    for case in solve_study(&SOLVE_STUDY_NODES) {
+        let _ = writeln!(
+            md,
+            "| {:e} | {:e} | {} | {:.2} | {} |",
+            case.alpha, case.dt_over_dx, case.nodes, case.backward_error, case.into_same_bits
+        );
+    }
+    Section {
+        id: "solve",
         markdown: md,
     }
 }

@@ -1,6 +1,7 @@
 //! Properties of the P1 matrices M and R, and the diagnosis of the talk's printed entries.
 
 use viscobar::matrices::{MatrixVariant, mass, stiffness};
+use viscobar::verify::SolveCase;
 
 /// `1ᵀM1` sums `J + 2` rounded entries: a few ulps of L.
 const MASS_SUM_TOL: f64 = 1e-12;
@@ -87,8 +88,9 @@ fn talk_printed_matrices_are_inconsistent() {
     }
 }
 
-/// The factorisation solves to round-off, for every size (the twisted split has edge cases at
-/// n = 1, 2, 3) and for matrices that are not diagonally dominant.
+/// The factorisation solves to round-off, for every size (the odd–even reduction and the twist
+/// have edge cases at small and at even or odd n) and for matrices that are not diagonally
+/// dominant.
 #[test]
 fn factorisation_solves_spd_tridiagonal_systems() {
     use viscobar::tridiag::{Ldlt, SymTridiag};
@@ -115,5 +117,45 @@ fn factorisation_solves_spd_tridiagonal_systems() {
                 );
             }
         }
+    }
+}
+
+/// Normwise backward error of the solve, in units of ε: Gaussian elimination on a tridiagonal
+/// SPD matrix gives `(A + ΔA) x̂ = b` with `|ΔA| ≤ γ₃ |A|` (for tridiagonal SPD `|L||D||Lᵀ| = |A|`;
+/// Higham, *Accuracy and Stability*, Thm 9.3 and 10.5), and evaluating `b − A x̂` adds at most
+/// four roundings of `|A||x̂| + |b|`.
+const BACKWARD_ULPS: f64 = 8.0;
+
+/// The solve is backward stable on the step matrices `C = M/Δt² + (½ + α/(2Δt)) R` from
+/// mass-dominated to stiff (`α = 10⁶`, `Δt = 10⁴ Δx`), at even and odd node counts, and
+/// `solve_into` gives the bits of `solve_in_place` (`verify::solve_study`, whose figures
+/// VERIFICATION.md shows). A look-ahead recurrence `y_i = (b_i − l b_i−1) + l l' y_i−2`, tried
+/// for speed, measured 31 ε on these matrices.
+#[test]
+fn factorisation_is_backward_stable_on_the_step_matrices() {
+    use viscobar::verify::{SOLVE_STUDY_CASES, SOLVE_STUDY_NODES, solve_study};
+    let nodes: Vec<usize> = (2..=24).chain(SOLVE_STUDY_NODES).collect();
+    let cases = solve_study(&nodes);
+    assert_eq!(
+        cases.len(),
+        nodes.len() * SOLVE_STUDY_CASES.len(),
+        "a factorisation failed"
+    );
+    for case in cases {
+        let SolveCase {
+            alpha,
+            dt_over_dx,
+            nodes,
+            backward_error,
+            into_same_bits,
+        } = case;
+        assert!(
+            into_same_bits,
+            "n = {nodes}: solve_into differs from solve_in_place"
+        );
+        assert!(
+            backward_error <= BACKWARD_ULPS,
+            "n = {nodes}, alpha = {alpha}, dt/dx = {dt_over_dx}: backward error {backward_error:.2} ε"
+        );
     }
 }
