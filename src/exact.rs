@@ -230,6 +230,12 @@ impl StepSolver for ExactSolver {
         z: &mut [f64],
         reactions: &mut [f64],
     ) -> Result<(SolveInfo, f64), StepFailure> {
+        if self.columns.is_empty() {
+            // Nothing to enumerate: the update is made inside the solve, and the state scale
+            // (read only by the cancellation test of constrained steps) is not needed.
+            self.factor.solve_into_and_add(rhs, z, u);
+            return Ok((SolveInfo { iterations: 1 }, 0.0));
+        }
         let Some((tried, mask)) = self.active_set(rhs, lower, z, reactions)? else {
             return Ok((SolveInfo { iterations: 1 }, add_in_place(u, z)));
         };

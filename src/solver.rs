@@ -66,9 +66,10 @@ pub trait StepSolver {
     /// (the exact end solver weighs its cancellation error against it). Default: ignored.
     fn set_state_scale(&mut self, _max_abs_u: f64) {}
 
-    /// [`StepSolver::solve`], then `u += z`; returns `max_i |u_i|` afterwards (the next
-    /// step's state scale). The default makes the two passes; the exact end solver merges its
-    /// superposition `z⁰ + Σ r_j c_j` with the addition when it may.
+    /// [`StepSolver::solve`], then `u += z`; returns `max_i |u_i|` afterwards, the next
+    /// step's state scale, or 0 from a solver that never reads it. The default makes the two
+    /// passes; the exact solver merges its superposition `z⁰ + Σ r_j c_j` with the addition
+    /// when it may, and without constrained nodes adds inside the solve (and returns 0).
     fn solve_and_advance(
         &mut self,
         rhs: &[f64],

@@ -158,6 +158,8 @@ impl SymTridiag {
 /// scaled at the end: per row (`ws = s`, `we = e`, scales 1) or, on a uniform mesh, as plain
 /// sums scaled once by `s` and `e` (half the multiplications).
 pub trait Interior: Copy {
+    /// Whether every row has the same coefficients (the kernels may then factor them out).
+    const UNIFORM: bool;
     fn s(self, i: usize) -> f64;
     /// `A_{i,i+1}`.
     fn e(self, i: usize) -> f64;
@@ -183,6 +185,7 @@ pub struct Uniform {
 }
 
 impl Interior for Rows<'_> {
+    const UNIFORM: bool = false;
     #[inline(always)]
     fn s(self, i: usize) -> f64 {
         self.s[i]
@@ -208,6 +211,7 @@ impl Interior for Rows<'_> {
 }
 
 impl Interior for Uniform {
+    const UNIFORM: bool = true;
     #[inline(always)]
     fn s(self, _: usize) -> f64 {
         self.s
@@ -511,21 +515,35 @@ impl Ldlt {
     pub fn solve_in_place(&self, b: &mut [f64]) {
         assert_eq!(b.len(), self.n, "right-hand side length");
         let x = Cell::from_mut(b).as_slice_of_cells();
-        self.solve_from(x, x);
+        self.solve_from::<_, false>(x, x, x);
     }
 
     /// `x = A⁻¹ b` (the same bits as copying `b` into `x` and solving in place).
     pub fn solve_into(&self, b: &[f64], x: &mut [f64]) {
         assert_eq!(b.len(), self.n, "right-hand side length");
         assert_eq!(x.len(), self.n, "solution length");
-        self.solve_from(b, Cell::from_mut(x).as_slice_of_cells());
+        let x = Cell::from_mut(x).as_slice_of_cells();
+        self.solve_from::<_, false>(b, x, x);
+    }
+
+    /// `x = A⁻¹ b`, then `u += x`: the bits of [`Ldlt::solve_into`] followed by the addition,
+    /// made as each `x_i` is found (the time step's update without a second pass over the
+    /// bar). Unlike [`add_in_place`] it does not track `max |u_i|`: that running maximum, a
+    /// chain of its own, made the fused sweep slower than the two passes.
+    pub fn solve_into_and_add(&self, b: &[f64], x: &mut [f64], u: &mut [f64]) {
+        assert_eq!(b.len(), self.n, "right-hand side length");
+        assert_eq!(x.len(), self.n, "solution length");
+        assert_eq!(u.len(), self.n, "state length");
+        let x = Cell::from_mut(x).as_slice_of_cells();
+        self.solve_from::<_, true>(b, x, Cell::from_mut(u).as_slice_of_cells());
     }
 
     /// The solve, reading the right-hand side from `b` (which may be `x` itself: every entry
     /// of `b` is read before `x` overwrites it). Inward, the two chains eliminate towards the
     /// twist row, folding in the odd nodes; outward, they substitute back, and each reduced
-    /// row fills in its inner odd node.
-    fn solve_from<V: Value>(&self, b: &[V], x: &[Cell<f64>]) {
+    /// row fills in its inner odd node. With `ADD`, each `x_i` is also added to `u_i`
+    /// (otherwise `u` is not touched and may be `x`).
+    fn solve_from<V: Value, const ADD: bool>(&self, b: &[V], x: &[Cell<f64>], u: &[Cell<f64>]) {
         let n = self.n;
         if n == 0 {
             return;
@@ -541,6 +559,9 @@ impl Ldlt {
         let (x_top, x_rest) = x.split_at(2 * m);
         let (x_mid, x_rest) = x_rest.split_at(1);
         let (x_bottom, x_outer) = x_rest.split_at(bottom_nodes);
+        let (u_top, u_rest) = u.split_at(2 * m);
+        let (u_mid, u_rest) = u_rest.split_at(1);
+        let (u_bottom, u_outer) = u_rest.split_at(bottom_nodes);
         let common = m.min(bottom_f.len());
 
         // Inward. Per chain: y (the elimination value), l (the multiplier of the row before)
@@ -583,41 +604,61 @@ impl Ldlt {
         let xm = (((b_mid[0].value() - ct) - cb) - lt * yt - lb * yb) * self.inv_twist;
         x_mid[0].set(xm);
 
+        let add = |u: &Cell<f64>, xi: f64| {
+            if ADD {
+                u.set(u.get() + xi);
+            }
+        };
+        add(&u_mid[0], xm);
+
         // Outward: x_2r = y_r/D_r − l_r x_(next even), then the inner odd node from its two
         // even neighbours (left one first).
         let (mut xt_, mut xb_) = (xm, xm);
-        let outward_top = |b: &[V], x: &[Cell<f64>], f: &[f64; 5], xn: &mut f64| {
-            let xe = x[0].get() - f[0] * *xn;
-            x[1].set(b[1].value() * f[4] - f[2] * xe - f[3] * *xn);
-            x[0].set(xe);
-            *xn = xe;
-        };
-        let outward_bottom = |b: &[V], x: &[Cell<f64>], f: &[f64; 5], xn: &mut f64| {
-            let xe = x[1].get() - f[0] * *xn;
-            x[0].set(b[0].value() * f[4] - f[2] * *xn - f[3] * xe);
-            x[1].set(xe);
-            *xn = xe;
-        };
+        let outward_top =
+            |b: &[V], x: &[Cell<f64>], u: &[Cell<f64>], f: &[f64; 5], xn: &mut f64| {
+                let xe = x[0].get() - f[0] * *xn;
+                let xo = b[1].value() * f[4] - f[2] * xe - f[3] * *xn;
+                x[1].set(xo);
+                x[0].set(xe);
+                add(&u[0], xe);
+                add(&u[1], xo);
+                *xn = xe;
+            };
+        let outward_bottom =
+            |b: &[V], x: &[Cell<f64>], u: &[Cell<f64>], f: &[f64; 5], xn: &mut f64| {
+                let xe = x[1].get() - f[0] * *xn;
+                let xo = b[0].value() * f[4] - f[2] * *xn - f[3] * xe;
+                x[0].set(xo);
+                x[1].set(xe);
+                add(&u[0], xo);
+                add(&u[1], xe);
+                *xn = xe;
+            };
         let mut top = (b_top.chunks_exact(2).zip(x_top.chunks_exact(2)))
-            .zip(top_f)
+            .zip(u_top.chunks_exact(2).zip(top_f))
             .rev();
         let mut bottom = (b_bottom.rchunks_exact(2).zip(x_bottom.rchunks_exact(2)))
-            .zip(bottom_f)
+            .zip(u_bottom.rchunks_exact(2).zip(bottom_f))
             .rev();
-        for ((bt, xt), ft) in top.by_ref().take(m - common) {
-            outward_top(bt, xt, ft, &mut xt_);
+        for ((bt, xt), (ut, ft)) in top.by_ref().take(m - common) {
+            outward_top(bt, xt, ut, ft, &mut xt_);
         }
-        for ((bb, xb), fb) in bottom.by_ref().take(bottom_f.len() - common) {
-            outward_bottom(bb, xb, fb, &mut xb_);
+        for ((bb, xb), (ub, fb)) in bottom.by_ref().take(bottom_f.len() - common) {
+            outward_bottom(bb, xb, ub, fb, &mut xb_);
         }
-        for (((bt, xt), ft), ((bb, xb), fb)) in top.zip(bottom) {
-            outward_top(bt, xt, ft, &mut xt_);
-            outward_bottom(bb, xb, fb, &mut xb_);
+        for (((bt, xt), (ut, ft)), ((bb, xb), (ub, fb))) in top.zip(bottom) {
+            outward_top(bt, xt, ut, ft, &mut xt_);
+            outward_bottom(bb, xb, ub, fb, &mut xb_);
         }
-        if let (Some([f1, inv_d]), Some(bo), Some(xo)) =
-            (self.outer, b_outer.first(), x_outer.first())
-        {
-            xo.set(bo.value() * inv_d - f1 * xb_);
+        if let (Some([f1, inv_d]), Some(bo), Some(xo), Some(uo)) = (
+            self.outer,
+            b_outer.first(),
+            x_outer.first(),
+            u_outer.first(),
+        ) {
+            let v = bo.value() * inv_d - f1 * xb_;
+            xo.set(v);
+            add(uo, v);
         }
     }
 
