@@ -900,64 +900,9 @@ fn rhs_into<const LOAD: bool, K: Interior>(
     for i in [0, n.saturating_sub(1)].into_iter().take(n.min(2)) {
         rhs[i] = finish(i, row_of(stiffness, y, i, n), row_of(mass, wi, i, n));
     }
-    if K::UNIFORM {
-        let (s_r, e_r) = (ri.s(1), ri.e(1));
-        let (s_a, e_a) = (mi.s(1) * inv_dt2 + c_w * s_r, mi.e(1) * inv_dt2 + c_w * e_r);
-        let coefficients = [s_a, e_a, s_r, e_r];
-        // R's interior rows sum to exactly 0 (its entries are ±1/Δx, 2/Δx): that term drops.
-        if s_r == 0.0 {
-            uniform_interior_rhs::<LOAD, false>(coefficients, u, w, force, rhs);
-        } else {
-            uniform_interior_rhs::<LOAD, true>(coefficients, u, w, force, rhs);
-        }
-    } else {
-        #[allow(clippy::needless_range_loop)] // a stencil: rows i − 1, i, i + 1
-        for i in 1..n.saturating_sub(1) {
-            rhs[i] = finish(i, inner_row_of(ri, y, i), inner_row_of(mi, wi, i));
-        }
-    }
-}
-
-/// The interior rows of [`rhs_into`] on a uniform mesh: `b = A w − R u (+ F)` with
-/// `A = M/Δt² + c_w R`, as `b_i = (s_A w_i − s_R u_i) + Δ²p_i (+ F_i)` where
-/// `p = e_A w − e_R u` and `Δ²p_i = (p_i−1 − p_i) + (p_i+1 − p_i)`. A rigid `u`, `w` (p
-/// constant) adds nothing, as in the difference form, with half its additions. Rows go in
-/// pairs, each `p` computed once and shifted between pairs, so the pair arithmetic maps onto
-/// two-lane vector instructions; `S_R = false` leaves out `s_R u_i` (`s_R = 0`).
-#[inline(always)]
-fn uniform_interior_rhs<const LOAD: bool, const S_R: bool>(
-    [s_a, e_a, s_r, e_r]: [f64; 4],
-    u: &[f64],
-    w: &[f64],
-    force: &[f64],
-    rhs: &mut [f64],
-) {
-    let n = rhs.len();
-    let p = |w: f64, u: f64| e_a * w - e_r * u;
-    let row = |w: f64, u: f64, f: f64, left: f64, mid: f64, right: f64| {
-        let q = if S_R { s_a * w - s_r * u } else { s_a * w };
-        let b = q + ((left - mid) + (right - mid));
-        if LOAD { b + f } else { b }
-    };
-    // Pairs (i, i + 1) for i = 1, 3, … while p_{i+3} exists; then single rows.
-    let pairs = if n >= 5 { (n - 3) / 2 } else { 0 };
-    if pairs > 0 {
-        let f_pairs = if LOAD { &force[1..] } else { &w[1..] };
-        let (mut prev, mut cur) = (p(w[0], u[0]), [p(w[1], u[1]), p(w[2], u[2])]);
-        let here = (w[1..].chunks_exact(2)).zip(u[1..].chunks_exact(2));
-        let ahead = (w[3..].chunks_exact(2)).zip(u[3..].chunks_exact(2));
-        let out = rhs[1..].chunks_exact_mut(2).zip(f_pairs.chunks_exact(2));
-        for (((b, f), (wh, uh)), (wa, ua)) in out.zip(here).zip(ahead).take(pairs) {
-            let next = [p(wa[0], ua[0]), p(wa[1], ua[1])];
-            b[0] = row(wh[0], uh[0], f[0], prev, cur[0], cur[1]);
-            b[1] = row(wh[1], uh[1], f[1], cur[0], cur[1], next[0]);
-            (prev, cur) = (cur[1], next);
-        }
-    }
-    for i in 1 + 2 * pairs..n.saturating_sub(1) {
-        let f = if LOAD { force[i] } else { 0.0 };
-        let (left, mid, right) = (p(w[i - 1], u[i - 1]), p(w[i], u[i]), p(w[i + 1], u[i + 1]));
-        rhs[i] = row(w[i], u[i], f, left, mid, right);
+    #[allow(clippy::needless_range_loop)] // a stencil: rows i − 1, i, i + 1
+    for i in 1..n.saturating_sub(1) {
+        rhs[i] = finish(i, inner_row_of(ri, y, i), inner_row_of(mi, wi, i));
     }
 }
 
@@ -1002,21 +947,37 @@ fn measure<const LOAD: bool, K: Interior>(
     // addition chains keep the adders busy (more lanes measured slower here), and the order
     // is fixed, so the sums are deterministic.
     let mut acc = [0.0f64; 7];
-    for i in 1..n.saturating_sub(1) {
-        let (zi, ui, di) = (z[i], u[i], d(i));
-        let (dz, du, dd) = (z[i + 1] - zi, u[i + 1] - ui, d(i + 1) - di);
-        acc[0] += mi.ws(i) * zi * zi;
-        acc[1] += mi.we(i) * dz * dz;
-        acc[2] += ri.ws(i) * ui * ui;
-        acc[3] += ri.we(i) * du * du;
-        acc[4] += ri.ws(i) * di * di;
-        acc[5] += ri.we(i) * dd * dd;
-        if LOAD {
-            acc[6] += force[i] * di;
+    if K::UNIFORM {
+        // R's interior rows sum to exactly 0: its node sums are then not needed.
+        acc = if ri.scale_s() == 0.0 {
+            uniform_measure::<LOAD, false>(u, z, w, force)
+        } else {
+            uniform_measure::<LOAD, true>(u, z, w, force)
+        };
+    } else {
+        for i in 1..n.saturating_sub(1) {
+            let (zi, ui, di) = (z[i], u[i], d(i));
+            let (dz, du, dd) = (z[i + 1] - zi, u[i + 1] - ui, d(i + 1) - di);
+            acc[0] += mi.ws(i) * zi * zi;
+            acc[1] += mi.we(i) * dz * dz;
+            acc[2] += ri.ws(i) * ui * ui;
+            acc[3] += ri.we(i) * du * du;
+            acc[4] += ri.ws(i) * di * di;
+            acc[5] += ri.we(i) * dd * dd;
+            if LOAD {
+                acc[6] += force[i] * di;
+            }
         }
     }
     let sum = |q: usize| acc[q];
-    let form = |k: K, node: usize, edge: usize| k.scale_s() * sum(node) - k.scale_e() * sum(edge);
+    let form = |k: K, node: usize, edge: usize| {
+        let nodes = if k.scale_s() == 0.0 {
+            0.0
+        } else {
+            k.scale_s() * sum(node)
+        };
+        nodes - k.scale_e() * sum(edge)
+    };
     let mut sums = StepSums {
         kinetic: form(mi, 0, 1),
         potential: form(ri, 2, 3),
@@ -1042,6 +1003,72 @@ fn measure<const LOAD: bool, K: Interior>(
         sums.viscous -= er * dd * dd;
     }
     sums
+}
+
+/// The interior sums of [`measure`] on a uniform mesh (weights 1): `Σ z_i²`, `Σ (Δz_i)²`,
+/// `Σ u_i²`, `Σ (Δu_i)²`, `Σ d_i²`, `Σ (Δd_i)²`, `Σ F_i d_i` over `i = 1..n−1` with `d = z + w`,
+/// `Δx_i = x_{i+1} − x_i`. Two lanes per sum (even and odd rows, added at the end: a fixed
+/// order, so deterministic), which map onto two-lane vector instructions and halve the
+/// additions' dependency chains; `S_R = false` skips `Σ u_i²` and `Σ d_i²` (left 0).
+#[inline(always)]
+fn uniform_measure<const LOAD: bool, const S_R: bool>(
+    u: &[f64],
+    z: &[f64],
+    w: &[f64],
+    force: &[f64],
+) -> [f64; 7] {
+    let n = u.len();
+    let rows = n.saturating_sub(2);
+    let pairs = rows / 2;
+    let mut acc = [[0.0f64; 2]; 7];
+    let add = |acc: &mut [[f64; 2]; 7],
+               lane: usize,
+               zi: f64,
+               ui: f64,
+               di: f64,
+               zn: f64,
+               un: f64,
+               dn: f64,
+               f: f64| {
+        let (dz, du, dd) = (zn - zi, un - ui, dn - di);
+        acc[0][lane] += zi * zi;
+        acc[1][lane] += dz * dz;
+        if S_R {
+            acc[2][lane] += ui * ui;
+            acc[4][lane] += di * di;
+        }
+        acc[3][lane] += du * du;
+        acc[5][lane] += dd * dd;
+        if LOAD {
+            acc[6][lane] += f * di;
+        }
+    };
+    if pairs > 0 {
+        let f_rows = if LOAD { &force[1..] } else { &z[1..] };
+        let here = (z[1..].chunks_exact(2).zip(u[1..].chunks_exact(2))).zip(w[1..].chunks_exact(2));
+        let ahead =
+            (z[2..].chunks_exact(2).zip(u[2..].chunks_exact(2))).zip(w[2..].chunks_exact(2));
+        for ((((zh, uh), wh), ((za, ua), wa)), f) in
+            here.zip(ahead).zip(f_rows.chunks_exact(2)).take(pairs)
+        {
+            let (dh, da) = (
+                [zh[0] + wh[0], zh[1] + wh[1]],
+                [za[0] + wa[0], za[1] + wa[1]],
+            );
+            for lane in 0..2 {
+                add(
+                    &mut acc, lane, zh[lane], uh[lane], dh[lane], za[lane], ua[lane], da[lane],
+                    f[lane],
+                );
+            }
+        }
+    }
+    for i in 1 + 2 * pairs..n.saturating_sub(1) {
+        let f = if LOAD { force[i] } else { 0.0 };
+        let (di, dn) = (z[i] + w[i], z[i + 1] + w[i + 1]);
+        add(&mut acc, 0, z[i], u[i], di, z[i + 1], u[i + 1], dn, f);
+    }
+    acc.map(|[even, odd]| even + odd)
 }
 
 /// `|u − w|²_R` in difference form (`u^{n−1} = u^n − w` for a step whose predecessor was not
