@@ -70,13 +70,7 @@ impl BlockPivotSolver {
         for (k, &i) in nodes.iter().enumerate() {
             slot[i] = k;
         }
-        let c_norm = (0..n)
-            .map(|i| {
-                c.diag[i].abs()
-                    + if i > 0 { c.off[i - 1].abs() } else { 0.0 }
-                    + if i + 1 < n { c.off[i].abs() } else { 0.0 }
-            })
-            .fold(0.0, f64::max);
+        let c_norm = c.inf_norm();
         Ok(Self {
             c: c.clone(),
             c_norm,

@@ -134,13 +134,7 @@ impl KktAudit {
     ) -> Result<Self, NotPositiveDefinite> {
         let factor = Ldlt::factor(c)?;
         let n = c.dim();
-        let c_norm = (0..n)
-            .map(|i| {
-                let left = if i > 0 { c.off[i - 1].abs() } else { 0.0 };
-                let right = if i + 1 < n { c.off[i].abs() } else { 0.0 };
-                left + c.diag[i].abs() + right
-            })
-            .fold(0.0, f64::max);
+        let c_norm = c.inf_norm();
         let inv_norm = inverse_norm_estimate(&factor);
         // Only the penalty law reads `schur_abs` (and the penalty solver has at most two
         // nodes): for an obstacle under every node it would be a dense k×k block, O(k n) work.

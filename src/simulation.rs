@@ -970,14 +970,7 @@ fn measure<const LOAD: bool, K: Interior>(
         }
     }
     let sum = |q: usize| acc[q];
-    let form = |k: K, node: usize, edge: usize| {
-        let nodes = if k.scale_s() == 0.0 {
-            0.0
-        } else {
-            k.scale_s() * sum(node)
-        };
-        nodes - k.scale_e() * sum(edge)
-    };
+    let form = |k: K, node: usize, edge: usize| k.scale_s() * sum(node) - k.scale_e() * sum(edge);
     let mut sums = StepSums {
         kinetic: form(mi, 0, 1),
         potential: form(ri, 2, 3),
@@ -1085,4 +1078,48 @@ fn potential_of_difference(stiffness: &SymTridiag, u: &[f64], w: &[f64]) -> f64 
         q -= stiffness.off[i] * d * d;
     }
     q
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Relative difference allowed between the two summation orders of `n` terms: each sum
+    /// carries at most about `n ε` of its absolute-value sum.
+    fn sum_tol(n: usize) -> f64 {
+        4.0 * n as f64 * f64::EPSILON
+    }
+
+    /// The uniform-mesh energy sums (two lanes, R's zero node sums skipped) agree with the
+    /// row-by-row kernel, for even and odd node counts (the pair loop has a tail).
+    #[test]
+    fn uniform_and_row_energy_sums_agree() {
+        for n in [2usize, 3, 4, 5, 6, 7, 50, 51] {
+            let dx = 1.0 / (n - 1) as f64;
+            let m = matrices::mass(matrices::MatrixVariant::Consistent, n, dx);
+            let r = matrices::stiffness(matrices::MatrixVariant::Consistent, n, dx);
+            let k = m.uniform().zip(r.uniform()).expect("a uniform mesh");
+            let v = |a: f64| {
+                (0..n)
+                    .map(|i| (a * i as f64 + 0.3).sin())
+                    .collect::<Vec<_>>()
+            };
+            let (u, z, w, f) = (v(0.7), v(1.3), v(2.1), v(0.4));
+            let uniform = measure::<true, Uniform>(&m, &r, k, &u, &z, &w, &f);
+            let rows = measure::<true, _>(&m, &r, (m.rows(), r.rows()), &u, &z, &w, &f);
+            let pairs = [
+                (uniform.kinetic, rows.kinetic),
+                (uniform.potential, rows.potential),
+                (uniform.viscous, rows.viscous),
+                (uniform.work, rows.work),
+            ];
+            for (p, q) in pairs {
+                // Scale: the sums of |terms| are at most of the size of the quadratic forms of
+                // |x| under |A|, bounded here by ‖A‖∞ max|x|² n.
+                let scale = (m.inf_norm() + r.inf_norm()) * 4.0 * n as f64;
+                assert!((p - q).abs() <= sum_tol(n) * scale, "n = {n}: {p} vs {q}");
+            }
+            assert!(uniform.kinetic != 0.0 && uniform.potential != 0.0);
+        }
+    }
 }

@@ -50,6 +50,18 @@ impl SymTridiag {
         SymTridiag::new(mix(&x.diag, &y.diag), mix(&x.off, &y.off))
     }
 
+    /// `‖A‖∞`, the largest absolute row sum.
+    pub fn inf_norm(&self) -> f64 {
+        let n = self.dim();
+        (0..n)
+            .map(|i| {
+                let left = if i > 0 { self.off[i - 1].abs() } else { 0.0 };
+                let right = if i + 1 < n { self.off[i].abs() } else { 0.0 };
+                left + self.diag[i].abs() + right
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// The principal sub-matrix on rows and columns `first..=last`.
     pub fn sub(&self, first: usize, last: usize) -> SymTridiag {
         SymTridiag::new(
@@ -152,7 +164,9 @@ impl SymTridiag {
 /// The interior rows (`1..n−1`) of a symmetric tridiagonal matrix as the per-step kernels read
 /// them: the row sum `s_i` and the off-diagonals `e_{i−1}`, `e_i`. [`Rows`] reads them from the
 /// matrix; [`Uniform`] holds the two numbers of a uniform mesh, so the kernels stream no
-/// coefficient vectors (same values, same bits).
+/// coefficient vectors. The right-hand side gets the same bits either way; the energy sums
+/// do not (the uniform kernel sums in two lanes and scales once), and agree to round-off
+/// (`simulation::tests::uniform_and_row_energy_sums_agree`).
 ///
 /// Quadratic forms over the interior are accumulated as `Σ ws_i x_i²` and `Σ we_i (Δx_i)²` and
 /// scaled at the end: per row (`ws = s`, `we = e`, scales 1) or, on a uniform mesh, as plain
@@ -286,15 +300,7 @@ pub(crate) fn max4(m: [f64; 4]) -> f64 {
 pub fn backward_error(a: &SymTridiag, x: &[f64], b: &[f64]) -> f64 {
     let max_abs = |v: &[f64]| v.iter().fold(0.0f64, |m, w| m.max(w.abs()));
     let residual = (a.mul(x).iter().zip(b)).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
-    let n = a.dim();
-    let a_norm = (0..n)
-        .map(|i| {
-            let left = if i > 0 { a.off[i - 1].abs() } else { 0.0 };
-            let right = if i + 1 < n { a.off[i].abs() } else { 0.0 };
-            a.diag[i].abs() + left + right
-        })
-        .fold(0.0, f64::max);
-    let scale = a_norm * max_abs(x) + max_abs(b);
+    let scale = a.inf_norm() * max_abs(x) + max_abs(b);
     if scale == 0.0 {
         0.0
     } else {

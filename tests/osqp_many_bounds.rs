@@ -45,13 +45,7 @@ fn max_abs(v: &[f64]) -> f64 {
 /// Round-off in a recomputed `(Cz − b)_i`: the audit's floor, [`ROUNDOFF_ULPS`] ulps of the
 /// magnitude of the terms.
 fn residual_floor(c: &SymTridiag, b: &[f64], z: &[f64]) -> f64 {
-    let c_norm = (0..c.dim())
-        .map(|i| {
-            let left = if i > 0 { c.off[i - 1].abs() } else { 0.0 };
-            let right = if i + 1 < c.dim() { c.off[i].abs() } else { 0.0 };
-            left + c.diag[i] + right
-        })
-        .fold(0.0, f64::max);
+    let c_norm = c.inf_norm();
     ROUNDOFF_ULPS * f64::EPSILON * (c_norm * max_abs(z) + max_abs(b))
 }
 

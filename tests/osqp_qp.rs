@@ -27,14 +27,7 @@ fn tolerances(c: &SymTridiag, b: &[f64], z: &[f64], r: &[f64]) -> (f64, f64) {
     let t_z = eps * (1.0 + norm(z));
     let t_f = eps * (1.0 + s_f);
     let tol_z = 2.0 * (t_z + t_f / common::MIN_MARGIN);
-    let n = c.dim();
-    let c_norm = (0..n)
-        .map(|i| {
-            let left = if i > 0 { c.off[i - 1].abs() } else { 0.0 };
-            let right = if i + 1 < n { c.off[i].abs() } else { 0.0 };
-            left + c.diag[i] + right
-        })
-        .fold(0.0, f64::max);
+    let c_norm = c.inf_norm();
     (tol_z, c_norm * tol_z + t_f)
 }
 
