@@ -21,6 +21,7 @@
 //! reactions `r_A = (Cz − b)_A`; the reduced matrices of the three non-empty active sets are
 //! factorised once per run.
 
+use crate::dispatch;
 use crate::solver::{SolveInfo, StepFailure, StepSolver};
 use crate::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag, add_in_place, max4};
 
@@ -437,8 +438,8 @@ impl ExactSolver {
             let (u, z) = (&mut u[a..b], &mut z[a..b]);
             let m = match (terms.next(), terms.next()) {
                 (None, _) => add_in_place(u, z),
-                (Some((r, c)), None) => add_column(u, z, r, c),
-                (Some((r, c)), Some((r2, c2))) => add_pair(u, z, r, c, r2, c2),
+                (Some((r, c)), None) => dispatch::run(AddColumn(u, z, r, c)),
+                (Some((r, c)), Some((r2, c2))) => dispatch::run(AddPair(u, z, (r, c), (r2, c2))),
             };
             max_abs = max_abs.max(m);
         }
@@ -453,8 +454,38 @@ impl ExactSolver {
     }
 }
 
+/// [`add_column`] with its arguments, for [`dispatch::run`] (AVX when the CPU has it, same
+/// bits: element-wise operations and an exact maximum).
+struct AddColumn<'a>(&'a mut [f64], &'a mut [f64], f64, &'a [f64]);
+
+impl dispatch::Kernel for AddColumn<'_> {
+    type Output = f64;
+    #[inline(always)]
+    fn call(self) -> f64 {
+        add_column(self.0, self.1, self.2, self.3)
+    }
+}
+
+/// [`add_pair`] with its arguments, for [`dispatch::run`].
+struct AddPair<'a>(
+    &'a mut [f64],
+    &'a mut [f64],
+    (f64, &'a [f64]),
+    (f64, &'a [f64]),
+);
+
+impl dispatch::Kernel for AddPair<'_> {
+    type Output = f64;
+    #[inline(always)]
+    fn call(self) -> f64 {
+        let (u, z, (r, a), (r2, b)) = (self.0, self.1, self.2, self.3);
+        add_pair(u, z, r, a, r2, b)
+    }
+}
+
 /// `z += r a`, then `u += z`; returns `max|u|` (the bits of [`Column::add_scaled`] and
 /// [`add_in_place`]).
+#[inline(always)]
 fn add_column(u: &mut [f64], z: &mut [f64], r: f64, a: &[f64]) -> f64 {
     let mut m = [0.0f64; 4];
     let (mut uc, mut zc, mut ac) = (
@@ -484,6 +515,7 @@ fn add_column(u: &mut [f64], z: &mut [f64], r: f64, a: &[f64]) -> f64 {
 
 /// `z = (z + r a) + r2 b`, then `u += z`; returns `max|u|` (the bits of
 /// [`Column::add_scaled_pair`] and [`add_in_place`]).
+#[inline(always)]
 fn add_pair(u: &mut [f64], z: &mut [f64], r: f64, a: &[f64], r2: f64, b: &[f64]) -> f64 {
     let mut m = [0.0f64; 4];
     let (mut uc, mut zc) = (u.chunks_exact_mut(4), z.chunks_exact_mut(4));

@@ -25,6 +25,7 @@ pub mod audit;
 pub mod closed_form;
 pub mod compare;
 pub mod converge;
+pub mod dispatch;
 pub mod error;
 pub mod exact;
 pub mod expr;

@@ -21,6 +21,7 @@
 //! where the contact term `½ r·δ = −½ r_j (u^{n−1}_j + a_j) <= 0` by complementarity.
 
 use crate::active_set::BlockPivotSolver;
+use crate::dispatch;
 use crate::error::{RunError, SceneError};
 use crate::exact::ExactSolver;
 use crate::expr::Expression;
@@ -866,15 +867,9 @@ fn row_of(a: &SymTridiag, x: impl Fn(usize) -> f64, i: usize, n: usize) -> f64 {
     r
 }
 
-/// The same row for an interior `i` (both neighbours exist), without branches.
-#[inline(always)]
-fn inner_row_of(a: impl Interior, x: impl Fn(usize) -> f64, i: usize) -> f64 {
-    let xi = x(i);
-    a.s(i) * xi + a.e(i - 1) * (x(i - 1) - xi) + a.e(i) * (x(i + 1) - xi)
-}
-
 /// `b = F + M w/Δt² + R ((½ − α/(2Δt)) w − u)` in one pass, both products in difference form.
-/// The interior loop has no branch, so it vectorises; `LOAD = false` skips the force.
+/// The interior rows are [`rhs_interior`], run through [`dispatch::run`]; `LOAD = false` skips
+/// the force.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn rhs_into<const LOAD: bool, K: Interior>(
@@ -893,16 +888,82 @@ fn rhs_into<const LOAD: bool, K: Interior>(
     let force = if LOAD { &force[..n] } else { &[][..] };
     let y = |i: usize| c_w * w[i] - u[i];
     let wi = |i: usize| w[i];
-    let finish = |i: usize, ry: f64, mw: f64| {
-        let b = ry + mw * inv_dt2;
-        if LOAD { b + force[i] } else { b }
-    };
     for i in [0, n.saturating_sub(1)].into_iter().take(n.min(2)) {
-        rhs[i] = finish(i, row_of(stiffness, y, i, n), row_of(mass, wi, i, n));
+        let b = row_of(stiffness, y, i, n) + row_of(mass, wi, i, n) * inv_dt2;
+        rhs[i] = if LOAD { b + force[i] } else { b };
     }
-    #[allow(clippy::needless_range_loop)] // a stencil: rows i − 1, i, i + 1
-    for i in 1..n.saturating_sub(1) {
-        rhs[i] = finish(i, inner_row_of(ri, y, i), inner_row_of(mi, wi, i));
+    if n < 3 {
+        return;
+    }
+    // R's interior rows sum to exactly 0 on a uniform mesh: its node term is then left out.
+    let args = (mi, ri, c_w, inv_dt2, u, w, force, rhs);
+    if K::UNIFORM && ri.s(1) == 0.0 {
+        dispatch::run(RhsInterior::<LOAD, false, K>(args))
+    } else {
+        dispatch::run(RhsInterior::<LOAD, true, K>(args))
+    }
+}
+
+/// [`rhs_interior`] with its arguments, for [`dispatch::run`].
+struct RhsInterior<'a, const LOAD: bool, const S_R: bool, K>(
+    (
+        K,
+        K,
+        f64,
+        f64,
+        &'a [f64],
+        &'a [f64],
+        &'a [f64],
+        &'a mut [f64],
+    ),
+);
+
+impl<const LOAD: bool, const S_R: bool, K: Interior> dispatch::Kernel
+    for RhsInterior<'_, LOAD, S_R, K>
+{
+    type Output = ();
+    #[inline(always)]
+    fn call(self) {
+        let (mi, ri, c_w, inv_dt2, u, w, force, rhs) = self.0;
+        rhs_interior::<LOAD, S_R, K>(mi, ri, c_w, inv_dt2, u, w, force, rhs)
+    }
+}
+
+/// The interior rows `1..n−1` of [`rhs_into`] (`n >= 3`). Row `i` of `A x` in difference form
+/// is `s_i x_i + A_i,i−1 (x_i−1 − x_i) + A_i,i+1 (x_i+1 − x_i) = (s_i x_i − g_i−1) + g_i` with the
+/// edge flux `g_i = A_i,i+1 (x_i+1 − x_i)`: the same bits as [`row_of`] (negation is exact),
+/// but each flux is computed once, for the two rows it enters, and carried to the next row.
+/// `S_R = false` drops `s_i y_i` from the stiffness rows (for `s_i = 0`; only the sign of a
+/// zero result can differ). No branch in the loop, so it vectorises, carried values included.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn rhs_interior<const LOAD: bool, const S_R: bool, K: Interior>(
+    mi: K,
+    ri: K,
+    c_w: f64,
+    inv_dt2: f64,
+    u: &[f64],
+    w: &[f64],
+    force: &[f64],
+    rhs: &mut [f64],
+) {
+    let n = rhs.len();
+    let y = |i: usize| c_w * w[i] - u[i];
+    let (mut y_i, mut w_i) = (y(1), w[1]);
+    let mut g_y = ri.e(0) * (y_i - y(0));
+    let mut g_w = mi.e(0) * (w_i - w[0]);
+    for i in 1..n - 1 {
+        let (y_next, w_next) = (y(i + 1), w[i + 1]);
+        let (g_y_next, g_w_next) = (ri.e(i) * (y_next - y_i), mi.e(i) * (w_next - w_i));
+        let ry = if S_R {
+            (ri.s(i) * y_i - g_y) + g_y_next
+        } else {
+            g_y_next - g_y
+        };
+        let mw = (mi.s(i) * w_i - g_w) + g_w_next;
+        let b = ry + mw * inv_dt2;
+        rhs[i] = if LOAD { b + force[i] } else { b };
+        (y_i, w_i, g_y, g_w) = (y_next, w_next, g_y_next, g_w_next);
     }
 }
 
@@ -998,70 +1059,151 @@ fn measure<const LOAD: bool, K: Interior>(
     sums
 }
 
+/// Lanes of the energy sums: row `i` adds into lane `(i − 1) mod LANES`.
+const LANES: usize = 4;
+
+/// Running sums of [`uniform_measure`], lane by lane.
+type Lanes = [[f64; LANES]; 7];
+
 /// The interior sums of [`measure`] on a uniform mesh (weights 1): `Σ z_i²`, `Σ (Δz_i)²`,
 /// `Σ u_i²`, `Σ (Δu_i)²`, `Σ d_i²`, `Σ (Δd_i)²`, `Σ F_i d_i` over `i = 1..n−1` with `d = z + w`,
-/// `Δx_i = x_{i+1} − x_i`. Two lanes per sum (even and odd rows, added at the end: a fixed
-/// order, so deterministic), which map onto two-lane vector instructions and halve the
-/// additions' dependency chains; `S_R = false` skips `Σ u_i²` and `Σ d_i²` (left 0).
-#[inline(always)]
+/// `Δx_i = x_{i+1} − x_i`. [`LANES`] lanes per sum, added at the end in a fixed order, which
+/// shortens the additions' dependency chains; `S_R = false` skips `Σ u_i²` and `Σ d_i²` (left
+/// 0). The whole blocks of [`LANES`] rows run as AVX vector instructions when the CPU has
+/// them ([`measure_blocks_avx`]: the compiler does not vectorise this loop by itself, the
+/// overlapping loads of rows `i` and `i + 1` defeat it), with the same bits as the portable
+/// [`measure_blocks`] (see [`dispatch`]).
 fn uniform_measure<const LOAD: bool, const S_R: bool>(
     u: &[f64],
     z: &[f64],
     w: &[f64],
     force: &[f64],
 ) -> [f64; 7] {
-    let n = u.len();
-    let rows = n.saturating_sub(2);
-    let pairs = rows / 2;
-    let mut acc = [[0.0f64; 2]; 7];
-    let add = |acc: &mut [[f64; 2]; 7],
-               lane: usize,
-               zi: f64,
-               ui: f64,
-               di: f64,
-               zn: f64,
-               un: f64,
-               dn: f64,
-               f: f64| {
-        let (dz, du, dd) = (zn - zi, un - ui, dn - di);
-        acc[0][lane] += zi * zi;
-        acc[1][lane] += dz * dz;
-        if S_R {
-            acc[2][lane] += ui * ui;
-            acc[4][lane] += di * di;
-        }
-        acc[3][lane] += du * du;
-        acc[5][lane] += dd * dd;
-        if LOAD {
-            acc[6][lane] += f * di;
-        }
+    let blocks = u.len().saturating_sub(2) / LANES;
+    #[cfg(target_arch = "x86_64")]
+    let mut acc = if dispatch::has_avx() {
+        // SAFETY: the CPU supports AVX.
+        unsafe { measure_blocks_avx::<LOAD, S_R>(u, z, w, force, blocks) }
+    } else {
+        measure_blocks::<LOAD, S_R>(u, z, w, force, blocks)
     };
-    if pairs > 0 {
-        let f_rows = if LOAD { &force[1..] } else { &z[1..] };
-        let here = (z[1..].chunks_exact(2).zip(u[1..].chunks_exact(2))).zip(w[1..].chunks_exact(2));
-        let ahead =
-            (z[2..].chunks_exact(2).zip(u[2..].chunks_exact(2))).zip(w[2..].chunks_exact(2));
-        for ((((zh, uh), wh), ((za, ua), wa)), f) in
-            here.zip(ahead).zip(f_rows.chunks_exact(2)).take(pairs)
-        {
-            let (dh, da) = (
-                [zh[0] + wh[0], zh[1] + wh[1]],
-                [za[0] + wa[0], za[1] + wa[1]],
-            );
-            for lane in 0..2 {
-                add(
-                    &mut acc, lane, zh[lane], uh[lane], dh[lane], za[lane], ua[lane], da[lane],
-                    f[lane],
-                );
-            }
+    #[cfg(not(target_arch = "x86_64"))]
+    let mut acc = measure_blocks::<LOAD, S_R>(u, z, w, force, blocks);
+    measure_tail::<LOAD, S_R>(u, z, w, force, 1 + LANES * blocks, &mut acc);
+    acc.map(|[a, b, c, d]| (a + b) + (c + d))
+}
+
+/// One row `i` of the sums into `lane`.
+#[inline(always)]
+fn measure_row<const LOAD: bool, const S_R: bool>(
+    acc: &mut Lanes,
+    lane: usize,
+    (u, z, w, force): (&[f64], &[f64], &[f64], &[f64]),
+    i: usize,
+) {
+    let (zi, ui, di) = (z[i], u[i], z[i] + w[i]);
+    let (dz, du, dd) = (z[i + 1] - zi, u[i + 1] - ui, (z[i + 1] + w[i + 1]) - di);
+    acc[0][lane] += zi * zi;
+    acc[1][lane] += dz * dz;
+    if S_R {
+        acc[2][lane] += ui * ui;
+        acc[4][lane] += di * di;
+    }
+    acc[3][lane] += du * du;
+    acc[5][lane] += dd * dd;
+    if LOAD {
+        acc[6][lane] += force[i] * di;
+    }
+}
+
+/// Rows `1..1 + LANES · blocks` of [`uniform_measure`], portable.
+fn measure_blocks<const LOAD: bool, const S_R: bool>(
+    u: &[f64],
+    z: &[f64],
+    w: &[f64],
+    force: &[f64],
+    blocks: usize,
+) -> Lanes {
+    let mut acc = [[0.0; LANES]; 7];
+    for i in (1..1 + LANES * blocks).step_by(LANES) {
+        for lane in 0..LANES {
+            measure_row::<LOAD, S_R>(&mut acc, lane, (u, z, w, force), i + lane);
         }
     }
-    for i in 1 + 2 * pairs..n.saturating_sub(1) {
-        let f = if LOAD { force[i] } else { 0.0 };
-        let (di, dn) = (z[i] + w[i], z[i + 1] + w[i + 1]);
-        add(&mut acc, 0, z[i], u[i], di, z[i + 1], u[i + 1], dn, f);
+    acc
+}
+
+/// Rows from `first` to `n − 2` (fewer than [`LANES`]), one per lane.
+fn measure_tail<const LOAD: bool, const S_R: bool>(
+    u: &[f64],
+    z: &[f64],
+    w: &[f64],
+    force: &[f64],
+    first: usize,
+    acc: &mut Lanes,
+) {
+    for (lane, i) in (first..u.len().saturating_sub(1)).enumerate() {
+        measure_row::<LOAD, S_R>(acc, lane, (u, z, w, force), i);
     }
-    acc.map(|[even, odd]| even + odd)
+}
+
+/// [`measure_blocks`] in AVX instructions: each lane's sums see the same operations in the
+/// same order, so the bits are the same.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+fn measure_blocks_avx<const LOAD: bool, const S_R: bool>(
+    u: &[f64],
+    z: &[f64],
+    w: &[f64],
+    force: &[f64],
+    blocks: usize,
+) -> Lanes {
+    use std::arch::x86_64::{
+        __m256d, _mm256_add_pd, _mm256_loadu_pd, _mm256_mul_pd, _mm256_setzero_pd,
+        _mm256_storeu_pd, _mm256_sub_pd,
+    };
+    let end = 1 + LANES * blocks;
+    let (u, z, w) = (&u[..end + 1], &z[..end + 1], &w[..end + 1]);
+    let force = if LOAD { &force[..end] } else { &[][..] };
+    // Four entries from `i`, bounds-checked (the loop's indices stay below `end + 1`). Macros,
+    // not closures: a closure is not compiled for AVX, and a vector it returns would go
+    // through memory.
+    macro_rules! load {
+        ($x:expr, $i:expr) => {{
+            let four: &[f64; LANES] = $x[$i..$i + LANES].try_into().expect("four entries");
+            // SAFETY: `four` is four readable doubles; unaligned loads are allowed.
+            unsafe { _mm256_loadu_pd(four.as_ptr()) }
+        }};
+    }
+    macro_rules! square_into {
+        ($acc:expr, $x:expr) => {{
+            let x: __m256d = $x;
+            $acc = _mm256_add_pd($acc, _mm256_mul_pd(x, x));
+        }};
+    }
+    let mut acc = [_mm256_setzero_pd(); 7];
+    for i in (1..end).step_by(LANES) {
+        let (zh, uh, wh) = (load!(z, i), load!(u, i), load!(w, i));
+        let (za, ua, wa) = (load!(z, i + 1), load!(u, i + 1), load!(w, i + 1));
+        let (dh, da) = (_mm256_add_pd(zh, wh), _mm256_add_pd(za, wa));
+        square_into!(acc[0], zh);
+        square_into!(acc[1], _mm256_sub_pd(za, zh));
+        if S_R {
+            square_into!(acc[2], uh);
+            square_into!(acc[4], dh);
+        }
+        square_into!(acc[3], _mm256_sub_pd(ua, uh));
+        square_into!(acc[5], _mm256_sub_pd(da, dh));
+        if LOAD {
+            acc[6] = _mm256_add_pd(acc[6], _mm256_mul_pd(load!(force, i), dh));
+        }
+    }
+    let mut sums = [[0.0; LANES]; 7];
+    for (lanes, v) in sums.iter_mut().zip(acc) {
+        // SAFETY: `lanes` has room for four doubles.
+        unsafe { _mm256_storeu_pd(lanes.as_mut_ptr(), v) };
+    }
+    sums
 }
 
 /// `|u − w|²_R` in difference form (`u^{n−1} = u^n − w` for a step whose predecessor was not
@@ -1090,11 +1232,11 @@ mod tests {
         4.0 * n as f64 * f64::EPSILON
     }
 
-    /// The uniform-mesh energy sums (two lanes, R's zero node sums skipped) agree with the
-    /// row-by-row kernel, for even and odd node counts (the pair loop has a tail).
+    /// The uniform-mesh energy sums (four lanes, R's zero node sums skipped) agree with the
+    /// row-by-row kernel, for every tail length of the four-lane loop.
     #[test]
     fn uniform_and_row_energy_sums_agree() {
-        for n in [2usize, 3, 4, 5, 6, 7, 50, 51] {
+        for n in [2usize, 3, 4, 5, 6, 7, 50, 51, 52, 53] {
             let dx = 1.0 / (n - 1) as f64;
             let m = matrices::mass(matrices::MatrixVariant::Consistent, n, dx);
             let r = matrices::stiffness(matrices::MatrixVariant::Consistent, n, dx);
@@ -1120,6 +1262,71 @@ mod tests {
                 assert!((p - q).abs() <= sum_tol(n) * scale, "n = {n}: {p} vs {q}");
             }
             assert!(uniform.kinetic != 0.0 && uniform.potential != 0.0);
+        }
+    }
+
+    /// The AVX and the baseline builds of the streaming kernels give the same bits (see
+    /// [`dispatch`]), on data with large common parts and tiny differences (the rigid-like
+    /// motion where round-off would show), for every tail length of the vector loops.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn kernels_give_the_same_bits_with_and_without_avx() {
+        if !dispatch::has_avx() {
+            eprintln!("this CPU has no AVX: only the baseline build runs, nothing to compare");
+            return;
+        }
+        for n in [3usize, 4, 5, 6, 7, 8, 9, 10, 101, 1002] {
+            let dx = 1.0 / (n - 1) as f64;
+            let m = matrices::mass(matrices::MatrixVariant::Consistent, n, dx);
+            let r = matrices::stiffness(matrices::MatrixVariant::Consistent, n, dx);
+            let k = m.uniform().zip(r.uniform()).expect("a uniform mesh");
+            let v = |a: f64, offset: f64, amp: f64| {
+                (0..n)
+                    .map(|i| offset + amp * (a * i as f64 + 0.3).sin())
+                    .collect::<Vec<_>>()
+            };
+            let (u, z, w, f) = (
+                v(0.7, 1e3, 1e-6),
+                v(1.3, 0.0, 1.0),
+                v(2.1, 1e-2, 1e-9),
+                v(0.4, -1.0, 0.1),
+            );
+            let (c_w, inv_dt2): (f64, f64) = (-4999.5, 1.0 / (dx * dx));
+            let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            for s_r in [false, true] {
+                let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+                let (ki, ui, wi, fi) = (k, &u[..], &w[..], &f[..]);
+                macro_rules! both {
+                    ($s:literal) => {
+                        dispatch::baseline(RhsInterior::<true, $s, Uniform>((
+                            ki.0, ki.1, c_w, inv_dt2, ui, wi, fi, &mut a,
+                        )));
+                        dispatch::run(RhsInterior::<true, $s, Uniform>((
+                            ki.0, ki.1, c_w, inv_dt2, ui, wi, fi, &mut b,
+                        )));
+                    };
+                }
+                if s_r {
+                    both!(true);
+                } else {
+                    both!(false);
+                }
+                assert_eq!(bits(&a), bits(&b), "rhs, n = {n}, s_R {s_r}");
+                let blocks = (n - 2) / LANES;
+                let (p, q) = if s_r {
+                    let portable = measure_blocks::<true, true>(&u, &z, &w, &f, blocks);
+                    // SAFETY: the CPU has AVX (checked above).
+                    let avx = unsafe { measure_blocks_avx::<true, true>(&u, &z, &w, &f, blocks) };
+                    (portable, avx)
+                } else {
+                    let portable = measure_blocks::<true, false>(&u, &z, &w, &f, blocks);
+                    // SAFETY: the CPU has AVX (checked above).
+                    let avx = unsafe { measure_blocks_avx::<true, false>(&u, &z, &w, &f, blocks) };
+                    (portable, avx)
+                };
+                let (p, q) = (p.concat(), q.concat());
+                assert_eq!(bits(&p), bits(&q), "energy sums, n = {n}, s_R {s_r}");
+            }
         }
     }
 }

@@ -4,6 +4,7 @@
 //! matrix-vector product, quadratic forms and a factorisation computed once per run and reused
 //! for every step.
 
+use crate::dispatch;
 use std::cell::Cell;
 use std::sync::Arc;
 
@@ -165,7 +166,7 @@ impl SymTridiag {
 /// them: the row sum `s_i` and the off-diagonals `e_{i−1}`, `e_i`. [`Rows`] reads them from the
 /// matrix; [`Uniform`] holds the two numbers of a uniform mesh, so the kernels stream no
 /// coefficient vectors. The right-hand side gets the same bits either way; the energy sums
-/// do not (the uniform kernel sums in two lanes and scales once), and agree to round-off
+/// do not (the uniform kernel sums in four lanes and scales once), and agree to round-off
 /// (`simulation::tests::uniform_and_row_energy_sums_agree`).
 ///
 /// Quadratic forms over the interior are accumulated as `Σ ws_i x_i²` and `Σ we_i (Δx_i)²` and
@@ -271,9 +272,25 @@ impl SymTridiag {
 }
 
 /// `u += z`, returning the new `max_i |u_i|` (four running maxima, so the loop vectorises;
-/// the maximum is exact, so the order does not change the bits).
-#[inline(never)]
+/// the maximum is exact, so the order does not change the bits). Run through
+/// [`dispatch::run`] (AVX when the CPU has it, same bits).
 pub fn add_in_place(u: &mut [f64], z: &[f64]) -> f64 {
+    dispatch::run(AddInPlace(u, z))
+}
+
+/// [`add_in_place`] with its arguments, for [`dispatch::run`].
+struct AddInPlace<'a>(&'a mut [f64], &'a [f64]);
+
+impl dispatch::Kernel for AddInPlace<'_> {
+    type Output = f64;
+    #[inline(always)]
+    fn call(self) -> f64 {
+        add_in_place_kernel(self.0, self.1)
+    }
+}
+
+#[inline(always)]
+fn add_in_place_kernel(u: &mut [f64], z: &[f64]) -> f64 {
     let mut m = [0.0f64; 4];
     let (mut uc, mut zc) = (u.chunks_exact_mut(4), z.chunks_exact(4));
     for (u4, z4) in (&mut uc).zip(&mut zc) {

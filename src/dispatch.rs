@@ -1,0 +1,56 @@
+//! The instruction set of the per-step streaming kernels, chosen at run time.
+//!
+//! The build targets baseline x86-64 (SSE2, two doubles per vector) and uses no target-cpu
+//! flags. The right-hand side, energy-sum and update kernels are throughput bound, so on a
+//! CPU with AVX [`run`] executes them compiled for AVX (four doubles per vector). The bits do
+//! not change: AVX without FMA performs the same IEEE operations in the same order (Rust never
+//! contracts `a * b + c` into a fused multiply-add), and every sum has its lane order fixed in
+//! the source, so the compiler's choice of vector width cannot reorder it.
+//! `simulation::tests::kernels_give_the_same_bits_with_and_without_avx` and
+//! `tridiag::tests::updates_give_the_same_bits_with_and_without_avx` check this.
+
+/// A streaming kernel with its arguments. `call` must be `#[inline(always)]`: it is then
+/// compiled into each caller, including the AVX one (a closure would be compiled once, for
+/// the baseline, and called from there).
+pub(crate) trait Kernel {
+    type Output;
+    fn call(self) -> Self::Output;
+}
+
+/// Runs `kernel`, compiled for AVX when the CPU has it (detected once; std caches the
+/// answer), else as built.
+#[inline(always)]
+pub(crate) fn run<K: Kernel>(kernel: K) -> K::Output {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx") {
+        // SAFETY: the CPU supports AVX, the only feature `with_avx` enables.
+        return unsafe { with_avx(kernel) };
+    }
+    kernel.call()
+}
+
+/// Runs `kernel` as built (baseline instruction set): for tests comparing the two paths.
+#[cfg(test)]
+#[inline(never)]
+pub(crate) fn baseline<K: Kernel>(kernel: K) -> K::Output {
+    kernel.call()
+}
+
+/// Whether [`run`] takes the AVX path on this CPU.
+pub fn has_avx() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+#[inline(never)]
+unsafe fn with_avx<K: Kernel>(kernel: K) -> K::Output {
+    kernel.call()
+}
