@@ -21,9 +21,10 @@
 //! reactions `r_A = (Cz − b)_A`; the reduced matrices of the three non-empty active sets are
 //! factorised once per run.
 
-use crate::dispatch;
 use crate::solver::{SolveInfo, StepFailure, StepSolver};
-use crate::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag, add_in_place, max4};
+use crate::tridiag::{
+    Ldlt, NotPositiveDefinite, SymTridiag, add_columns_in_place, add_in_place, max4,
+};
 
 /// Largest cancellation `max|z⁰| / max(|z|, |u^n|)` over the columns' support accepted from
 /// the superposition `z⁰ + Σ r_j c_j`: its rounding error is about `ε max|z⁰|`, i.e. this many
@@ -438,8 +439,8 @@ impl ExactSolver {
             let (u, z) = (&mut u[a..b], &mut z[a..b]);
             let m = match (terms.next(), terms.next()) {
                 (None, _) => add_in_place(u, z),
-                (Some((r, c)), None) => dispatch::run(AddColumn(u, z, r, c)),
-                (Some((r, c)), Some((r2, c2))) => dispatch::run(AddPair(u, z, (r, c), (r2, c2))),
+                (Some((r, c)), None) => add_columns_in_place(u, z, [(r, c)]),
+                (Some((r, c)), Some(t)) => add_columns_in_place(u, z, [(r, c), t]),
             };
             max_abs = max_abs.max(m);
         }
@@ -452,89 +453,6 @@ impl ExactSolver {
         }
         Some(max_abs)
     }
-}
-
-/// [`add_column`] with its arguments, for [`dispatch::run`] (AVX when the CPU has it, same
-/// bits: element-wise operations and an exact maximum).
-struct AddColumn<'a>(&'a mut [f64], &'a mut [f64], f64, &'a [f64]);
-
-impl dispatch::Kernel for AddColumn<'_> {
-    type Output = f64;
-    #[inline(always)]
-    fn call(self) -> f64 {
-        add_column(self.0, self.1, self.2, self.3)
-    }
-}
-
-/// [`add_pair`] with its arguments, for [`dispatch::run`].
-struct AddPair<'a>(
-    &'a mut [f64],
-    &'a mut [f64],
-    (f64, &'a [f64]),
-    (f64, &'a [f64]),
-);
-
-impl dispatch::Kernel for AddPair<'_> {
-    type Output = f64;
-    #[inline(always)]
-    fn call(self) -> f64 {
-        let (u, z, (r, a), (r2, b)) = (self.0, self.1, self.2, self.3);
-        add_pair(u, z, r, a, r2, b)
-    }
-}
-
-/// `z += r a`, then `u += z`; returns `max|u|` (the bits of [`Column::add_scaled`] and
-/// [`add_in_place`]).
-#[inline(always)]
-fn add_column(u: &mut [f64], z: &mut [f64], r: f64, a: &[f64]) -> f64 {
-    let mut m = [0.0f64; 4];
-    let (mut uc, mut zc, mut ac) = (
-        u.chunks_exact_mut(4),
-        z.chunks_exact_mut(4),
-        a.chunks_exact(4),
-    );
-    for ((u4, z4), a4) in (&mut uc).zip(&mut zc).zip(&mut ac) {
-        for k in 0..4 {
-            z4[k] += r * a4[k];
-            u4[k] += z4[k];
-            m[k] = m[k].max(u4[k].abs());
-        }
-    }
-    let rest = uc
-        .into_remainder()
-        .iter_mut()
-        .zip(zc.into_remainder())
-        .zip(ac.remainder());
-    for ((ui, zi), ai) in rest {
-        *zi += r * ai;
-        *ui += *zi;
-        m[0] = m[0].max(ui.abs());
-    }
-    max4(m)
-}
-
-/// `z = (z + r a) + r2 b`, then `u += z`; returns `max|u|` (the bits of
-/// [`Column::add_scaled_pair`] and [`add_in_place`]).
-#[inline(always)]
-fn add_pair(u: &mut [f64], z: &mut [f64], r: f64, a: &[f64], r2: f64, b: &[f64]) -> f64 {
-    let mut m = [0.0f64; 4];
-    let (mut uc, mut zc) = (u.chunks_exact_mut(4), z.chunks_exact_mut(4));
-    let (mut ac, mut bc) = (a.chunks_exact(4), b.chunks_exact(4));
-    for (((u4, z4), a4), b4) in (&mut uc).zip(&mut zc).zip(&mut ac).zip(&mut bc) {
-        for k in 0..4 {
-            z4[k] = (z4[k] + r * a4[k]) + r2 * b4[k];
-            u4[k] += z4[k];
-            m[k] = m[k].max(u4[k].abs());
-        }
-    }
-    let rest = (uc.into_remainder().iter_mut().zip(zc.into_remainder()))
-        .zip(ac.remainder().iter().zip(bc.remainder()));
-    for ((ui, zi), (ai, bi)) in rest {
-        *zi = (*zi + r * ai) + r2 * bi;
-        *ui += *zi;
-        m[0] = m[0].max(ui.abs());
-    }
-    max4(m)
 }
 
 /// The reactions of active set `mask` (bit `j`: node `j`) from `m r = d` restricted to it
