@@ -417,6 +417,52 @@ impl ExactSolver {
             }
         }
         let first = first.min(end);
+        let live = |(_, r): (&Column, &f64)| *r != 0.0;
+        let covers =
+            |(col, _): (&Column, &f64)| col.support.start <= first && col.support.end >= end;
+        let mut max_abs = if (self.columns.iter().zip(reactions))
+            .filter(|&t| live(t))
+            .all(covers)
+        {
+            // Every column in play covers the whole range (the usual case: one piece).
+            let mut terms = (self.columns.iter().zip(reactions))
+                .filter(|&t| live(t))
+                .map(|(col, &r)| {
+                    (
+                        r,
+                        &col.values[first - col.support.start..end - col.support.start],
+                    )
+                });
+            let (u, z) = (&mut u[first..end], &mut z[first..end]);
+            match (terms.next(), terms.next()) {
+                (None, _) => add_in_place(u, z),
+                (Some(t), None) => add_columns_in_place(u, z, [t]),
+                (Some(t), Some(t2)) => add_columns_in_place(u, z, [t, t2]),
+            }
+        } else {
+            self.add_in_pieces(first, end, u, z, reactions)
+        };
+        for (j, col) in self.columns.iter().enumerate() {
+            if active(j) {
+                z[col.node] = lower[j];
+                u[col.node] += lower[j];
+                max_abs = max_abs.max(u[col.node].abs());
+            }
+        }
+        Some(max_abs)
+    }
+
+    /// The superposition and `u += z` over `first..end` for columns whose supports cut it
+    /// into pieces: each piece adds the columns it meets (see
+    /// [`ExactSolver::superpose_and_add`]); returns `max|u|` over the range.
+    fn add_in_pieces(
+        &self,
+        first: usize,
+        end: usize,
+        u: &mut [f64],
+        z: &mut [f64],
+        reactions: &[f64],
+    ) -> f64 {
         // Pieces of constant column set between consecutive cuts.
         let mut cuts = [first, end, first, end, first, end];
         for (k, col) in self.columns.iter().enumerate() {
@@ -444,14 +490,7 @@ impl ExactSolver {
             };
             max_abs = max_abs.max(m);
         }
-        for (j, col) in self.columns.iter().enumerate() {
-            if active(j) {
-                z[col.node] = lower[j];
-                u[col.node] += lower[j];
-                max_abs = max_abs.max(u[col.node].abs());
-            }
-        }
-        Some(max_abs)
+        max_abs
     }
 }
 
