@@ -1,11 +1,13 @@
 //! The instruction set of the per-step streaming kernels, chosen at run time.
 //!
 //! The build targets baseline x86-64 (SSE2, two doubles per vector) and uses no target-cpu
-//! flags. The right-hand side, energy-sum and update kernels are throughput bound, so on a
-//! CPU with AVX [`run`] executes them compiled for AVX (four doubles per vector). The bits do
-//! not change: AVX without FMA performs the same IEEE operations in the same order (Rust never
-//! contracts `a * b + c` into a fused multiply-add), and every sum has its lane order fixed in
-//! the source, so the compiler's choice of vector width cannot reorder it.
+//! flags. The right-hand side, the energy sums and the update `z += r c; u += z` are
+//! throughput bound, so on a CPU with AVX (four doubles per vector) they run as AVX code:
+//! the right-hand side through [`run`] (the compiler vectorises it), the other two as AVX
+//! intrinsics behind [`has_avx`] (the compiler does not vectorise them). The bits do not
+//! change: AVX without FMA performs the same IEEE operations in the same order (Rust never
+//! contracts `a * b + c` into a fused multiply-add), and every sum has its lane order fixed
+//! in the source, so the vector width cannot reorder it.
 //! `simulation::tests::kernels_give_the_same_bits_with_and_without_avx` and
 //! `tridiag::tests::updates_give_the_same_bits_with_and_without_avx` check this.
 

@@ -868,7 +868,7 @@ fn row_of(a: &SymTridiag, x: impl Fn(usize) -> f64, i: usize, n: usize) -> f64 {
 }
 
 /// `b = F + M w/Δt² + R ((½ − α/(2Δt)) w − u)` in one pass, both products in difference form.
-/// The interior rows are [`rhs_interior`], run through [`dispatch::run`]; `LOAD = false` skips
+/// The interior rows are [`RhsInterior`], run through [`dispatch::run`]; `LOAD = false` skips
 /// the force.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
@@ -896,27 +896,43 @@ fn rhs_into<const LOAD: bool, K: Interior>(
         return;
     }
     // R's interior rows sum to exactly 0 on a uniform mesh: its node term is then left out.
-    let args = (mi, ri, c_w, inv_dt2, u, w, force, rhs);
+    macro_rules! kernel {
+        ($s_r:literal) => {
+            RhsInterior::<LOAD, $s_r, K> {
+                coefficients: (mi, ri),
+                c_w,
+                inv_dt2,
+                u,
+                w,
+                force,
+                rhs,
+            }
+        };
+    }
     if K::UNIFORM && ri.s(1) == 0.0 {
-        dispatch::run(RhsInterior::<LOAD, false, K>(args))
+        dispatch::run(kernel!(false))
     } else {
-        dispatch::run(RhsInterior::<LOAD, true, K>(args))
+        dispatch::run(kernel!(true))
     }
 }
 
-/// [`rhs_interior`] with its arguments, for [`dispatch::run`].
-struct RhsInterior<'a, const LOAD: bool, const S_R: bool, K>(
-    (
-        K,
-        K,
-        f64,
-        f64,
-        &'a [f64],
-        &'a [f64],
-        &'a [f64],
-        &'a mut [f64],
-    ),
-);
+/// The interior rows of [`rhs_into`] with its arguments, for [`dispatch::run`].
+///
+/// Rows `1..n−1` (`n >= 3`). Row `i` of `A x` in difference form
+/// is `s_i x_i + A_i,i−1 (x_i−1 − x_i) + A_i,i+1 (x_i+1 − x_i) = (s_i x_i − g_i−1) + g_i` with the
+/// edge flux `g_i = A_i,i+1 (x_i+1 − x_i)`: the same bits as [`row_of`] (negation is exact),
+/// but each flux is computed once, for the two rows it enters, and carried to the next row.
+/// `S_R = false` drops `s_i y_i` from the stiffness rows (for `s_i = 0`; only the sign of a
+/// zero result can differ). No branch in the loop, so it vectorises, carried values included.
+struct RhsInterior<'a, const LOAD: bool, const S_R: bool, K> {
+    coefficients: (K, K),
+    c_w: f64,
+    inv_dt2: f64,
+    u: &'a [f64],
+    w: &'a [f64],
+    force: &'a [f64],
+    rhs: &'a mut [f64],
+}
 
 impl<const LOAD: bool, const S_R: bool, K: Interior> dispatch::Kernel
     for RhsInterior<'_, LOAD, S_R, K>
@@ -924,46 +940,33 @@ impl<const LOAD: bool, const S_R: bool, K: Interior> dispatch::Kernel
     type Output = ();
     #[inline(always)]
     fn call(self) {
-        let (mi, ri, c_w, inv_dt2, u, w, force, rhs) = self.0;
-        rhs_interior::<LOAD, S_R, K>(mi, ri, c_w, inv_dt2, u, w, force, rhs)
-    }
-}
-
-/// The interior rows `1..n−1` of [`rhs_into`] (`n >= 3`). Row `i` of `A x` in difference form
-/// is `s_i x_i + A_i,i−1 (x_i−1 − x_i) + A_i,i+1 (x_i+1 − x_i) = (s_i x_i − g_i−1) + g_i` with the
-/// edge flux `g_i = A_i,i+1 (x_i+1 − x_i)`: the same bits as [`row_of`] (negation is exact),
-/// but each flux is computed once, for the two rows it enters, and carried to the next row.
-/// `S_R = false` drops `s_i y_i` from the stiffness rows (for `s_i = 0`; only the sign of a
-/// zero result can differ). No branch in the loop, so it vectorises, carried values included.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn rhs_interior<const LOAD: bool, const S_R: bool, K: Interior>(
-    mi: K,
-    ri: K,
-    c_w: f64,
-    inv_dt2: f64,
-    u: &[f64],
-    w: &[f64],
-    force: &[f64],
-    rhs: &mut [f64],
-) {
-    let n = rhs.len();
-    let y = |i: usize| c_w * w[i] - u[i];
-    let (mut y_i, mut w_i) = (y(1), w[1]);
-    let mut g_y = ri.e(0) * (y_i - y(0));
-    let mut g_w = mi.e(0) * (w_i - w[0]);
-    for i in 1..n - 1 {
-        let (y_next, w_next) = (y(i + 1), w[i + 1]);
-        let (g_y_next, g_w_next) = (ri.e(i) * (y_next - y_i), mi.e(i) * (w_next - w_i));
-        let ry = if S_R {
-            (ri.s(i) * y_i - g_y) + g_y_next
-        } else {
-            g_y_next - g_y
-        };
-        let mw = (mi.s(i) * w_i - g_w) + g_w_next;
-        let b = ry + mw * inv_dt2;
-        rhs[i] = if LOAD { b + force[i] } else { b };
-        (y_i, w_i, g_y, g_w) = (y_next, w_next, g_y_next, g_w_next);
+        let Self {
+            coefficients: (mi, ri),
+            c_w,
+            inv_dt2,
+            u,
+            w,
+            force,
+            rhs,
+        } = self;
+        let n = rhs.len();
+        let y = |i: usize| c_w * w[i] - u[i];
+        let (mut y_i, mut w_i) = (y(1), w[1]);
+        let mut g_y = ri.e(0) * (y_i - y(0));
+        let mut g_w = mi.e(0) * (w_i - w[0]);
+        for i in 1..n - 1 {
+            let (y_next, w_next) = (y(i + 1), w[i + 1]);
+            let (g_y_next, g_w_next) = (ri.e(i) * (y_next - y_i), mi.e(i) * (w_next - w_i));
+            let ry = if S_R {
+                (ri.s(i) * y_i - g_y) + g_y_next
+            } else {
+                g_y_next - g_y
+            };
+            let mw = (mi.s(i) * w_i - g_w) + g_w_next;
+            let b = ry + mw * inv_dt2;
+            rhs[i] = if LOAD { b + force[i] } else { b };
+            (y_i, w_i, g_y, g_w) = (y_next, w_next, g_y_next, g_w_next);
+        }
     }
 }
 
@@ -1298,12 +1301,17 @@ mod tests {
                 let (ki, ui, wi, fi) = (k, &u[..], &w[..], &f[..]);
                 macro_rules! both {
                     ($s:literal) => {
-                        dispatch::baseline(RhsInterior::<true, $s, Uniform>((
-                            ki.0, ki.1, c_w, inv_dt2, ui, wi, fi, &mut a,
-                        )));
-                        dispatch::run(RhsInterior::<true, $s, Uniform>((
-                            ki.0, ki.1, c_w, inv_dt2, ui, wi, fi, &mut b,
-                        )));
+                        let kernel = |rhs| RhsInterior::<true, $s, Uniform> {
+                            coefficients: ki,
+                            c_w,
+                            inv_dt2,
+                            u: ui,
+                            w: wi,
+                            force: fi,
+                            rhs,
+                        };
+                        dispatch::baseline(kernel(&mut a));
+                        dispatch::run(kernel(&mut b));
                     };
                 }
                 if s_r {

@@ -310,12 +310,26 @@ fn update<const K: usize, const WRITE_Z: bool>(
     len: usize,
     terms: [(f64, &[f64]); K],
 ) -> f64 {
+    max4(update_from::<K, WRITE_Z>(
+        u, z_ptr, len, &terms, 0, [0.0; 4],
+    ))
+}
+
+/// Entries `from..len` of [`update`], entry `i` into running maximum `i mod 4` of `m`.
+#[inline(always)]
+fn update_from<const K: usize, const WRITE_Z: bool>(
+    u: &mut [f64],
+    z_ptr: *mut f64,
+    len: usize,
+    terms: &[(f64, &[f64]); K],
+    from: usize,
+    mut m: [f64; 4],
+) -> [f64; 4] {
     assert_eq!(u.len(), len, "state length");
-    let mut m = [0.0f64; 4];
-    for i in 0..len {
+    for i in from..len {
         // SAFETY: `i < len`, and the callers' `z` is `len` doubles, writable when `WRITE_Z`.
         let mut zi = unsafe { *z_ptr.add(i) };
-        for (r, a) in &terms {
+        for (r, a) in terms {
             zi += r * a[i];
         }
         if WRITE_Z && K > 0 {
@@ -325,7 +339,7 @@ fn update<const K: usize, const WRITE_Z: bool>(
         u[i] += zi;
         m[i % 4] = m[i % 4].max(u[i].abs());
     }
-    max4(m)
+    m
 }
 
 /// [`update`] in AVX instructions: blocks of four entries, then the rest one by one.
@@ -366,20 +380,15 @@ fn update_avx<const K: usize, const WRITE_Z: bool>(
     let mut lanes = [0.0f64; 4];
     // SAFETY: `lanes` has room for four doubles.
     unsafe { _mm256_storeu_pd(lanes.as_mut_ptr(), m) };
-    for i in 4 * blocks..len {
-        // SAFETY: `i < len`.
-        let mut zi = unsafe { *z_ptr.add(i) };
-        for (r, a) in &terms {
-            zi += r * a[i];
-        }
-        if WRITE_Z && K > 0 {
-            // SAFETY: as above.
-            unsafe { *z_ptr.add(i) = zi };
-        }
-        u[i] += zi;
-        lanes[i % 4] = lanes[i % 4].max(u[i].abs());
-    }
-    max4(lanes)
+    // The rest one by one.
+    max4(update_from::<K, WRITE_Z>(
+        u,
+        z_ptr,
+        len,
+        &terms,
+        4 * blocks,
+        lanes,
+    ))
 }
 
 /// The largest of four running maxima.
