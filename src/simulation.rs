@@ -1075,83 +1075,56 @@ type Lanes = [[f64; LANES]; 7];
 /// 0). The whole blocks of [`LANES`] rows run as AVX vector instructions when the CPU has
 /// them ([`measure_blocks_avx`]: the compiler does not vectorise this loop by itself, the
 /// overlapping loads of rows `i` and `i + 1` defeat it), with the same bits as the portable
-/// [`measure_blocks`] (see [`dispatch`]).
+/// [`measure_rows`] (see [`dispatch`]).
 fn uniform_measure<const LOAD: bool, const S_R: bool>(
     u: &[f64],
     z: &[f64],
     w: &[f64],
     force: &[f64],
 ) -> [f64; 7] {
-    let blocks = u.len().saturating_sub(2) / LANES;
+    let (rows, zero) = (1..u.len().saturating_sub(1), [[0.0; LANES]; 7]);
     #[cfg(target_arch = "x86_64")]
-    let mut acc = if dispatch::has_avx() {
+    let acc = if dispatch::has_avx() {
+        let blocks = rows.len() / LANES;
         // SAFETY: the CPU supports AVX.
-        unsafe { measure_blocks_avx::<LOAD, S_R>(u, z, w, force, blocks) }
+        let acc = unsafe { measure_blocks_avx::<LOAD, S_R>(u, z, w, force, blocks) };
+        measure_rows::<LOAD, S_R>((u, z, w, force), 1 + LANES * blocks..rows.end, acc)
     } else {
-        measure_blocks::<LOAD, S_R>(u, z, w, force, blocks)
+        measure_rows::<LOAD, S_R>((u, z, w, force), rows, zero)
     };
     #[cfg(not(target_arch = "x86_64"))]
-    let mut acc = measure_blocks::<LOAD, S_R>(u, z, w, force, blocks);
-    measure_tail::<LOAD, S_R>(u, z, w, force, 1 + LANES * blocks, &mut acc);
+    let acc = measure_rows::<LOAD, S_R>((u, z, w, force), rows, zero);
     acc.map(|[a, b, c, d]| (a + b) + (c + d))
 }
 
-/// One row `i` of the sums into `lane`.
-#[inline(always)]
-fn measure_row<const LOAD: bool, const S_R: bool>(
-    acc: &mut Lanes,
-    lane: usize,
+/// Rows `rows` of [`uniform_measure`], portable, row `i` into lane `(i − 1) mod LANES` of
+/// `acc`: all the rows, or the rows after [`measure_blocks_avx`]'s blocks.
+fn measure_rows<const LOAD: bool, const S_R: bool>(
     (u, z, w, force): (&[f64], &[f64], &[f64], &[f64]),
-    i: usize,
-) {
-    let (zi, ui, di) = (z[i], u[i], z[i] + w[i]);
-    let (dz, du, dd) = (z[i + 1] - zi, u[i + 1] - ui, (z[i + 1] + w[i + 1]) - di);
-    acc[0][lane] += zi * zi;
-    acc[1][lane] += dz * dz;
-    if S_R {
-        acc[2][lane] += ui * ui;
-        acc[4][lane] += di * di;
-    }
-    acc[3][lane] += du * du;
-    acc[5][lane] += dd * dd;
-    if LOAD {
-        acc[6][lane] += force[i] * di;
-    }
-}
-
-/// Rows `1..1 + LANES · blocks` of [`uniform_measure`], portable.
-fn measure_blocks<const LOAD: bool, const S_R: bool>(
-    u: &[f64],
-    z: &[f64],
-    w: &[f64],
-    force: &[f64],
-    blocks: usize,
+    rows: std::ops::Range<usize>,
+    mut acc: Lanes,
 ) -> Lanes {
-    let mut acc = [[0.0; LANES]; 7];
-    for i in (1..1 + LANES * blocks).step_by(LANES) {
-        for lane in 0..LANES {
-            measure_row::<LOAD, S_R>(&mut acc, lane, (u, z, w, force), i + lane);
+    for i in rows {
+        let lane = (i - 1) % LANES;
+        let (zi, ui, di) = (z[i], u[i], z[i] + w[i]);
+        let (dz, du, dd) = (z[i + 1] - zi, u[i + 1] - ui, (z[i + 1] + w[i + 1]) - di);
+        acc[0][lane] += zi * zi;
+        acc[1][lane] += dz * dz;
+        if S_R {
+            acc[2][lane] += ui * ui;
+            acc[4][lane] += di * di;
+        }
+        acc[3][lane] += du * du;
+        acc[5][lane] += dd * dd;
+        if LOAD {
+            acc[6][lane] += force[i] * di;
         }
     }
     acc
 }
 
-/// Rows from `first` to `n − 2` (fewer than [`LANES`]), one per lane.
-fn measure_tail<const LOAD: bool, const S_R: bool>(
-    u: &[f64],
-    z: &[f64],
-    w: &[f64],
-    force: &[f64],
-    first: usize,
-    acc: &mut Lanes,
-) {
-    for (lane, i) in (first..u.len().saturating_sub(1)).enumerate() {
-        measure_row::<LOAD, S_R>(acc, lane, (u, z, w, force), i);
-    }
-}
-
-/// [`measure_blocks`] in AVX instructions: each lane's sums see the same operations in the
-/// same order, so the bits are the same.
+/// Rows `1..1 + LANES · blocks` of [`measure_rows`] in AVX instructions, from zero sums:
+/// each lane's sums see the same operations in the same order, so the bits are the same.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 fn measure_blocks_avx<const LOAD: bool, const S_R: bool>(
@@ -1323,12 +1296,20 @@ mod tests {
                 assert_eq!(bits(&a), bits(&b), "rhs, n = {n}, s_R {s_r}");
                 let blocks = (n - 2) / LANES;
                 let (p, q) = if s_r {
-                    let portable = measure_blocks::<true, true>(&u, &z, &w, &f, blocks);
+                    let portable = measure_rows::<true, true>(
+                        (&u, &z, &w, &f),
+                        1..1 + LANES * blocks,
+                        [[0.0; LANES]; 7],
+                    );
                     // SAFETY: the CPU has AVX (checked above).
                     let avx = unsafe { measure_blocks_avx::<true, true>(&u, &z, &w, &f, blocks) };
                     (portable, avx)
                 } else {
-                    let portable = measure_blocks::<true, false>(&u, &z, &w, &f, blocks);
+                    let portable = measure_rows::<true, false>(
+                        (&u, &z, &w, &f),
+                        1..1 + LANES * blocks,
+                        [[0.0; LANES]; 7],
+                    );
                     // SAFETY: the CPU has AVX (checked above).
                     let avx = unsafe { measure_blocks_avx::<true, false>(&u, &z, &w, &f, blocks) };
                     (portable, avx)
