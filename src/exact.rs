@@ -9,8 +9,17 @@
 //! smallest violation in the order ∅, {first}, {second}, {both} wins: deterministic, and equal to
 //! the exact answer whenever that one satisfies KKT to round-off.
 //!
-//! Cost per step: one tridiagonal solve, O(1) work for the enumeration, and one pass adding
-//! `r_j c_j` over the numerical support of `c_j` when a node is in contact.
+//! Warm start. A contact usually lasts many steps, so each solve first tries the previous
+//! answer's active set `P ≠ ∅` by the direct solve below, and keeps it when it meets the KKT
+//! conditions exactly in floating point (reactions `>= 0` on `P`, bounds off it); only on a
+//! miss (the contact set changes) does it enumerate. By uniqueness the kept set is the
+//! enumeration's, but the bits differ (direct solve against superposition), and in a tie the
+//! two may pick different sets for the same point: an answer depends on the sequence of
+//! calls, not only on `(b, lo)` (the same sequence gives the same bits).
+//!
+//! Cost per step: one tridiagonal solve and O(1) work while the contact set persists; when it
+//! changes, the wasted warm solve, one more solve, the enumeration and one pass adding
+//! `r_j c_j` over the numerical support of `c_j`.
 //!
 //! Cancellation. When contact stops a large free motion (`Δt ≫ Δx` with stiff `C`: `z⁰` is
 //! the rigid flight `≈ Δt v`, `z` a tiny deflection), `z = z⁰ + Σ r_j c_j` cancels
@@ -69,6 +78,10 @@ pub struct ExactSolver {
     merged: u64,
     /// `max|u^n|` of the state `z` is added to ([`StepSolver::set_state_scale`]; 0 if not given).
     state_scale: f64,
+    /// The active set of the last answer (the mask of [`ExactSolver::enumerate`]), tried first.
+    previous: u8,
+    /// Steps answered by the direct solve on the previous active set ([`ExactSolver::warm`]).
+    warm: u64,
 }
 
 impl ExactSolver {
@@ -109,6 +122,8 @@ impl ExactSolver {
             resolved: 0,
             merged: 0,
             state_scale: 0.0,
+            previous: 0,
+            warm: 0,
         })
     }
 
@@ -118,6 +133,12 @@ impl ExactSolver {
         self.resolved
     }
 
+    /// Steps so far answered by the direct solve on the previous step's active set (the warm
+    /// start met the KKT conditions, no enumeration).
+    pub fn warm_steps(&self) -> u64 {
+        self.warm
+    }
+
     /// Steps so far whose superposition and `u += z` were one pass (through
     /// [`StepSolver::solve_and_advance`]).
     pub fn merged_steps(&self) -> u64 {
@@ -125,7 +146,9 @@ impl ExactSolver {
     }
 
     /// The direct solve on active set `mask`: `z_A = lo_A`, `C_FF z_F = b_F − C_FA lo_A`,
-    /// `r_A = (Cz − b)_A` (round-off below zero clamped, as in `active_set`).
+    /// `r_A = (Cz − b)_A` (round-off below zero clamped, as in `active_set`). Returns whether
+    /// the answer met the KKT conditions before the clamp: `r_A >= 0` and `z_j >= lo_j` off
+    /// `A` (false on a NaN).
     fn solve_on_active_set(
         &self,
         mask: u8,
@@ -133,7 +156,8 @@ impl ExactSolver {
         lower: &[f64],
         z: &mut [f64],
         reactions: &mut [f64],
-    ) {
+    ) -> bool {
+        let mut kkt = true;
         let n = z.len();
         z.copy_from_slice(rhs);
         let active = |i: usize| {
@@ -172,8 +196,35 @@ impl ExactSolver {
             }
             // Round-off below zero clamped; a NaN kept, for the caller's finiteness check.
             let rj = cz - rhs[i];
+            kkt &= rj >= 0.0;
             reactions[j] = if rj < 0.0 { 0.0 } else { rj };
         }
+        for (j, col) in self.columns.iter().enumerate() {
+            if mask & (1 << j) == 0 {
+                kkt &= z[col.node] >= lower[j];
+            }
+        }
+        kkt
+    }
+
+    /// Warm start: the direct solve on the previous answer's active set, kept when it meets the
+    /// KKT conditions exactly in floating point (unclamped reactions `>= 0` on the set,
+    /// `z_j >= lo_j` off it). `None` when there is nothing to try (the previous set was empty:
+    /// the enumeration tries ∅ first anyway), else whether the answer was kept; a miss leaves
+    /// `z` and `reactions` to be overwritten.
+    fn warm(
+        &mut self,
+        rhs: &[f64],
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Option<bool> {
+        if self.previous == 0 {
+            return None;
+        }
+        let kept = self.solve_on_active_set(self.previous, rhs, lower, z, reactions);
+        self.warm += u64::from(kept);
+        Some(kept)
     }
 
     /// Reactions and KKT violation of active set `mask` (bit k = constrained node k active),
@@ -213,12 +264,19 @@ impl StepSolver for ExactSolver {
         z: &mut [f64],
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
+        let missed = match self.warm(rhs, lower, z, reactions) {
+            Some(true) => return Ok(SolveInfo { iterations: 1 }),
+            Some(false) => 1,
+            None => 0,
+        };
         let Some((tried, mask)) = self.active_set(rhs, lower, z, reactions)? else {
             // Non-finite values anywhere are caught by the stepper's energy check.
             return Ok(SolveInfo { iterations: 1 });
         };
         self.superpose_or_resolve(mask, rhs, lower, z, reactions)?;
-        Ok(SolveInfo { iterations: tried })
+        Ok(SolveInfo {
+            iterations: missed + tried,
+        })
     }
 
     /// As [`StepSolver::solve`] then `u += z`, with the same bits, but when the cancellation
@@ -238,10 +296,17 @@ impl StepSolver for ExactSolver {
             self.factor.solve_into_and_add(rhs, z, u);
             return Ok((SolveInfo { iterations: 1 }, 0.0));
         }
+        let missed = match self.warm(rhs, lower, z, reactions) {
+            Some(true) => return Ok((SolveInfo { iterations: 1 }, add_in_place(u, z))),
+            Some(false) => 1,
+            None => 0,
+        };
         let Some((tried, mask)) = self.active_set(rhs, lower, z, reactions)? else {
             return Ok((SolveInfo { iterations: 1 }, add_in_place(u, z)));
         };
-        let info = SolveInfo { iterations: tried };
+        let info = SolveInfo {
+            iterations: missed + tried,
+        };
         if let Some(max_abs) = self.superpose_and_add(mask, lower, u, z, reactions) {
             self.merged += 1;
             return Ok((info, max_abs));
@@ -255,7 +320,7 @@ impl ExactSolver {
     /// `z = z⁰ = C⁻¹ b`, then the active set by enumeration ([`ExactSolver::enumerate`]):
     /// `(sets tried, mask)`, or `None` when no node is constrained.
     fn active_set(
-        &self,
+        &mut self,
         rhs: &[f64],
         lower: &[f64],
         z: &mut [f64],
@@ -265,7 +330,9 @@ impl ExactSolver {
         if self.columns.is_empty() {
             return Ok(None);
         }
-        self.enumerate(lower, z, reactions).map(Some)
+        let (tried, mask) = self.enumerate(lower, z, reactions)?;
+        self.previous = mask;
+        Ok(Some((tried, mask)))
     }
 
     /// [`ExactSolver::superpose`], and the direct solve when it cancelled.
@@ -775,16 +842,96 @@ mod tests {
         let nodes = c.dim();
         let ends = [0, nodes - 1];
         let (mut z, mut reactions) = (vec![0.0; nodes], [0.0; 2]);
-        let mut solver = ExactSolver::new(&c, &ends).unwrap();
-        solver.set_state_scale(1e3);
-        solver
-            .solve(&b, &[0.0, 0.0], &mut z, &mut reactions)
-            .unwrap();
-        assert_eq!(solver.resolved_steps(), 0);
-        solver.set_state_scale(10.0);
-        solver
-            .solve(&b, &[0.0, 0.0], &mut z, &mut reactions)
-            .unwrap();
-        assert_eq!(solver.resolved_steps(), 1);
+        for (state, resolved) in [(1e3, 0), (10.0, 1)] {
+            // A fresh solver: a second call on the same one would keep the first's active set
+            // by the warm start and never superpose.
+            let mut solver = ExactSolver::new(&c, &ends).unwrap();
+            solver.set_state_scale(state);
+            solver
+                .solve(&b, &[0.0, 0.0], &mut z, &mut reactions)
+                .unwrap();
+            assert_eq!(solver.resolved_steps(), resolved, "state {state}");
+        }
+    }
+
+    /// The warm start on the stiff rigid flight (both ends stopped) and on a mild bar: the
+    /// second call keeps the first call's active set by the direct solve, passes the KKT audit
+    /// at its round-off floors and agrees with the enumeration of a fresh solver; `solve` and
+    /// `solve_and_advance` give the same bits on it. When the contact set changes (one
+    /// bound dropped far below), the warm answer fails KKT and the step is enumerated: the
+    /// bits of a fresh solver's answer, with the wasted attempt counted as a set tried.
+    #[test]
+    fn warm_start_keeps_a_lasting_contact_and_enumerates_when_it_changes() {
+        let (stiff, b_stiff) = rigid_flight();
+        let mild = {
+            let elements = 50;
+            let dx = 1.0 / elements as f64;
+            let c = SymTridiag::combine(
+                1.0 / (dx * dx),
+                &mass(MatrixVariant::Consistent, elements + 1, dx),
+                0.5 + 0.1 / (2.0 * dx),
+                &stiffness(MatrixVariant::Consistent, elements + 1, dx),
+            );
+            let b = c.mul(&vec![-0.01; elements + 1]);
+            (c, b)
+        };
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for (c, b) in [(&stiff, &b_stiff), (&mild.0, &mild.1)] {
+            let nodes = c.dim();
+            let ends = [0, nodes - 1];
+            let fresh = |lower: &[f64; 2]| {
+                let mut s = ExactSolver::new(c, &ends).unwrap();
+                let (mut z, mut r) = (vec![0.0; nodes], [0.0; 2]);
+                let info = s.solve(b, lower, &mut z, &mut r).unwrap();
+                (z, r, info.iterations)
+            };
+            let both = [0.0, 0.0];
+            let (z_enum, r_enum, _) = fresh(&both);
+            assert!(r_enum.iter().all(|r| *r > 0.0), "both ends in contact");
+
+            let mut solver = ExactSolver::new(c, &ends).unwrap();
+            let mut advancing = ExactSolver::new(c, &ends).unwrap();
+            let (mut z, mut r) = (vec![0.0; nodes], [0.0; 2]);
+            let (mut z2, mut r2, mut u2) = (vec![0.0; nodes], [0.0; 2], vec![0.0; nodes]);
+            for call in 0..2 {
+                let info = solver.solve(b, &both, &mut z, &mut r).unwrap();
+                u2.fill(1.0);
+                advancing
+                    .solve_and_advance(b, &both, &mut u2, &mut z2, &mut r2)
+                    .unwrap();
+                assert_eq!(solver.warm_steps(), call, "warm on the second call only");
+                assert_eq!(info.iterations, if call == 0 { 4 } else { 1 });
+            }
+            assert_eq!((bits(&z), bits(&r)), (bits(&z2), bits(&r2)));
+            let mut audit = KktAudit::new(c, &ends, false).unwrap();
+            let law = Law::Signorini {
+                eps_abs: 0.0,
+                eps_rel: 0.0,
+            };
+            audit.check(law, b, &both, &z, &r).unwrap();
+            let z_max = z_enum.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            // The direct solve against the enumeration's answer (direct too on the stiff bar,
+            // superposed on the mild one): both to a few ulps of |z|.
+            let tol = 64.0 * f64::EPSILON * z_max;
+            for (a, e) in z.iter().zip(&z_enum) {
+                assert!((a - e).abs() <= tol, "{a:e} vs {e:e}");
+            }
+
+            // The right end released: its warm reaction would be negative.
+            let released = [0.0, -1e9];
+            let info = solver.solve(b, &released, &mut z, &mut r).unwrap();
+            assert_eq!(solver.warm_steps(), 1, "a miss is not counted as warm");
+            let (z_fresh, r_fresh, tried) = fresh(&released);
+            assert_eq!((bits(&z), bits(&r)), (bits(&z_fresh), bits(&r_fresh)));
+            assert_eq!(info.iterations, tried + 1);
+            assert!(r[0] > 0.0 && r[1] == 0.0, "r = {r:?}");
+
+            // Back to both bounds: the warm set {left} now leaves the right end below its bound.
+            let info = solver.solve(b, &both, &mut z, &mut r).unwrap();
+            assert_eq!(solver.warm_steps(), 1, "a miss is not counted as warm");
+            let (z_fresh, r_fresh, tried) = fresh(&both);
+            assert_eq!((bits(&z), bits(&r)), (bits(&z_fresh), bits(&r_fresh)));
+            assert_eq!(info.iterations, tried + 1);
+        }
     }
 }

@@ -13,15 +13,67 @@ use viscobar::tridiag::SymTridiag;
 /// of systems with condition number below 1e4 here, so 1e-9 leaves a wide margin over round-off.
 const AGREEMENT_TOL: f64 = 1e-9;
 
+/// KKT residuals of `(z, r)` and its distance to the dense brute-force oracle.
+fn check_against_oracle(
+    c: &SymTridiag,
+    b: &[f64],
+    nodes: &[usize],
+    lower: &[f64],
+    z: &[f64],
+    r: &[f64],
+) -> Result<(), TestCaseError> {
+    let n = c.dim();
+    let scale = 1.0 + b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    // KKT: stationarity C z − b − Σ r_j e_j = 0, feasibility, sign, complementarity.
+    let mut stat = c.mul(z);
+    for i in 0..n {
+        stat[i] -= b[i];
+    }
+    for (j, &node) in nodes.iter().enumerate() {
+        stat[node] -= r[j];
+    }
+    let zscale = 1.0 + z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for v in &stat {
+        prop_assert!(
+            v.abs() <= AGREEMENT_TOL * scale * zscale,
+            "stationarity {v:e}"
+        );
+    }
+    for (j, &node) in nodes.iter().enumerate() {
+        prop_assert!(z[node] >= lower[j] - AGREEMENT_TOL * zscale);
+        prop_assert!(r[j] >= -AGREEMENT_TOL * scale);
+        prop_assert!((r[j] * (z[node] - lower[j])).abs() <= AGREEMENT_TOL * scale * zscale);
+    }
+
+    let oracle = brute_force(&c.to_dense(), b, nodes, lower, AGREEMENT_TOL * zscale)
+        .unwrap()
+        .unwrap();
+    for (i, (zi, oi)) in z.iter().zip(&oracle.z).enumerate() {
+        prop_assert!(
+            (zi - oi).abs() <= AGREEMENT_TOL * zscale,
+            "node {i}: exact {zi} oracle {oi}"
+        );
+    }
+    for (rj, oj) in r.iter().zip(&oracle.reactions) {
+        prop_assert!((rj - oj).abs() <= AGREEMENT_TOL * scale * zscale);
+    }
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(2000))]
 
+    /// Two problems in a row on one solver, the second a rescaled first (`s b`, bounds moved
+    /// by `t`): the first is enumerated, the second usually answered by the warm start on the
+    /// first's active set, or enumerated after a miss. Both must meet KKT and match the oracle.
     #[test]
     fn exact_solver_satisfies_kkt_and_matches_brute_force(
         c in common::spd_tridiag(23),
         seed_b in prop::collection::vec(-5.0f64..5.0, 24),
         lo in prop::collection::vec(-2.0f64..2.0, 2),
         which in 0usize..4,
+        s in 0.5f64..1.5,
+        t in -0.2f64..0.2,
     ) {
         let n = c.dim();
         let b = &seed_b[..n];
@@ -36,29 +88,48 @@ proptest! {
         let mut z = vec![0.0; n];
         let mut r = vec![0.0; nodes.len()];
         solver.solve(b, lower, &mut z, &mut r).unwrap();
+        check_against_oracle(&c, b, &nodes, lower, &z, &r)?;
 
-        let scale = 1.0 + b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        // KKT: stationarity C z − b − Σ r_j e_j = 0, feasibility, sign, complementarity.
-        let mut stat = c.mul(&z);
-        for i in 0..n { stat[i] -= b[i]; }
-        for (j, &node) in nodes.iter().enumerate() { stat[node] -= r[j]; }
-        let zscale = 1.0 + z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for v in &stat { prop_assert!(v.abs() <= AGREEMENT_TOL * scale * zscale, "stationarity {v:e}"); }
-        for (j, &node) in nodes.iter().enumerate() {
-            prop_assert!(z[node] >= lower[j] - AGREEMENT_TOL * zscale);
-            prop_assert!(r[j] >= -AGREEMENT_TOL * scale);
-            prop_assert!((r[j] * (z[node] - lower[j])).abs() <= AGREEMENT_TOL * scale * zscale);
-        }
+        let b2: Vec<f64> = b.iter().map(|v| s * v).collect();
+        let lower2: Vec<f64> = lower.iter().map(|v| v + t).collect();
+        solver.solve(&b2, &lower2, &mut z, &mut r).unwrap();
+        check_against_oracle(&c, &b2, &nodes, &lower2, &z, &r)?;
+    }
+}
 
-        let oracle = brute_force(&c.to_dense(), b, &nodes, lower, AGREEMENT_TOL * zscale).unwrap().unwrap();
-        for i in 0..n {
-            prop_assert!((z[i] - oracle.z[i]).abs() <= AGREEMENT_TOL * zscale,
-                "node {i}: exact {} oracle {}", z[i], oracle.z[i]);
-        }
-        for j in 0..nodes.len() {
-            prop_assert!((r[j] - oracle.reactions[j]).abs() <= AGREEMENT_TOL * scale * zscale);
+/// The proptest above reaches the warm start: over a fixed sample of its distribution, most
+/// second problems with an active bound are answered warm.
+#[test]
+fn the_warm_start_is_exercised_by_the_random_problems() {
+    use proptest::strategy::ValueTree;
+    use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+    let mut runner = TestRunner::new_with_rng(
+        Config::default(),
+        TestRng::from_seed(RngAlgorithm::ChaCha, &[7; 32]),
+    );
+    let (mut warm, mut active) = (0, 0);
+    for _ in 0..500 {
+        let c = common::spd_tridiag(23)
+            .new_tree(&mut runner)
+            .unwrap()
+            .current();
+        let n = c.dim();
+        let b: Vec<f64> = (0..n).map(|i| ((i * 7 + n) as f64).sin() * 5.0).collect();
+        let nodes = [0, n - 1];
+        let (mut z, mut r) = (vec![0.0; n], vec![0.0; 2]);
+        let mut solver = ExactSolver::new(&c, &nodes).unwrap();
+        solver.solve(&b, &[0.5, 0.5], &mut z, &mut r).unwrap();
+        if r.iter().any(|v| *v > 0.0) {
+            active += 1;
+            let b2: Vec<f64> = b.iter().map(|v| 1.1 * v).collect();
+            solver.solve(&b2, &[0.55, 0.45], &mut z, &mut r).unwrap();
+            warm += solver.warm_steps();
         }
     }
+    assert!(
+        active >= 100 && 2 * warm >= active,
+        "warm {warm} of {active}"
+    );
 }
 
 /// Round-off level of the tie test below (entries of size 1, condition number 12).
