@@ -94,17 +94,22 @@ impl ExactSolver {
         let factor = Ldlt::factor(c)?;
         let columns = inverse_columns(&factor, nodes);
         let schur = schur_complement(&columns);
+        let actives: Vec<Vec<usize>> = (1u8..(1 << nodes.len()))
+            .map(|mask| {
+                (nodes.iter().enumerate())
+                    .filter(|&(j, _)| mask & (1 << j) != 0)
+                    .map(|(_, &node)| node)
+                    .collect()
+            })
+            .collect();
         let mut reduced: Vec<Ldlt> = Vec::new();
-        for mask in 1u8..(1 << nodes.len()) {
-            let active: Vec<usize> = (nodes.iter().enumerate())
-                .filter(|&(j, _)| mask & (1 << j) != 0)
-                .map(|(_, &node)| node)
+        for active in &actives {
+            // End nodes change one half only: the other is taken from a factorisation made
+            // before (neither computed nor stored twice).
+            let known: Vec<(&[usize], &Ldlt)> = std::iter::once((&[][..], &factor))
+                .chain(actives.iter().map(Vec::as_slice).zip(&reduced))
                 .collect();
-            let mut f = Ldlt::factor_with_identity_rows(c, &active)?;
-            // End nodes change one half only: store the other once.
-            for other in std::iter::once(&factor).chain(&reduced) {
-                f.share_halves(other);
-            }
+            let f = Ldlt::factor_with_identity_rows_sharing(c, active, &known)?;
             reduced.push(f);
         }
         let mut rows = [[0.0; 3]; 2];
