@@ -32,7 +32,7 @@
 
 use crate::solver::{SolveInfo, StepFailure, StepSolver};
 use crate::tridiag::{
-    Ldlt, NotPositiveDefinite, SymTridiag, add_columns_in_place, add_in_place, max4,
+    Ldlt, NotPositiveDefinite, RowChange, SymTridiag, add_columns_in_place, add_in_place, max4,
 };
 
 /// Largest cancellation `max|z⁰| / max(|z|, |u^n|)` over the columns' support accepted from
@@ -94,30 +94,8 @@ impl ExactSolver {
         let factor = Ldlt::factor(c)?;
         let columns = inverse_columns(&factor, nodes);
         let schur = schur_complement(&columns);
-        let actives: Vec<Vec<usize>> = (1u8..(1 << nodes.len()))
-            .map(|mask| {
-                (nodes.iter().enumerate())
-                    .filter(|&(j, _)| mask & (1 << j) != 0)
-                    .map(|(_, &node)| node)
-                    .collect()
-            })
-            .collect();
-        let mut reduced: Vec<Ldlt> = Vec::new();
-        for active in &actives {
-            // End nodes change one half only: the other is taken from a factorisation made
-            // before (neither computed nor stored twice).
-            let known: Vec<(&[usize], &Ldlt)> = std::iter::once((&[][..], &factor))
-                .chain(actives.iter().map(Vec::as_slice).zip(&reduced))
-                .collect();
-            let f = Ldlt::factor_with_identity_rows_sharing(c, active, &known)?;
-            reduced.push(f);
-        }
-        let mut rows = [[0.0; 3]; 2];
-        for (row, &i) in rows.iter_mut().zip(nodes) {
-            let left = if i > 0 { c.off[i - 1] } else { 0.0 };
-            let right = if i + 1 < c.dim() { c.off[i] } else { 0.0 };
-            *row = [left, right, c.row_sums()[i]];
-        }
+        let reduced = factor_each_subset(c, nodes, RowChange::Identity, &factor)?;
+        let rows = constraint_rows(c, nodes);
         Ok(Self {
             factor,
             columns,
@@ -190,17 +168,9 @@ impl ExactSolver {
             if mask & (1 << j) == 0 {
                 continue;
             }
-            let (i, [left, right, sum]) = (col.node, self.rows[j]);
-            // Row i of C z in difference form (exact for a rigid z where s_i = 0).
-            let mut cz = sum * z[i];
-            if i > 0 {
-                cz += left * (z[i - 1] - z[i]);
-            }
-            if i + 1 < n {
-                cz += right * (z[i + 1] - z[i]);
-            }
+            let i = col.node;
             // Round-off below zero clamped; a NaN kept, for the caller's finiteness check.
-            let rj = cz - rhs[i];
+            let rj = row_product(self.rows[j], i, z) - rhs[i];
             kkt &= rj >= 0.0;
             reactions[j] = if rj < 0.0 { 0.0 } else { rj };
         }
@@ -566,6 +536,59 @@ impl ExactSolver {
     }
 }
 
+/// The factorisations of `C` with the rows of each non-empty subset `mask` of `nodes` changed
+/// by `change`, at index `mask − 1`; shared with the penalty solver. End nodes change one half
+/// only: the other is taken from `factor` (of `C`) or a factorisation made before, neither
+/// computed nor stored twice.
+pub(crate) fn factor_each_subset(
+    c: &SymTridiag,
+    nodes: &[usize],
+    change: RowChange,
+    factor: &Ldlt,
+) -> Result<Vec<Ldlt>, NotPositiveDefinite> {
+    let subsets: Vec<Vec<usize>> = (1u8..(1 << nodes.len()))
+        .map(|mask| {
+            (nodes.iter().enumerate())
+                .filter(|&(j, _)| mask & (1 << j) != 0)
+                .map(|(_, &node)| node)
+                .collect()
+        })
+        .collect();
+    let mut made: Vec<Ldlt> = Vec::new();
+    for subset in &subsets {
+        let known: Vec<(&[usize], &Ldlt)> = std::iter::once((&[][..], factor))
+            .chain(subsets.iter().map(Vec::as_slice).zip(&made))
+            .collect();
+        made.push(Ldlt::factor_with_rows_changed(c, subset, change, &known)?);
+    }
+    Ok(made)
+}
+
+/// Row `i` of `C` at each constrained node `i`: `C_i,i−1`, `C_i,i+1` (0 where absent) and the
+/// row sum, for [`row_product`]; shared with the penalty solver.
+pub(crate) fn constraint_rows(c: &SymTridiag, nodes: &[usize]) -> [[f64; 3]; 2] {
+    let mut rows = [[0.0; 3]; 2];
+    for (row, &i) in rows.iter_mut().zip(nodes) {
+        let left = if i > 0 { c.off[i - 1] } else { 0.0 };
+        let right = if i + 1 < c.dim() { c.off[i] } else { 0.0 };
+        *row = [left, right, c.row_sums()[i]];
+    }
+    rows
+}
+
+/// `(C z)_i` from row `i` of [`constraint_rows`], in difference form: exact for a rigid `z`
+/// where the row sum is 0.
+pub(crate) fn row_product([left, right, sum]: [f64; 3], i: usize, z: &[f64]) -> f64 {
+    let mut cz = sum * z[i];
+    if i > 0 {
+        cz += left * (z[i - 1] - z[i]);
+    }
+    if i + 1 < z.len() {
+        cz += right * (z[i + 1] - z[i]);
+    }
+    cz
+}
+
 /// The reactions of active set `mask` (bit `j`: node `j`) from `m r = d` restricted to it
 /// (zero off it), by Cramer's rule; shared with the penalty solver, whose `m` is `S + εI`.
 pub(crate) fn masked_solve(m: &[[f64; 2]; 2], d: &[f64; 2], mask: u8) -> [f64; 2] {
@@ -714,25 +737,28 @@ impl Column {
     }
 }
 
+/// `C` of a free-free bar of 20 elements at `α = 1e6`, `Δt = 1e4 Δx`, and the `b` of a rigid
+/// flight at `Δt v = −500` per step: the stiff case matrix's worst cancellation (tests of the
+/// exact and penalty solvers).
+#[cfg(test)]
+pub(crate) fn rigid_flight() -> (SymTridiag, Vec<f64>) {
+    use crate::matrices::{MatrixVariant, mass, stiffness};
+    let (elements, alpha) = (20usize, 1e6);
+    let dx = 1.0 / elements as f64;
+    let dt = 1e4 * dx;
+    let nodes = elements + 1;
+    let m = mass(MatrixVariant::Consistent, nodes, dx);
+    let r = stiffness(MatrixVariant::Consistent, nodes, dx);
+    let c = SymTridiag::combine(1.0 / (dt * dt), &m, 0.5 + alpha / (2.0 * dt), &r);
+    let b = c.mul(&vec![-500.0; nodes]);
+    (c, b)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::audit::{KktAudit, Law};
     use crate::matrices::{MatrixVariant, mass, stiffness};
-
-    /// `C` of a free-free bar of 20 elements at `α = 1e6`, `Δt = 1e4 Δx`, and the `b` of a
-    /// rigid flight at `Δt v = −500` per step.
-    fn rigid_flight() -> (SymTridiag, Vec<f64>) {
-        let (elements, alpha) = (20usize, 1e6);
-        let dx = 1.0 / elements as f64;
-        let dt = 1e4 * dx;
-        let nodes = elements + 1;
-        let m = mass(MatrixVariant::Consistent, nodes, dx);
-        let r = stiffness(MatrixVariant::Consistent, nodes, dx);
-        let c = SymTridiag::combine(1.0 / (dt * dt), &m, 0.5 + alpha / (2.0 * dt), &r);
-        let b = c.mul(&vec![-500.0; nodes]);
-        (c, b)
-    }
 
     /// Regression (found by the stiff case matrix): a free-free bar of 20 elements at
     /// `α = 1e6`, `Δt = 1e4 Δx`, flying rigidly at `Δt v = −500` per step onto obstacles at gap 0

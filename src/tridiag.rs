@@ -443,7 +443,7 @@ pub struct Ldlt {
     /// its inner side (towards the twist): `top[r] = [l_r, 1/D_r, f1_o, f2_o, 1/d_o]` with
     /// `o = 2r + 1` for rows `r = 0..μ` (`l_r = E'_r/D_r`); `bottom[k]` the same for row
     /// `r = ν−1−k > μ` with `o = 2r − 1` and `l_r = E'_r−1/D_r`. A half that several
-    /// factorisations have is stored once ([`Ldlt::factor_with_identity_rows_sharing`]).
+    /// factorisations have is stored once ([`Ldlt::factor_with_rows_changed`]).
     top: Arc<Vec<[f64; 5]>>,
     bottom: Arc<Vec<[f64; 5]>>,
     /// `[f1, 1/d]` of the last node when it is odd (`n` even): it is on no reduced row's inner
@@ -452,6 +452,15 @@ pub struct Ldlt {
     /// `1/D_μ`, the twist pivot.
     inv_twist: f64,
     n: usize,
+}
+
+/// How [`Ldlt::factor_with_rows_changed`] changes the rows (and columns) of its nodes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RowChange {
+    /// Replaced by identity ones: the exact solver's active set, `z_j = lo_j`.
+    Identity,
+    /// This added to the diagonal entry: the penalty solver's contact spring `1/ε`.
+    AddToDiagonal(f64),
 }
 
 /// The matrix was not numerically positive definite: pivot `index` came out as `pivot`.
@@ -494,22 +503,25 @@ impl Ldlt {
         a: &SymTridiag,
         nodes: &[usize],
     ) -> Result<Self, NotPositiveDefinite> {
-        Self::factor_with_identity_rows_sharing(a, nodes, &[])
+        Self::factor_with_rows_changed(a, nodes, RowChange::Identity, &[])
     }
 
-    /// As [`Ldlt::factor_with_identity_rows`], but each half is taken from a factorisation of
-    /// the same `a` in `known` (given with its own identity rows) whose identity rows among the
-    /// nodes that half reads are the same: that half is then neither computed nor stored
-    /// again. The top half reads nodes `0..=2μ`, the bottom half `2μ..n` (`2μ`, the twist
-    /// node, both), so identity rows at one end leave the other end's half as it was.
-    pub fn factor_with_identity_rows_sharing(
+    /// The factorisation of `a` with the rows of `nodes` changed by `change`, read from `a`
+    /// without copying it. Each half is taken from a factorisation in `known` (made by this
+    /// function from the same `a` with the same `change`, or the plain one with no nodes,
+    /// given with its own nodes) whose changed rows among the nodes that half reads are the
+    /// same: that half is then neither computed nor stored again. The top half reads nodes
+    /// `0..=2μ`, the bottom half `2μ..n` (`2μ`, the twist node, both), so changed rows at one
+    /// end leave the other end's half as it was.
+    pub fn factor_with_rows_changed(
         a: &SymTridiag,
         nodes: &[usize],
+        change: RowChange,
         known: &[(&[usize], &Ldlt)],
     ) -> Result<Self, NotPositiveDefinite> {
         let n = a.dim();
         let twist_node = 2 * (n.div_ceil(2) / 2);
-        // The identity rows a half reads, as a sorted list.
+        // The changed rows a half reads, as a sorted list.
         let seen = |nodes: &[usize], top: bool| {
             let mut v: Vec<usize> = (nodes.iter().copied())
                 .filter(|&i| {
@@ -531,19 +543,28 @@ impl Ldlt {
                     .then(|| Arc::clone(if top { &f.top } else { &f.bottom }))
             })
         };
-        let identity = |i: usize| nodes.contains(&i);
-        Self::factor_by(
-            n,
-            |i| if identity(i) { 1.0 } else { a.diag[i] },
-            |i| {
-                if identity(i) || identity(i + 1) {
-                    0.0
-                } else {
-                    a.off[i]
-                }
-            },
-            [reuse(true), reuse(false)],
-        )
+        let changed = |i: usize| nodes.contains(&i);
+        let halves = [reuse(true), reuse(false)];
+        match change {
+            RowChange::Identity => Self::factor_by(
+                n,
+                |i| if changed(i) { 1.0 } else { a.diag[i] },
+                |i| {
+                    if changed(i) || changed(i + 1) {
+                        0.0
+                    } else {
+                        a.off[i]
+                    }
+                },
+                halves,
+            ),
+            RowChange::AddToDiagonal(s) => Self::factor_by(
+                n,
+                |i| if changed(i) { a.diag[i] + s } else { a.diag[i] },
+                |i| a.off[i],
+                halves,
+            ),
+        }
     }
 
     /// The factorisation of the matrix with diagonal `d(i)` and off-diagonal `e(i) = A_i,i+1`;
@@ -820,11 +841,11 @@ impl Ldlt {
 mod tests {
     use super::*;
 
-    /// Each factorisation made with halves taken from earlier ones (as the exact solver makes
-    /// its reduced ones) equals the one computed from scratch bit for bit, for identity rows at
-    /// the ends, next to them, at the twist node and inside, at every size from 2 to 13 and
-    /// at 101 and 1000; with both ends of a bar of 5 nodes or more, the plain factorisation and
-    /// the three reduced ones hold four distinct halves.
+    /// Each factorisation made with halves taken from earlier ones (as the exact and penalty
+    /// solvers make theirs) equals the one computed from scratch bit for bit, for identity rows
+    /// and for a diagonal shift, at the ends, next to them, at the twist node and inside, at
+    /// every size from 2 to 13 and at 101 and 1000; with both ends of a bar of 5 nodes or
+    /// more, the plain factorisation and the three changed ones hold four distinct halves.
     #[test]
     fn shared_halves_equal_the_halves_computed_from_scratch() {
         let bits = |f: &Ldlt| {
@@ -843,22 +864,26 @@ mod tests {
             );
             let twist_node = 2 * (n.div_ceil(2) / 2);
             let plain = Ldlt::factor(&a).unwrap();
-            for pair in [
-                [0, n - 1],
-                [1, n - 2],
-                [0, twist_node],
-                [twist_node, n - 1],
-                [n / 3, n - 1],
-            ] {
+            let changes = [RowChange::Identity, RowChange::AddToDiagonal(7.5)];
+            for (change, pair) in changes.into_iter().flat_map(|change| {
+                [
+                    [0, n - 1],
+                    [1, n - 2],
+                    [0, twist_node],
+                    [twist_node, n - 1],
+                    [n / 3, n - 1],
+                ]
+                .map(|pair| (change, pair))
+            }) {
                 let sets: [&[usize]; 3] = [&pair[..1], &pair[1..], &pair[..]];
                 let mut made: Vec<Ldlt> = Vec::new();
                 for set in sets {
                     let known: Vec<(&[usize], &Ldlt)> = std::iter::once((&[][..], &plain))
                         .chain(sets.iter().copied().zip(&made))
                         .collect();
-                    let shared = Ldlt::factor_with_identity_rows_sharing(&a, set, &known).unwrap();
-                    let fresh = Ldlt::factor_with_identity_rows(&a, set).unwrap();
-                    assert_eq!(bits(&shared), bits(&fresh), "n {n}, identity rows {set:?}");
+                    let shared = Ldlt::factor_with_rows_changed(&a, set, change, &known).unwrap();
+                    let fresh = Ldlt::factor_with_rows_changed(&a, set, change, &[]).unwrap();
+                    assert_eq!(bits(&shared), bits(&fresh), "n {n}, {change:?} at {set:?}");
                     made.push(shared);
                 }
                 if pair == [0, n - 1] && n >= 5 {
