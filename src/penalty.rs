@@ -31,8 +31,9 @@
 //!
 //! Direct solve. On the chosen support `A` the answer is computed, not superposed: `z` from
 //! `(C + Σ_{j∈A} e_j e_jᵀ/ε) z = b + Σ_{j∈A} lo_j e_j/ε` (the factorisations of these
-//! tridiagonal matrices are made once per run, sharing the unchanged halves) and
-//! `r_j = (lo_j − z_j)/ε`. This is backward stable: the superposition `z⁰ + Σ r_j c_j`
+//! tridiagonal matrices are made once per run, sharing the unchanged halves), and `r_j` from
+//! the gap `(lo_j − z_j)/ε` or from stationarity `(C z − b)_j`, whichever the audit weighs at
+//! round-off ([`PenaltySolver::solve_on_support`]). This is backward stable: the superposition `z⁰ + Σ r_j c_j`
 //! cancels `max|z⁰| / max|z|` digits when contact stops a fast stiff bar, and failed the
 //! audit's stationarity and penalty-law checks there (the stiff case matrix). Warm start, as
 //! in [`crate::exact`]: the previous step's support is tried first by this direct solve and
