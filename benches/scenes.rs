@@ -1,10 +1,10 @@
-//! Each talk scene end to end at its default size (`viscobar::figures::talk_scenes`): set-up,
+//! Each talk scene end to end at its default size (`viscobar::study::figures::talk_scenes`): set-up,
 //! start-up and every step with the energy balance, through `run::run_in_memory` (no files
 //! written, so disk speed does not enter). Throughput in node-steps.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use viscobar::figures::talk_scenes;
-use viscobar::run::run_in_memory;
+use viscobar::study::figures::talk_scenes;
+use viscobar::time::run::run_in_memory;
 
 fn bench_scenes(c: &mut Criterion) {
     let mut group = c.benchmark_group("scenes");

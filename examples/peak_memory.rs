@@ -47,7 +47,7 @@ fn main() {
     .expect("scene");
     let before = vm_hwm_kib();
     let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/peak-memory");
-    let summary = viscobar::run::run_to_dir("peak-memory", &scene, &out, false).expect("run");
+    let summary = viscobar::time::run::run_to_dir("peak-memory", &scene, &out, false).expect("run");
     let peak = vm_hwm_kib().expect("/proc/self/status has VmHWM");
     println!(
         "{ends}: elements {elements}, steps {}, nodes {}: wall {:.1} s, {:.2} ns per node-step",

@@ -12,38 +12,18 @@
 //! discretised with P1 elements in space and the implicit three-level scheme (VI)_h in time,
 //! each step a bound-constrained quadratic programme solved exactly.
 //!
-//! Modules, one concept each: [`tridiag`] (banded kernels), [`matrices`] (M and R),
-//! [`scene`] (input), [`expr`] (expressions), [`solver`] (the step-solver seam), [`exact`] (the
-//! exact enumeration), [`osqp_solver`] (OSQP, Stellato et al. 2020) and [`penalty`] (the talk's
-//! penalised problem (PP)), [`audit`] (the independent optimality check of their answers),
-//! [`oracle`] (a dense brute-force reference for tests), [`simulation`] (the time stepper and
-//! energy balance), [`closed_form`] (exact solutions), [`run`] (outputs).
+//! Layers, each a folder whose module doc says what it owns; imports point down this list only
+//! (`tests/layers.rs` checks it):
+//! [`linalg`] (tridiagonal kernels) → [`step`] (the step solvers and their audit) →
+//! [`scene`] (input) → [`bar`] (matrices, closed forms) → [`time`] (the time loop, energy
+//! balance and outputs) → [`study`] (the verification studies).
 
-pub mod active_set;
-pub mod agreement;
-pub mod audit;
-pub mod closed_form;
-pub mod compare;
-pub mod converge;
-pub mod dispatch;
-pub mod error;
-pub mod exact;
-pub mod expr;
-pub mod figures;
-pub mod matrices;
-pub mod oracle;
-pub mod osqp_solver;
-pub mod penalty;
-pub mod run;
+pub mod bar;
+pub mod linalg;
 pub mod scene;
-pub mod simulation;
-pub mod solver;
-pub mod spectrum;
-pub mod stiff;
+pub mod step;
 pub mod study;
-pub mod tridiag;
-pub mod verify;
+pub mod time;
 
-pub use error::{RunError, SceneError};
-pub use scene::Scene;
-pub use simulation::Simulation;
+pub use scene::{Scene, SceneError};
+pub use time::{RunError, Simulation};

@@ -36,7 +36,7 @@ enum Command {
     /// u(x, t) and contact history) and one per talk figure (l = 0 beside forced).
     Figures {
         /// Output folder.
-        #[arg(long, default_value = viscobar::figures::DEFAULT_OUT)]
+        #[arg(long, default_value = viscobar::study::figures::DEFAULT_OUT)]
         out: PathBuf,
         /// Step solver (overrides [solver] method of every scene).
         #[arg(long)]
@@ -51,7 +51,7 @@ enum Command {
         #[arg(long, default_value = "exact,osqp,penalty")]
         solvers: String,
         /// Levels of refinement (elements doubled per level from the scene's mesh).
-        #[arg(long, default_value_t = viscobar::converge::DEFAULT_LEVELS)]
+        #[arg(long, default_value_t = viscobar::study::converge::DEFAULT_LEVELS)]
         levels: u32,
         /// dt/dx at every level [default: the scene's].
         #[arg(long)]
@@ -142,7 +142,7 @@ fn main() {
                 .iter()
                 .map(|s| format!("solver.method=\"{s}\""))
                 .collect();
-            match viscobar::figures::write_talk_figures(&out, &set) {
+            match viscobar::study::figures::write_talk_figures(&out, &set) {
                 Ok(files) => {
                     for f in &files {
                         println!("wrote {}", f.display());
@@ -162,8 +162,12 @@ fn main() {
 fn run(name: &str, out: Option<PathBuf>, set: &[String]) -> Result<(), viscobar::RunError> {
     let (scene_name, scene) = scene::load(name, set)?;
     let out = out.unwrap_or_else(|| PathBuf::from("out").join(&scene_name));
-    let summary =
-        viscobar::run::run_to_dir(&scene_name, &scene, &out, std::io::stderr().is_terminal())?;
+    let summary = viscobar::time::run::run_to_dir(
+        &scene_name,
+        &scene,
+        &out,
+        std::io::stderr().is_terminal(),
+    )?;
     println!(
         "{}: {} steps of {} nodes with `{}` in {:.3} s ({:.1} ns per node-step); \
          max identity residual {:.1e}; results in {}",
@@ -192,8 +196,8 @@ fn converge(
     ratio: Option<f64>,
     out: Option<PathBuf>,
     viscosity_sweep: bool,
-) -> Result<(), viscobar::converge::ConvergeError> {
-    use viscobar::converge;
+) -> Result<(), viscobar::study::converge::ConvergeError> {
+    use viscobar::study::converge;
     let settings = converge::parse_solvers(solvers)?;
     let (scene_name, scene) = scene::load(name, &[])?;
     let out = out.unwrap_or_else(|| PathBuf::from("out").join(format!("converge-{scene_name}")));
@@ -219,11 +223,11 @@ fn converge(
 
 fn verify(update: Option<PathBuf>, stiff: bool) -> i32 {
     let sections = if stiff {
-        Ok(vec![viscobar::verify::stiff_section(
-            viscobar::stiff::Size::Full,
+        Ok(vec![viscobar::study::verify::stiff_section(
+            viscobar::study::stiff::Size::Full,
         )])
     } else {
-        viscobar::verify::sections()
+        viscobar::study::verify::sections()
     };
     let sections = match sections {
         Ok(s) => s,
@@ -233,14 +237,14 @@ fn verify(update: Option<PathBuf>, stiff: bool) -> i32 {
         }
     };
     let Some(path) = update else {
-        print!("{}", viscobar::verify::render(&sections));
+        print!("{}", viscobar::study::verify::render(&sections));
         return 0;
     };
     let result = std::fs::read_to_string(&path)
         .map_err(|e| format!("cannot read {}: {e}", path.display()))
-        .and_then(|doc| viscobar::verify::update_document(&doc, &sections))
+        .and_then(|doc| viscobar::study::verify::update_document(&doc, &sections))
         .and_then(|doc| {
-            viscobar::run::write_atomically(&path, doc.as_bytes())
+            viscobar::time::run::write_atomically(&path, doc.as_bytes())
                 .map_err(|e| format!("cannot write {}: {e}", path.display()))
         });
     match result {

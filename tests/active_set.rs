@@ -5,11 +5,11 @@
 mod common;
 
 use proptest::prelude::*;
-use viscobar::active_set::BlockPivotSolver;
-use viscobar::matrices::{MatrixVariant, mass, stiffness};
-use viscobar::oracle::brute_force;
-use viscobar::solver::StepSolver;
-use viscobar::tridiag::SymTridiag;
+use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
+use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::step::StepSolver;
+use viscobar::step::block_pivot::BlockPivotSolver;
+use viscobar::step::oracle::brute_force;
 
 /// Agreement with the dense oracle and KKT residuals, relative: both are backward-stable
 /// solves of systems with condition number below 1e4 here.

@@ -5,8 +5,8 @@
 //! with L2 errors 2.10e-2 and 1.09e-2 at the scenes' own meshes.
 
 mod common;
-use viscobar::closed_form::{self, ClosedForm, FallingBar};
-use viscobar::study::{error_against, observed_order};
+use viscobar::bar::closed_form::{self, ClosedForm, FallingBar};
+use viscobar::study::accuracy::{error_against, observed_order};
 
 /// The scheme is second order in (dx, dt) for smooth solutions (the card asks for 2 ± 0.15).
 const MODAL_ORDER: f64 = 2.0;
@@ -71,7 +71,7 @@ fn clamped_impact_error_is_bounded_and_decreases_at_the_kink_rate() {
 fn impact_contact_interval_and_reaction_match_the_closed_form() {
     // Contact on [t1, t1 + 2L] = [0.1, 2.1] with reaction v0 = 1 (nodal force = -s(0)).
     let scene = common::builtin("impact", &["mesh.elements=400", "time.step=0.0025"]);
-    let (records, summary, _) = viscobar::run::run_in_memory("impact", &scene).unwrap();
+    let (records, summary, _) = viscobar::time::run::run_in_memory("impact", &scene).unwrap();
     let intervals = &summary.contact_intervals["left"];
     assert_eq!(intervals.len(), 1, "one contact episode: {intervals:?}");
     let [start, end] = intervals[0];

@@ -7,7 +7,7 @@
 //! relative energy loss ~ α^0.49.
 
 mod common;
-use viscobar::converge::{self, SolverSetting};
+use viscobar::study::converge::{self, SolverSetting};
 
 /// Second order in (dx, dt) for smooth solutions (the card asks for 2 ± 0.15).
 const MODAL_ORDER: f64 = 2.0;
@@ -137,7 +137,7 @@ fn falling_bar_converges_in_displacement_energy_and_contact_times() {
         .iter()
         .map(|r| r.contact_time_error.unwrap())
         .collect();
-    let p = viscobar::study::observed_order(&h, &c);
+    let p = viscobar::study::accuracy::observed_order(&h, &c);
     assert!(
         c.iter().all(|e| e.is_finite())
             && p >= CONTACT_TIME_ORDER_BAND.0

@@ -77,7 +77,7 @@ fn thinned_energy_never_rises_without_load() {
         if scene.load.density.is_some() {
             continue;
         }
-        let (_, summary, _) = viscobar::run::run_in_memory(name, &scene).unwrap();
+        let (_, summary, _) = viscobar::time::run::run_in_memory(name, &scene).unwrap();
         let rise = summary.max_energy_rise.expect("unforced");
         assert!(rise <= ENERGY_RISE_TOL, "{name}: {rise:e}");
     }

@@ -2,8 +2,8 @@
 //! built-in scene.
 
 mod common;
-use viscobar::run::run_in_memory;
 use viscobar::scene::builtin_names;
+use viscobar::time::run::run_in_memory;
 
 /// Relative residual of the energy identity: the identity is exact algebra, so only round-off
 /// remains (measured: below 1e-14 on every built-in scene, see VERIFICATION.md).

@@ -4,10 +4,10 @@
 mod common;
 
 use proptest::prelude::*;
-use viscobar::exact::ExactSolver;
-use viscobar::oracle::brute_force;
-use viscobar::solver::StepSolver;
-use viscobar::tridiag::SymTridiag;
+use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::step::StepSolver;
+use viscobar::step::exact::ExactSolver;
+use viscobar::step::oracle::brute_force;
 
 /// Relative agreement with the oracle and KKT residuals: both sides are backward-stable solves
 /// of systems with condition number below 1e4 here, so 1e-9 leaves a wide margin over round-off.

@@ -7,7 +7,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use viscobar::Simulation;
-use viscobar::figures::{self, Sampling, TALK_FIGURES};
+use viscobar::study::figures::{self, Sampling, TALK_FIGURES};
 
 fn viscobar(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_viscobar"))
@@ -86,7 +86,7 @@ fn sampled_run_holds_the_runs_mesh_values_and_peak_reactions() {
         peak > 0.0,
         "the window must contain contact, or the test checks nothing"
     );
-    let (_, summary, _) = viscobar::run::run_in_memory("both-ends", &scene).unwrap();
+    let (_, summary, _) = viscobar::time::run::run_in_memory("both-ends", &scene).unwrap();
     assert_eq!(run.summary.contact_intervals, summary.contact_intervals);
 }
 

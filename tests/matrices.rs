@@ -1,7 +1,7 @@
 //! Properties of the P1 matrices M and R, and the diagnosis of the talk's printed entries.
 
-use viscobar::matrices::{MatrixVariant, mass, stiffness};
-use viscobar::verify::SolveCase;
+use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
+use viscobar::study::verify::SolveCase;
 
 /// `1ᵀM1` sums `J + 2` rounded entries: a few ulps of L.
 const MASS_SUM_TOL: f64 = 1e-12;
@@ -93,7 +93,7 @@ fn talk_printed_matrices_are_inconsistent() {
 /// dominant.
 #[test]
 fn factorisation_solves_spd_tridiagonal_systems() {
-    use viscobar::tridiag::{Ldlt, SymTridiag};
+    use viscobar::linalg::tridiag::{Ldlt, SymTridiag};
     // Backward-stable solve with condition number below 1e3 here.
     const SOLVE_TOL: f64 = 1e-12;
     for n in 1..40usize {
@@ -133,7 +133,7 @@ const BACKWARD_ULPS: f64 = 8.0;
 /// for speed in a one-off probe (not in the tree), measured 31 ε on these matrices.
 #[test]
 fn factorisation_is_backward_stable_on_the_step_matrices() {
-    use viscobar::verify::{SOLVE_STUDY_CASES, SOLVE_STUDY_NODES, solve_study};
+    use viscobar::study::verify::{SOLVE_STUDY_CASES, SOLVE_STUDY_NODES, solve_study};
     let nodes: Vec<usize> = (2..=24).chain(SOLVE_STUDY_NODES).collect();
     let cases = solve_study(&nodes);
     assert_eq!(

@@ -27,12 +27,12 @@
 mod common;
 
 use proptest::prelude::*;
-use viscobar::active_set::BlockPivotSolver;
-use viscobar::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
-use viscobar::osqp_solver::{OsqpSettings, OsqpSolver};
-use viscobar::scene::OSQP_DEFAULT_EPS;
-use viscobar::solver::StepSolver;
-use viscobar::tridiag::{Ldlt, SymTridiag};
+use viscobar::linalg::tridiag::{Ldlt, SymTridiag};
+use viscobar::step::StepSolver;
+use viscobar::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
+use viscobar::step::block_pivot::BlockPivotSolver;
+use viscobar::step::osqp::OSQP_DEFAULT_EPS;
+use viscobar::step::osqp::{OsqpSettings, OsqpSolver};
 
 /// Largest problem drawn: large enough for many simultaneous contact changes, small enough that
 /// 200 cases of two OSQP solves each stay within seconds.
@@ -85,7 +85,7 @@ fn a_posteriori_bound(
         * (natural_residual(c, b, nodes, lo, z) + natural_residual(c, b, nodes, lo, z2))
 }
 
-/// The bound above with OSQP's residuals at their audit caps (src/audit.rs with
+/// The bound above with OSQP's residuals at their audit caps (src/step/audit.rs with
 /// `AUDIT_MARGIN·eps`: `t_f` in force, `t_z` in displacement) and the exact answer's at the
 /// round-off floor. With `ρ = Cz − b − Σ r_j e_j`, `|ρ_i| <= t_f`, so `|ν_i| <= t_f` at a free
 /// node; at a bound node `g = z_i − lo_j >= −t_z`, `r_j >= −t_f` and `|g r_j| <= t_z|r_j| + t_f|g|`

@@ -5,12 +5,12 @@
 mod common;
 
 use proptest::prelude::*;
-use viscobar::audit::AUDIT_MARGIN;
-use viscobar::exact::ExactSolver;
-use viscobar::osqp_solver::{OsqpSettings, OsqpSolver};
-use viscobar::scene::OSQP_DEFAULT_EPS;
-use viscobar::solver::StepSolver;
-use viscobar::tridiag::SymTridiag;
+use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::step::StepSolver;
+use viscobar::step::audit::AUDIT_MARGIN;
+use viscobar::step::exact::ExactSolver;
+use viscobar::step::osqp::OSQP_DEFAULT_EPS;
+use viscobar::step::osqp::{OsqpSettings, OsqpSolver};
 
 fn norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))

@@ -5,7 +5,7 @@
 //! round-off. An independent implementation measured drifts of 7.9e-7 (talk form) and 2.7e-10
 //! (increment form) after 26 000 steps at J = 8192. See `study::rigid_mode_drift`.
 
-use viscobar::study::rigid_mode_drift;
+use viscobar::study::accuracy::rigid_mode_drift;
 
 const ELEMENTS: u64 = 8193; // J = 8192
 const STEPS: usize = 26_000;

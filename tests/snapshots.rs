@@ -23,7 +23,7 @@ use insta::with_settings;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use viscobar::figures::{self, Sampling};
+use viscobar::study::figures::{self, Sampling};
 
 mod common;
 

@@ -9,15 +9,17 @@ use std::process::Command;
 
 use osqp::Status;
 use viscobar::RunError;
-use viscobar::audit::AUDIT_MARGIN;
-use viscobar::compare::{compare, start_up_problem};
-use viscobar::osqp_solver::{OSQP_INFTY, OsqpSettings, OsqpSolver, raw_problem};
-use viscobar::run::run_in_memory;
-use viscobar::scene::{OSQP_DEFAULT_EPS, PENALTY_DEFAULT_EPSILON, Scene, builtin_names};
-use viscobar::simulation::Simulation;
-use viscobar::solver::{StepFailure, StepSolver};
-use viscobar::study::observed_order;
-use viscobar::tridiag::SymTridiag;
+use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::scene::{Scene, builtin_names};
+use viscobar::step::audit::AUDIT_MARGIN;
+use viscobar::step::osqp::OSQP_DEFAULT_EPS;
+use viscobar::step::osqp::{OSQP_INFTY, OsqpSettings, OsqpSolver, raw_problem};
+use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::step::{StepFailure, StepSolver};
+use viscobar::study::accuracy::observed_order;
+use viscobar::study::compare::{compare, start_up_problem};
+use viscobar::time::run::run_in_memory;
+use viscobar::time::simulation::Simulation;
 
 // ---- tolerances -------------------------------------------------------------------------
 
@@ -299,8 +301,8 @@ fn stiff_impact(ratio: f64, extra: &[&str]) -> Scene {
 fn step_failure(
     result: Result<
         (
-            Vec<viscobar::simulation::StepRecord>,
-            viscobar::run::Summary,
+            Vec<viscobar::time::simulation::StepRecord>,
+            viscobar::time::run::Summary,
             Simulation,
         ),
         RunError,
@@ -690,7 +692,7 @@ fn cli_warns_about_accepted_inaccurate_steps() {
 fn penalty_solver_refuses_a_bad_epsilon_without_panicking() {
     let c = SymTridiag::new(vec![2.0, 2.0], vec![-1.0]);
     for eps in [0.0, -1.0, f64::NAN, f64::INFINITY] {
-        assert!(viscobar::penalty::PenaltySolver::new(&c, &[0], eps).is_err());
+        assert!(viscobar::step::penalty::PenaltySolver::new(&c, &[0], eps).is_err());
     }
     // A scene built in code, never validated, gets an error naming the field.
     let mut scene = common::builtin("impact", &["solver.method=\"penalty\""]);

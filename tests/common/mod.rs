@@ -3,8 +3,8 @@
 
 use proptest::prelude::*;
 use viscobar::Scene;
+use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::scene;
-use viscobar::tridiag::SymTridiag;
 
 /// Loads a built-in scene with overrides.
 pub fn builtin(name: &str, overrides: &[&str]) -> Scene {

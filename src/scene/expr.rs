@@ -2,7 +2,7 @@
 //!
 //! Besides `x` and `t`, the name `pi` may be used (exmex itself spells the constant `PI` or `π`).
 
-use crate::error::SceneError;
+use crate::scene::SceneError;
 use exmex::prelude::*;
 use exmex::{FloatOpsFactory, MatchLiteral};
 

@@ -9,10 +9,11 @@
 //! no system font library is needed. Every file is written to a temporary name in the output
 //! folder and renamed into place, so it is whole or absent.
 
-use crate::error::RunError;
-use crate::run::{CONTACT_GAP_TOL, Summary, Tracker};
 use crate::scene::{self, Scene};
-use crate::simulation::{Simulation, StepRecord};
+use crate::time::RunError;
+use crate::time::run::{Summary, Tracker};
+use crate::time::simulation::CONTACT_GAP_TOL;
+use crate::time::simulation::{Simulation, StepRecord};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::element::Polygon;

@@ -20,17 +20,19 @@
 //!
 //! where the contact term `½ r·δ = −½ r_j (u^{n−1}_j + a_j) <= 0` by complementarity.
 
-use crate::active_set::BlockPivotSolver;
-use crate::dispatch;
-use crate::error::{RunError, SceneError};
-use crate::exact::ExactSolver;
-use crate::expr::Expression;
-use crate::matrices;
-use crate::osqp_solver::{OsqpSettings, OsqpSolver};
-use crate::penalty::PenaltySolver;
-use crate::scene::{Condition, PENALTY_DEFAULT_EPSILON, Scene, Side, SolverMethod};
-use crate::solver::{SolverReport, StepSolver};
-use crate::tridiag::{Interior, Ldlt, SymTridiag, Uniform, add_in_place, dot};
+use crate::bar::matrices;
+use crate::linalg::dispatch;
+use crate::linalg::tridiag::{Interior, Ldlt, SymTridiag, Uniform, add_in_place, dot};
+use crate::scene::SceneError;
+use crate::scene::expr::Expression;
+use crate::scene::{Condition, Scene, Side, SolverMethod};
+use crate::step::block_pivot::BlockPivotSolver;
+use crate::step::exact::ExactSolver;
+use crate::step::osqp::OsqpSolver;
+use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
+use crate::step::penalty::PenaltySolver;
+use crate::step::{SolverReport, StepSolver};
+use crate::time::RunError;
 use std::time::Instant;
 
 /// Calls `$body` with `$load` as a `const bool` and the interior coefficients of `M` and `R`
@@ -59,6 +61,10 @@ macro_rules! monomorphise {
         }
     };
 }
+
+/// A constrained node counts as in contact when its gap `u + a` is at most this: the exact
+/// solver puts active nodes on the obstacle up to the rounding of `u^n + z` (a few ulps of |u|).
+pub const CONTACT_GAP_TOL: f64 = 1e-12;
 
 /// A constrained node: `u[node] >= -gap`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -203,7 +209,7 @@ pub fn make_solver(scene: &Scene, disc: &Discretisation) -> Result<Box<dyn StepS
         SolverMethod::Osqp => Ok(Box::new(OsqpSolver::new(
             &disc.step_matrix,
             &nodes,
-            OsqpSettings::from_spec(&scene.solver),
+            scene.solver.osqp_settings(),
         )?)),
         SolverMethod::Penalty => Ok(Box::new(PenaltySolver::new(
             &disc.step_matrix,
@@ -291,7 +297,7 @@ pub struct StepRecord {
     pub min_gap: f64,
     pub min_reaction: f64,
     pub max_complementarity: f64,
-    /// Constrained nodes in contact (gap at most [`crate::run::CONTACT_GAP_TOL`]) and the
+    /// Constrained nodes in contact (gap at most [`CONTACT_GAP_TOL`]) and the
     /// extent `[x_min, x_max]` of that contact set (`NaN` when empty).
     pub contact_nodes: usize,
     pub contact_extent: [f64; 2],
@@ -509,7 +515,7 @@ impl Simulation {
         self.potential = self.disc.stiffness.quad(&self.u);
         self.energy = 0.5 * dot(&self.z, mz) * self.inv_dt2 + 0.25 * (self.potential + potential0);
         if !self.energy.is_finite() {
-            return Err(self.failure(1, crate::solver::StepFailure::NonFinite));
+            return Err(self.failure(1, crate::step::StepFailure::NonFinite));
         }
         std::mem::swap(&mut self.w, &mut self.z);
         self.n = 1;
@@ -526,7 +532,7 @@ impl Simulation {
         Ok(())
     }
 
-    fn failure(&self, step: usize, failure: crate::solver::StepFailure) -> RunError {
+    fn failure(&self, step: usize, failure: crate::step::StepFailure) -> RunError {
         RunError::Step {
             step,
             time: step as f64 * self.disc.dt,
@@ -657,7 +663,7 @@ impl Simulation {
             .into_iter()
             .fold(0.0, f64::max);
         if !(energy.is_finite() && residual.is_finite()) {
-            return Err(self.failure(record.step, crate::solver::StepFailure::NonFinite));
+            return Err(self.failure(record.step, crate::step::StepFailure::NonFinite));
         }
         record.energy = energy;
         record.work = work;
@@ -694,7 +700,7 @@ impl Simulation {
             min_gap = min_gap.min(gap);
             min_reaction = min_reaction.min(reaction);
             max_comp = max_comp.max((gap * reaction).abs());
-            if gap <= crate::run::CONTACT_GAP_TOL {
+            if gap <= CONTACT_GAP_TOL {
                 let x = self.disc.x(c.node);
                 if count == 0 {
                     lo = x;

@@ -302,8 +302,8 @@ impl ClosedForm for ClampedImpact {
 /// assumptions (checked: end conditions, no distributed obstacle, elastic bar and load where
 /// required, a uniform initial velocity, initial displacement at 101 points).
 pub fn for_scene(name: &str, scene: &Scene) -> Option<Box<dyn ClosedForm>> {
-    use crate::expr::Expression;
     use crate::scene::Condition::{Clamped, Free, Signorini};
+    use crate::scene::expr::Expression;
     let ends = (scene.left.condition, scene.right.condition);
     let unloaded = scene.load.density.is_none();
     let elastic = scene.bar.viscosity == 0.0 && unloaded;

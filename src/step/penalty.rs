@@ -11,7 +11,7 @@
 //! `z_j − lo_j = −ε r_j` is negative in contact: penetration ≈ ε × reaction, and
 //! complementarity holds only in the limit ε → 0.
 //!
-//! Solution, exact to round-off. As in [`crate::exact`], with `z⁰ = C⁻¹ b`, `c_j = C⁻¹ e_j`
+//! Solution, exact to round-off. As in [`crate::step::exact`], with `z⁰ = C⁻¹ b`, `c_j = C⁻¹ e_j`
 //! and `S_jk = (C⁻¹)_jk` on the constrained nodes, `z = z⁰ + Σ_j r_j c_j`, and the conditions
 //! become the linear complementarity problem in `r ∈ ℝᵏ` (k <= 2):
 //!
@@ -36,18 +36,21 @@
 //! round-off ([`PenaltySolver::solve_on_support`]). This is backward stable: the superposition `z⁰ + Σ r_j c_j`
 //! cancels `max|z⁰| / max|z|` digits when contact stops a fast stiff bar, and failed the
 //! audit's stationarity and penalty-law checks there (the stiff case matrix). Warm start, as
-//! in [`crate::exact`]: the previous step's support is tried first by this direct solve and
+//! in [`crate::step::exact`]: the previous step's support is tried first by this direct solve and
 //! kept when it meets the conditions (`z_j <= lo_j` on it, `z_j >= lo_j` off it); the
 //! enumeration runs only when the support changes.
 
-use crate::audit::{KktAudit, Law};
-use crate::error::{RunError, SceneError};
-use crate::exact::{
+use crate::linalg::tridiag::{Ldlt, NotPositiveDefinite, RowChange, SymTridiag};
+use crate::step::audit::{KktAudit, Law};
+use crate::step::exact::{
     Column, constraint_rows, factor_each_subset, inverse_columns, least_violating, masked_solve,
     row_product, schur_complement,
 };
-use crate::solver::{SolveInfo, SolverReport, StepFailure, StepSolver};
-use crate::tridiag::{Ldlt, NotPositiveDefinite, RowChange, SymTridiag};
+use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
+
+/// ε of the penalised problem unless set: penetration ≈ ε × reaction, so about 1e-6 for the
+/// talk's reactions of order 1.
+pub const PENALTY_DEFAULT_EPSILON: f64 = 1e-6;
 
 /// Why the penalty solver could not be set up.
 #[derive(Debug, thiserror::Error)]
@@ -58,27 +61,6 @@ pub enum PenaltySetupError {
     Epsilon(f64),
     #[error("the penalty solver handles the two Signorini ends only, not {0} constrained nodes")]
     TooManyBounds(usize),
-}
-
-impl From<PenaltySetupError> for RunError {
-    fn from(e: PenaltySetupError) -> Self {
-        match e {
-            PenaltySetupError::Matrix(m) => RunError::Matrix(m),
-            PenaltySetupError::Epsilon(v) => RunError::Scene(SceneError::Invalid {
-                field: "solver.epsilon".into(),
-                value: v.to_string(),
-                allowed: "must be a finite number > 0".into(),
-            }),
-            PenaltySetupError::TooManyBounds(k) => RunError::Scene(SceneError::Invalid {
-                field: "solver.method".into(),
-                value: "\"penalty\"".into(),
-                allowed: format!(
-                    "the penalty solver handles the two Signorini ends only; this scene constrains \
-                     {k} nodes (use exact or osqp for an obstacle)"
-                ),
-            }),
-        }
-    }
 }
 
 /// Normal compliance with parameter `ε`, solved exactly per step, audited every step.
@@ -266,7 +248,7 @@ mod tests {
     /// everywhere, the stiff matrix's `Δt = 1e-3 Δx` rows (VERIFICATION.md) fail the law.
     #[test]
     fn stiff_impact_on_penalty_springs_passes_the_audit() {
-        let (c, b) = crate::exact::rigid_flight();
+        let (c, b) = crate::step::exact::rigid_flight();
         let n = c.dim();
         let ends = [0, n - 1];
         let springs = [(1e4, true), (10.0, true), (0.1, false), (1e-4, false)];

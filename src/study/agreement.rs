@@ -9,15 +9,16 @@
 //!
 //! Everything is deterministic (no timings): the same build prints the same numbers.
 
-use crate::compare::{StepProblem, compare, start_up_problem};
-use crate::error::RunError;
-use crate::exact::ExactSolver;
-use crate::osqp_solver::{OsqpSettings, OsqpSolver, raw_problem};
-use crate::run::run_in_memory;
-use crate::scene::{self, PENALTY_DEFAULT_EPSILON, Scene};
-use crate::solver::StepSolver;
-use crate::study::observed_order;
-use crate::tridiag::{Ldlt, SymTridiag};
+use crate::linalg::tridiag::{Ldlt, SymTridiag};
+use crate::scene::{self, Scene};
+use crate::step::StepSolver;
+use crate::step::exact::ExactSolver;
+use crate::step::osqp::{OsqpSettings, OsqpSolver, raw_problem};
+use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
+use crate::study::accuracy::observed_order;
+use crate::study::compare::{StepProblem, compare, start_up_problem};
+use crate::time::RunError;
+use crate::time::run::run_in_memory;
 use osqp::Status;
 use std::fmt::Write;
 
@@ -54,8 +55,8 @@ fn max_distance(a: &[f64], b: &[f64]) -> f64 {
 /// The audit report of an OSQP or penalty run (both always audit).
 fn audit_of<'a>(
     name: &str,
-    s: &'a crate::run::Summary,
-) -> Result<&'a crate::audit::AuditReport, RunError> {
+    s: &'a crate::time::run::Summary,
+) -> Result<&'a crate::step::AuditReport, RunError> {
     s.audit.as_ref().ok_or_else(|| RunError::SolverSetup {
         solver: s.solver.clone(),
         reason: format!("{name}: the run kept no audit report"),

@@ -1,5 +1,5 @@
 //! An independent check of every step answer against the optimality conditions of the step
-//! problem (see [`crate::solver`]):
+//! problem (see [`crate::step::solver`]):
 //!
 //! ```text
 //!   C z = b + Σ_j r_j e_j,   z_j >= lo_j,   r_j >= 0,   r_j (z_j − lo_j) = 0        (Signorini)
@@ -30,9 +30,8 @@
 //! still shows when recomputed in floating point (see [`ROUNDOFF_ULPS`]); with `eps = 0` (the
 //! penalty solver, which solves its problem directly) only the floors remain.
 
-use crate::solver::StepFailure;
-use crate::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
-use serde::Serialize;
+use crate::linalg::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
+use crate::step::report::{AuditReport, StepFailure, Worst};
 
 /// Margin over OSQP's own stopping test: OSQP evaluates its residuals on its scaled copy of the
 /// data and may accept a polished answer that trades a little of one residual for the other
@@ -58,52 +57,6 @@ pub enum Law {
     Signorini { eps_abs: f64, eps_rel: f64 },
     /// Normal compliance `ε r_j = max(0, lo_j − z_j)`, solved directly: round-off floors only.
     Penalty { epsilon: f64 },
-}
-
-/// The worst value of one audited quantity over a run, and its worst ratio to its tolerance
-/// (the audit fails when the ratio exceeds 1).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct Worst {
-    pub max: f64,
-    pub max_over_tolerance: f64,
-}
-
-impl Worst {
-    fn observe(&mut self, value: f64, tolerance: f64) {
-        self.max = self.max.max(value);
-        let ratio = if tolerance > 0.0 {
-            value / tolerance
-        } else if value > 0.0 {
-            f64::INFINITY
-        } else {
-            0.0
-        };
-        self.max_over_tolerance = self.max_over_tolerance.max(ratio);
-    }
-}
-
-/// The worst audit residuals of a run (`summary.json`, field `audit`). Checks that do not apply
-/// to the law are absent: primal feasibility and complementarity for the penalty law, the
-/// penalty law for Signorini.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct AuditReport {
-    /// Steps audited.
-    pub steps: u64,
-    /// `max_j (lo_j − z_j)⁺`, displacement.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub primal_violation: Option<Worst>,
-    /// `max_j (−r_j)⁺`, force.
-    pub negative_reaction: Worst,
-    /// `max_j |r_j (z_j − lo_j)|`, force × displacement.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub complementarity: Option<Worst>,
-    /// `max_j |ε r_j − max(0, lo_j − z_j)|`, displacement.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub penalty_law: Option<Worst>,
-    /// `‖Cz − b − Σ r_j e_j‖_∞`, force.
-    pub stationarity: Worst,
-    /// `‖C⁻¹(Cz − b − Σ r_j e_j)‖_∞`, displacement.
-    pub stationarity_displacement: Worst,
 }
 
 /// The audit of one run: the matrix, its factorisation, scratch space and the worst residuals.

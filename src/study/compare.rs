@@ -1,10 +1,11 @@
 //! Two runs of the same discretisation side by side, e.g. one scene with two step solvers:
 //! the largest difference of the displacements over all nodes and steps.
 
-use crate::error::{RunError, SceneError};
-use crate::run::{Summary, Tracker};
 use crate::scene::Scene;
-use crate::simulation::{Simulation, StepRecord};
+use crate::scene::SceneError;
+use crate::time::RunError;
+use crate::time::run::{Summary, Tracker};
+use crate::time::simulation::{Simulation, StepRecord};
 
 /// How far run `b` is from run `a`, over every step `u^1 … u^N` and every node.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -84,7 +85,7 @@ pub fn compare(name: &str, a: &Scene, b: &Scene) -> Result<Comparison, RunError>
 /// One step problem `min ½zᵀCz − bᵀz, z_j >= lo_j` with the exact solver's answer `(z, r)`.
 #[derive(Clone, Debug)]
 pub struct StepProblem {
-    pub c: crate::tridiag::SymTridiag,
+    pub c: crate::linalg::tridiag::SymTridiag,
     /// Local indices of the constrained nodes.
     pub nodes: Vec<usize>,
     pub b: Vec<f64>,
@@ -96,7 +97,7 @@ pub struct StepProblem {
 /// The start-up step problem of `scene` (the step `u^0 → u^1`) as the exact solver of the scene's
 /// constraints sees it, and its answer: the data on which other solvers are probed in isolation.
 pub fn start_up_problem(scene: &Scene) -> Result<StepProblem, RunError> {
-    use crate::solver::{SolveInfo, StepFailure, StepSolver};
+    use crate::step::{SolveInfo, StepFailure, StepSolver};
     use std::cell::RefCell;
     use std::rc::Rc;
 
@@ -126,12 +127,12 @@ pub fn start_up_problem(scene: &Scene) -> Result<StepProblem, RunError> {
 
     let mut exact = scene.clone();
     exact.solver.method = crate::scene::SolverMethod::Exact;
-    let disc = crate::simulation::Discretisation::new(&exact)?;
+    let disc = crate::time::simulation::Discretisation::new(&exact)?;
     let c = disc.step_matrix.clone();
     let nodes = disc.constrained_locals();
     let first = Rc::default();
     let recorder = Recorder {
-        inner: crate::simulation::make_solver(&exact, &disc)?,
+        inner: crate::time::simulation::make_solver(&exact, &disc)?,
         first: Rc::clone(&first),
     };
     // Setting the simulation up solves the start-up step.

@@ -4,7 +4,7 @@
 //! matrix-vector product, quadratic forms and a factorisation computed once per run and reused
 //! for every step.
 
-use crate::dispatch;
+use crate::linalg::dispatch;
 use std::cell::Cell;
 use std::sync::Arc;
 

@@ -3,13 +3,25 @@
 //! The keys are the public interface; unknown keys are refused so that a typo such as
 //! `viscocity` is an error, not a silently ignored setting.
 
-use crate::error::SceneError;
-use crate::expr::Expression;
-use crate::matrices::MatrixVariant;
+use crate::scene::SceneError;
+use crate::scene::expr::Expression;
+use crate::step::osqp::{OSQP_DEFAULT_EPS, OsqpSettings};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// A scene as read from TOML, before validation (see [`Scene::validate`]).
+/// Which pair of matrices a scene uses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MatrixVariant {
+    /// `M = Δx/6 · tridiag(1, 4, 1)` with end diagonals `Δx/3`;
+    /// `R = 1/Δx · tridiag(−1, 2, −1)` with end diagonals `1/Δx`.
+    #[default]
+    Consistent,
+    /// The entries as printed in the talk (inconsistent; for diagnosis only).
+    TalkPrinted,
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
@@ -195,19 +207,22 @@ pub struct SolverSpec {
     pub epsilon: Option<f64>,
 }
 
-/// OSQP's `eps_abs` and `eps_rel` unless set: tight enough that, polished, the answer agrees
-/// with the exact solver to round-off on the talk's scenes (VERIFICATION.md, section "Step solvers").
-pub const OSQP_DEFAULT_EPS: f64 = 1e-10;
-/// OSQP's iteration limit unless set: far above what the talk's scenes need per step.
-pub const OSQP_DEFAULT_MAX_ITER: u32 = 100_000;
-/// Rho adaptation every 25 iterations unless set: OSQP 0.6's default (0 = tied to the setup
-/// time) makes the iteration, hence the bits of the answer, depend on the machine's load.
-pub const OSQP_DEFAULT_ADAPTIVE_RHO_INTERVAL: u32 = 25;
-/// ε of the penalised problem unless set: penetration ≈ ε × reaction, so about 1e-6 for the
-/// talk's reactions of order 1.
-pub const PENALTY_DEFAULT_EPSILON: f64 = 1e-6;
-
 impl SolverSpec {
+    /// The OSQP settings this spec asks for, OSQP's defaults for those not given.
+    pub fn osqp_settings(&self) -> OsqpSettings {
+        let d = OsqpSettings::default();
+        OsqpSettings {
+            eps_abs: self.eps_abs.unwrap_or(d.eps_abs),
+            eps_rel: self.eps_rel.unwrap_or(d.eps_rel),
+            polish: self.polish.unwrap_or(d.polish),
+            max_iter: self.max_iter.unwrap_or(d.max_iter),
+            adaptive_rho_interval: self
+                .adaptive_rho_interval
+                .unwrap_or(d.adaptive_rho_interval),
+            accept_inaccurate: self.accept_inaccurate.unwrap_or(d.accept_inaccurate),
+        }
+    }
+
     /// The settings that are set and belong to `method`s other than `self.method`, by name.
     fn foreign_settings(&self) -> Vec<(&'static str, SolverMethod)> {
         let osqp = [
@@ -337,27 +352,27 @@ pub const MAX_STEPS: u64 = 1_000_000_000;
 
 /// Built-in scenes, embedded from `scenes/*.toml`.
 pub const BUILTIN: &[(&str, &str)] = &[
-    ("modal", include_str!("../scenes/modal.toml")),
-    ("impact", include_str!("../scenes/impact.toml")),
-    ("falling-bar", include_str!("../scenes/falling-bar.toml")),
+    ("modal", include_str!("../../scenes/modal.toml")),
+    ("impact", include_str!("../../scenes/impact.toml")),
+    ("falling-bar", include_str!("../../scenes/falling-bar.toml")),
     (
         "clamped-impact",
-        include_str!("../scenes/clamped-impact.toml"),
+        include_str!("../../scenes/clamped-impact.toml"),
     ),
-    ("both-ends", include_str!("../scenes/both-ends.toml")),
+    ("both-ends", include_str!("../../scenes/both-ends.toml")),
     (
         "both-ends-forced",
-        include_str!("../scenes/both-ends-forced.toml"),
+        include_str!("../../scenes/both-ends-forced.toml"),
     ),
-    ("one-end", include_str!("../scenes/one-end.toml")),
+    ("one-end", include_str!("../../scenes/one-end.toml")),
     (
         "one-end-forced",
-        include_str!("../scenes/one-end-forced.toml"),
+        include_str!("../../scenes/one-end-forced.toml"),
     ),
-    ("distributed", include_str!("../scenes/distributed.toml")),
+    ("distributed", include_str!("../../scenes/distributed.toml")),
     (
         "distributed-forced",
-        include_str!("../scenes/distributed-forced.toml"),
+        include_str!("../../scenes/distributed-forced.toml"),
     ),
 ];
 

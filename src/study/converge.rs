@@ -7,12 +7,12 @@
 //! files do not depend on the scheduling. Wall times do: they are the only non-deterministic
 //! column.
 
-use crate::closed_form::{self, ClosedForm, Impact};
-use crate::error::RunError;
-use crate::run::{Tracker, write_atomically};
+use crate::bar::closed_form::{self, ClosedForm, Impact};
 use crate::scene::{Scene, SolverMethod, SolverSpec};
-use crate::simulation::Simulation;
-use crate::study::observed_order;
+use crate::study::accuracy::observed_order;
+use crate::time::RunError;
+use crate::time::run::{Tracker, write_atomically};
+use crate::time::simulation::Simulation;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -38,7 +38,7 @@ pub enum ConvergeError {
     #[error(transparent)]
     Run(#[from] RunError),
     #[error(transparent)]
-    Scene(#[from] crate::error::SceneError),
+    Scene(#[from] crate::scene::SceneError),
     #[error("cannot draw {path}: {message}")]
     Draw { path: PathBuf, message: String },
     #[error("cannot write {path}: {source}")]
@@ -185,10 +185,11 @@ pub struct Row {
 }
 
 fn impact_of(scene: &Scene) -> Option<Impact> {
-    let v = crate::expr::Expression::parse("initial.velocity", &scene.initial.velocity, false)
-        .ok()?
-        .eval(0.0, 0.0)
-        .ok()?;
+    let v =
+        crate::scene::expr::Expression::parse("initial.velocity", &scene.initial.velocity, false)
+            .ok()?
+            .eval(0.0, 0.0)
+            .ok()?;
     Some(Impact {
         length: scene.bar.length,
         gap: scene.left.gap?,
@@ -585,7 +586,7 @@ fn write_plot(
     lines: &[(String, Vec<(f64, f64)>)],
 ) -> Result<(), ConvergeError> {
     use plotters::prelude::*;
-    crate::figures::register_font().map_err(|e| ConvergeError::Draw {
+    crate::study::figures::register_font().map_err(|e| ConvergeError::Draw {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;

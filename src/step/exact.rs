@@ -24,16 +24,16 @@
 //! Cancellation. When contact stops a large free motion (`Δt ≫ Δx` with stiff `C`: `z⁰` is
 //! the rigid flight `≈ Δt v`, `z` a tiny deflection), `z = z⁰ + Σ r_j c_j` cancels
 //! `max|z⁰| / max|z|` digits and its error, about `ε max|z⁰|`, can reach `z` itself (found by
-//! the stiff case matrix, `src/stiff.rs`: an error as large as `z` at `α = 1e6`, `Δt = 1e4 Δx`). When that
+//! the stiff case matrix, `src/study/stiff.rs`: an error as large as `z` at `α = 1e6`, `Δt = 1e4 Δx`). When that
 //! ratio (against `max(|z|, |u^n|)`) exceeds [`RESOLVE_CANCELLATION`], the step is recomputed on the chosen active set `A`
 //! by a backward-stable direct solve, `z_A = lo_A`, `C_FF z_F = b_F − C_FA lo_A`, with the
 //! reactions `r_A = (Cz − b)_A`; the reduced matrices of the three non-empty active sets are
 //! factorised once per run.
 
-use crate::solver::{SolveInfo, StepFailure, StepSolver};
-use crate::tridiag::{
+use crate::linalg::tridiag::{
     Ldlt, NotPositiveDefinite, RowChange, SymTridiag, add_columns_in_place, add_in_place, max4,
 };
+use crate::step::{SolveInfo, StepFailure, StepSolver};
 
 /// Largest cancellation `max|z⁰| / max(|z|, |u^n|)` over the columns' support accepted from
 /// the superposition `z⁰ + Σ r_j c_j`: its rounding error is about `ε max|z⁰|`, i.e. this many
@@ -742,7 +742,7 @@ impl Column {
 /// exact and penalty solvers).
 #[cfg(test)]
 pub(crate) fn rigid_flight() -> (SymTridiag, Vec<f64>) {
-    use crate::matrices::{MatrixVariant, mass, stiffness};
+    use crate::bar::matrices::{MatrixVariant, mass, stiffness};
     let (elements, alpha) = (20usize, 1e6);
     let dx = 1.0 / elements as f64;
     let dt = 1e4 * dx;
@@ -757,8 +757,8 @@ pub(crate) fn rigid_flight() -> (SymTridiag, Vec<f64>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::audit::{KktAudit, Law};
-    use crate::matrices::{MatrixVariant, mass, stiffness};
+    use crate::bar::matrices::{MatrixVariant, mass, stiffness};
+    use crate::step::audit::{KktAudit, Law};
 
     /// Two direct solves of the same reduced system, each a few ulps of `max|z|` off, agree to
     /// this many.
@@ -786,7 +786,7 @@ mod tests {
         };
         audit.check(law, &b, &lower, &z, &reactions).unwrap();
 
-        let mut pivot = crate::active_set::BlockPivotSolver::new(&c, &ends).unwrap();
+        let mut pivot = crate::step::block_pivot::BlockPivotSolver::new(&c, &ends).unwrap();
         let (mut z_pivot, mut r_pivot) = (vec![0.0; nodes], [0.0; 2]);
         pivot.solve(&b, &lower, &mut z_pivot, &mut r_pivot).unwrap();
         let z_max = z_pivot.iter().fold(0.0f64, |a, v| a.max(v.abs()));

@@ -6,20 +6,8 @@
 //! (`R·1 ≠ 0`). The consistent matrices are the default; the printed ones are kept as
 //! [`MatrixVariant::TalkPrinted`] so that the tests can show what is wrong with them.
 
-use crate::tridiag::SymTridiag;
-use serde::{Deserialize, Serialize};
-
-/// Which pair of matrices a scene uses.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum MatrixVariant {
-    /// `M = Δx/6 · tridiag(1, 4, 1)` with end diagonals `Δx/3`;
-    /// `R = 1/Δx · tridiag(−1, 2, −1)` with end diagonals `1/Δx`.
-    #[default]
-    Consistent,
-    /// The entries as printed in the talk (inconsistent; for diagnosis only).
-    TalkPrinted,
-}
+use crate::linalg::tridiag::SymTridiag;
+pub use crate::scene::MatrixVariant;
 
 /// Mass matrix on `nodes = J + 2` nodes with spacing `dx`.
 pub fn mass(variant: MatrixVariant, nodes: usize, dx: f64) -> SymTridiag {

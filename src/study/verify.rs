@@ -3,12 +3,12 @@
 //! document is regenerated (`viscobar verify --update VERIFICATION.md`), never hand-edited.
 //! Every figure here is deterministic (no timings), so a test checks the document is current.
 
-use crate::closed_form;
-use crate::error::RunError;
-use crate::matrices::{MatrixVariant, mass, stiffness};
-use crate::run::run_in_memory;
+use crate::bar::closed_form;
+use crate::bar::matrices::{MatrixVariant, mass, stiffness};
 use crate::scene;
-use crate::study::{error_against, observed_order, rigid_mode_drift};
+use crate::study::accuracy::{error_against, observed_order, rigid_mode_drift};
+use crate::time::RunError;
+use crate::time::run::run_in_memory;
 use std::fmt::Write;
 
 /// One generated block of VERIFICATION.md.
@@ -26,20 +26,20 @@ pub const RIGID_STEPS: usize = 26_000;
 
 /// All sections, in document order.
 /// Errors are those of the runs and of the α-sweep (both carry their exit code).
-pub fn sections() -> Result<Vec<Section>, crate::converge::ConvergeError> {
+pub fn sections() -> Result<Vec<Section>, crate::study::converge::ConvergeError> {
     Ok(vec![
         matrices_section(),
         solve_section(),
         scenes_section()?,
         Section {
             id: "solver-agreement",
-            markdown: crate::agreement::markdown()?,
+            markdown: crate::study::agreement::markdown()?,
         },
         convergence_section()?,
         falling_bar_section()?,
         roundoff_section()?,
         viscosity_section()?,
-        stiff_section(crate::stiff::Size::Full),
+        stiff_section(crate::study::stiff::Size::Full),
     ])
 }
 
@@ -57,7 +57,7 @@ fn matrices_section() -> Section {
                 .mul(&vec![1.0; nodes])
                 .iter()
                 .fold(0.0f64, |a, v| a.max(v.abs()));
-            let sym = |a: &crate::tridiag::SymTridiag| {
+            let sym = |a: &crate::linalg::tridiag::SymTridiag| {
                 let d = a.to_dense();
                 d == d.transpose()
             };
@@ -113,14 +113,14 @@ pub fn solve_study(nodes: &[usize]) -> Vec<SolveCase> {
                 mass(MatrixVariant::Consistent, n, dx),
                 stiffness(MatrixVariant::Consistent, n, dx),
             );
-            let c = crate::tridiag::SymTridiag::combine(
+            let c = crate::linalg::tridiag::SymTridiag::combine(
                 1.0 / (dt * dt),
                 &m,
                 0.5 + alpha / (2.0 * dt),
                 &r,
             );
             let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() + 0.1).collect();
-            let Ok(factor) = crate::tridiag::Ldlt::factor(&c) else {
+            let Ok(factor) = crate::linalg::tridiag::Ldlt::factor(&c) else {
                 continue;
             };
             let mut x = b.clone();
@@ -131,7 +131,7 @@ pub fn solve_study(nodes: &[usize]) -> Vec<SolveCase> {
                 alpha,
                 dt_over_dx: ratio,
                 nodes: n,
-                backward_error: crate::tridiag::backward_error(&c, &x, &b),
+                backward_error: crate::linalg::tridiag::backward_error(&c, &x, &b),
                 into_same_bits: x.iter().zip(&y).all(|(p, q)| p.to_bits() == q.to_bits()),
             });
         }
@@ -242,8 +242,8 @@ fn convergence_section() -> Result<Section, RunError> {
 
 /// The falling bar through `viscobar converge` (exact solver; the wall times are left out):
 /// the errors in displacement, energy and contact times, and their observed orders.
-fn falling_bar_section() -> Result<Section, crate::converge::ConvergeError> {
-    use crate::converge::{SolverSetting, study};
+fn falling_bar_section() -> Result<Section, crate::study::converge::ConvergeError> {
+    use crate::study::converge::{SolverSetting, study};
     let (_, base) = scene::load("falling-bar", &[])?;
     let st = study(
         "falling-bar",
@@ -270,7 +270,7 @@ fn falling_bar_section() -> Result<Section, crate::converge::ConvergeError> {
         );
     }
     let h: Vec<f64> = st.rows.iter().map(|r| r.dx).collect();
-    let order = |f: fn(&crate::converge::Row) -> Option<f64>| {
+    let order = |f: fn(&crate::study::converge::Row) -> Option<f64>| {
         let e: Option<Vec<f64>> = st.rows.iter().map(f).collect();
         e.map_or("-".to_string(), |e| {
             format!("{:.3}", observed_order(&h, &e))
@@ -339,9 +339,10 @@ pub fn update_document(doc: &str, sections: &[Section]) -> Result<String, String
 pub const SWEEP_ALPHAS: [f64; 4] = [1e-1, 1e-2, 1e-3, 1e-4];
 pub const SWEEP_ELEMENTS: [u64; 2] = [800, 1600];
 
-fn viscosity_section() -> Result<Section, crate::converge::ConvergeError> {
+fn viscosity_section() -> Result<Section, crate::study::converge::ConvergeError> {
     let (_, base) = scene::load("impact", &[])?;
-    let sweep = crate::converge::viscosity_sweep("impact", &base, &SWEEP_ALPHAS, &SWEEP_ELEMENTS)?;
+    let sweep =
+        crate::study::converge::viscosity_sweep("impact", &base, &SWEEP_ALPHAS, &SWEEP_ELEMENTS)?;
     Ok(Section {
         id: "viscosity",
         markdown: sweep.markdown(),
@@ -350,9 +351,9 @@ fn viscosity_section() -> Result<Section, crate::converge::ConvergeError> {
 
 /// The stiff and extreme case matrix at full size (about 40 s on 2 cores; alone:
 /// `viscobar verify --stiff`); `tests/stiff.rs` runs the reduced size.
-pub fn stiff_section(size: crate::stiff::Size) -> Section {
+pub fn stiff_section(size: crate::study::stiff::Size) -> Section {
     Section {
         id: "stiff",
-        markdown: crate::stiff::markdown(&crate::stiff::run_all(size)),
+        markdown: crate::study::stiff::markdown(&crate::study::stiff::run_all(size)),
     }
 }

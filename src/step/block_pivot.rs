@@ -26,8 +26,8 @@
 //! The active set is warm-started from the previous step; when it is empty, the factorisation
 //! of `C` computed once per run is used.
 
-use crate::solver::{SolveInfo, StepFailure, StepSolver};
-use crate::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
+use crate::linalg::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
+use crate::step::{SolveInfo, StepFailure, StepSolver};
 
 /// Block iterations allowed without a decrease of the number of infeasible indices before the
 /// single-pivot safeguard takes over (Júdice & Pires use a small constant; 10 keeps the fast

@@ -16,7 +16,7 @@
 //! until the interval stops shrinking, so a small eigenvalue is resolved to round-off of `‖A‖`
 //! (relative error about `κ(A)·ε`, which is what the condition number is needed for).
 
-use crate::tridiag::SymTridiag;
+use crate::linalg::tridiag::SymTridiag;
 
 /// Number of eigenvalues of `a` strictly below `x` (Sturm count). A zero pivot is replaced by
 /// `−pivmin` (LAPACK `dlaebz`), the smallest perturbation that keeps the recurrence finite.
@@ -181,7 +181,7 @@ mod tests {
 
     #[test]
     fn step_matrices_match_dense_from_mass_dominated_to_stiff() {
-        use crate::matrices::{MatrixVariant, mass, stiffness};
+        use crate::bar::matrices::{MatrixVariant, mass, stiffness};
         let nodes = 21;
         let dx = 1.0 / 20.0;
         let m = mass(MatrixVariant::Consistent, nodes, dx);

@@ -1,10 +1,10 @@
 //! Error measurement against closed forms, shared by the tests and the CLI studies.
 
-use crate::closed_form::ClosedForm;
-use crate::error::RunError;
+use crate::bar::closed_form::ClosedForm;
+use crate::linalg::tridiag::{Ldlt, SymTridiag};
 use crate::scene::Scene;
-use crate::simulation::{Discretisation, Simulation};
-use crate::tridiag::{Ldlt, SymTridiag};
+use crate::time::RunError;
+use crate::time::simulation::{Discretisation, Simulation};
 
 /// Errors of a run against an exact solution, at the nodes and every time step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

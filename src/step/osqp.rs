@@ -12,28 +12,33 @@
 //!
 //! OSQP's dual `y` is negative at an active lower bound, so the reaction is `r = −y`.
 //!
-//! Every answer OSQP reports as solved is audited ([`crate::audit`]); a status other than
+//! Every answer OSQP reports as solved is audited ([`crate::step::audit`]); a status other than
 //! "solved" (or "solved inaccurate" with `accept_inaccurate`) or a failed audit is an error.
 //!
 //! Determinism: OSQP runs single-threaded, and the rho adaptation interval is fixed (OSQP's
 //! default adapts after a fraction of the set-up *time*), so a run gives the same bits every
 //! time on a given machine and build.
 
-use crate::audit::{INACCURATE_FACTOR, KktAudit, Law};
-use crate::error::RunError;
-use crate::scene::{
-    OSQP_DEFAULT_ADAPTIVE_RHO_INTERVAL, OSQP_DEFAULT_EPS, OSQP_DEFAULT_MAX_ITER, SolverSpec,
-};
-use crate::solver::{SolveInfo, SolverReport, StepFailure, StepSolver};
-use crate::tridiag::{NotPositiveDefinite, SymTridiag};
+use crate::linalg::tridiag::{NotPositiveDefinite, SymTridiag};
+use crate::step::audit::{INACCURATE_FACTOR, KktAudit, Law};
+use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
 use osqp::{CscMatrix, Problem, Settings, Status};
 use std::borrow::Cow;
+
+/// OSQP's `eps_abs` and `eps_rel` unless set: tight enough that, polished, the answer agrees
+/// with the exact solver to round-off on the talk's scenes (VERIFICATION.md, section "Step solvers").
+pub const OSQP_DEFAULT_EPS: f64 = 1e-10;
+/// OSQP's iteration limit unless set: far above what the talk's scenes need per step.
+pub const OSQP_DEFAULT_MAX_ITER: u32 = 100_000;
+/// Rho adaptation every 25 iterations unless set: OSQP 0.6's default (0 = tied to the setup
+/// time) makes the iteration, hence the bits of the answer, depend on the machine's load.
+pub const OSQP_DEFAULT_ADAPTIVE_RHO_INTERVAL: u32 = 25;
 
 /// OSQP's infinity (`OSQP_INFTY` in constants.h): bounds at or beyond it count as absent.
 /// `f64::INFINITY` must not be used: it breaks OSQP's infeasibility tests.
 pub const OSQP_INFTY: f64 = 1e30;
 
-/// The OSQP settings a scene can choose (see [`SolverSpec`] for the defaults).
+/// The OSQP settings a scene can choose (defaults: the `OSQP_DEFAULT_*` constants).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OsqpSettings {
     pub eps_abs: f64,
@@ -58,21 +63,6 @@ impl Default for OsqpSettings {
 }
 
 impl OsqpSettings {
-    /// The scene's settings, defaults for those not given.
-    pub fn from_spec(spec: &SolverSpec) -> Self {
-        let d = Self::default();
-        Self {
-            eps_abs: spec.eps_abs.unwrap_or(d.eps_abs),
-            eps_rel: spec.eps_rel.unwrap_or(d.eps_rel),
-            polish: spec.polish.unwrap_or(d.polish),
-            max_iter: spec.max_iter.unwrap_or(d.max_iter),
-            adaptive_rho_interval: spec
-                .adaptive_rho_interval
-                .unwrap_or(d.adaptive_rho_interval),
-            accept_inaccurate: spec.accept_inaccurate.unwrap_or(d.accept_inaccurate),
-        }
-    }
-
     fn to_osqp(self) -> Settings {
         Settings::default()
             .verbose(false)
@@ -92,18 +82,6 @@ pub enum OsqpSetupError {
     Matrix(#[from] NotPositiveDefinite),
     #[error("{0}")]
     Osqp(String),
-}
-
-impl From<OsqpSetupError> for RunError {
-    fn from(e: OsqpSetupError) -> Self {
-        match e {
-            OsqpSetupError::Matrix(m) => RunError::Matrix(m),
-            OsqpSetupError::Osqp(reason) => RunError::SolverSetup {
-                solver: "osqp".into(),
-                reason,
-            },
-        }
-    }
 }
 
 /// OSQP on the step problem, set up once per run, audited every step.

@@ -1,7 +1,6 @@
-//! Error types. Bad input ([`SceneError`]) is kept apart from failures during a run
-//! ([`RunError`]) and from a step solver's own outcome ([`crate::solver::StepFailure`]).
+//! [`SceneError`]: a scene that cannot be run as written, kept apart from failures during a run
+//! ([`crate::time::RunError`]) and from a step solver's own outcome ([`crate::step::StepFailure`]).
 
-use crate::solver::StepFailure;
 use std::path::PathBuf;
 
 /// A scene that cannot be run as written. Every variant names the offending field or item.
@@ -50,37 +49,4 @@ pub enum SceneError {
     },
     #[error("--set {assignment}: {reason}")]
     Override { assignment: String, reason: String },
-}
-
-/// A run that started but could not finish.
-#[derive(Debug, thiserror::Error)]
-pub enum RunError {
-    #[error(transparent)]
-    Scene(#[from] SceneError),
-    #[error("step {step} (t = {time}): solver `{solver}` failed: {failure}")]
-    Step {
-        step: usize,
-        time: f64,
-        solver: String,
-        failure: StepFailure,
-    },
-    #[error("the step matrix C is not positive definite ({0}); check dt, viscosity and matrices")]
-    Matrix(#[from] crate::tridiag::NotPositiveDefinite),
-    #[error("solver `{solver}` cannot be set up: {reason}")]
-    SolverSetup { solver: String, reason: String },
-    #[error("cannot write {path}: {source}")]
-    Write {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-}
-
-impl RunError {
-    /// Process exit code: 2 for bad input, 1 for a failure during the run.
-    pub fn exit_code(&self) -> i32 {
-        match self {
-            RunError::Scene(_) => 2,
-            _ => 1,
-        }
-    }
 }

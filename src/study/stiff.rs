@@ -9,12 +9,12 @@
 //!
 //! Per run (solver): the largest relative energy-identity residual, the largest penetration,
 //! the distance to the exact solver (max over nodes and steps), the cumulative drift of the
-//! energy balance, and, for the exact solver, the KKT audit of [`crate::audit`] at its
+//! energy balance, and, for the exact solver, the KKT audit of [`crate::step::audit`] at its
 //! round-off floors (`eps = 0`), an independent check of the reference itself. `κ(C)` comes
-//! from [`crate::spectrum`].
+//! from [`crate::linalg::spectrum`].
 //!
 //! Tolerances. A backward-stable tridiagonal solve leaves a stationarity residual
-//! `ρ = Cz − b − r` of about `ROUNDOFF_ULPS·ε·|C||z|` ([`crate::audit::ROUNDOFF_ULPS`]). The
+//! `ρ = Cz − b − r` of about `ROUNDOFF_ULPS·ε·|C||z|` ([`crate::step::audit::ROUNDOFF_ULPS`]). The
 //! energy identity is the scheme multiplied by `δ/2` (`δ = u^{n+1} − u^{n−1}`), so its
 //! residual is `½ρ·δ` plus the rounding of the energy sums (`n` terms each). The terms of the
 //! identity are quadratic forms of size `δᵀCδ ≥ λ_min |δ|²`, while `|ρ·δ| ≲ ε λ_max |z||δ|`:
@@ -23,11 +23,13 @@
 //! apart by `ROUNDOFF_ULPS·ε·κ(C)·|u|` per step; the stable scheme carries such a
 //! perturbation forward without growth, so over `N` steps `N` times that ([`roundoff_distance`]).
 
-use crate::audit::{AUDIT_MARGIN, KktAudit, Law, ROUNDOFF_ULPS};
-use crate::error::RunError;
-use crate::scene::{OSQP_DEFAULT_EPS, PENALTY_DEFAULT_EPSILON, Scene};
-use crate::simulation::{Discretisation, Simulation, make_solver};
-use crate::solver::{SolveInfo, SolverReport, StepFailure, StepSolver};
+use crate::scene::Scene;
+use crate::step::audit::{AUDIT_MARGIN, KktAudit, Law, ROUNDOFF_ULPS};
+use crate::step::osqp::OSQP_DEFAULT_EPS;
+use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
+use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
+use crate::time::RunError;
+use crate::time::simulation::{Discretisation, Simulation, make_solver};
 use rayon::prelude::*;
 use std::fmt::Write;
 
@@ -421,7 +423,7 @@ impl StepSolver for Audited {
 /// end enumeration puts an active node on its bound exactly, moving `z_j` by its forward error
 /// (up to `κ ε |z|`), which leaves a force residual `C_jj` times that by design. Its image in
 /// displacement, `‖C⁻¹(Cz − b − r)‖`, is checked: that is the error of the answer.
-fn worst_ratio(r: &crate::audit::AuditReport) -> f64 {
+fn worst_ratio(r: &crate::step::AuditReport) -> f64 {
     [
         r.primal_violation.map_or(0.0, |w| w.max_over_tolerance),
         r.negative_reaction.max_over_tolerance,
@@ -478,7 +480,7 @@ impl Live {
         self.sim = None;
     }
 
-    fn observe(&mut self, r: &crate::simulation::StepRecord, first: bool) {
+    fn observe(&mut self, r: &crate::time::simulation::StepRecord, first: bool) {
         let o = &mut self.out;
         o.steps_done = r.step;
         o.max_violation = o.max_violation.max(-r.min_gap);
@@ -540,7 +542,7 @@ pub fn run_case(case: &Case) -> CaseResult {
                 Ok(sim) => {
                     if kappa.is_none() {
                         let d = sim.discretisation();
-                        kappa = crate::spectrum::condition_number(&d.step_matrix);
+                        kappa = crate::linalg::spectrum::condition_number(&d.step_matrix);
                         max_gap = d.constraints.iter().fold(0.0, |m, c| m.max(c.gap));
                         schur = d.ends_only().then(|| inverse_diagonal_range(d)).flatten();
                     }
@@ -597,7 +599,7 @@ pub fn run_case(case: &Case) -> CaseResult {
 
 /// `(min_j, max_j) (C⁻¹)_jj` over the constrained nodes, one O(n) solve each (at most two).
 fn inverse_diagonal_range(d: &Discretisation) -> Option<(f64, f64)> {
-    let factor = crate::tridiag::Ldlt::factor(&d.step_matrix).ok()?;
+    let factor = crate::linalg::tridiag::Ldlt::factor(&d.step_matrix).ok()?;
     d.constrained_locals()
         .iter()
         .map(|&j| factor.column_of_inverse(j)[j])

@@ -11,40 +11,7 @@
 //! which every implementation must meet, are `C z = b + Σ_j r_j e_j`, `z_j >= lo_j`, `r_j >= 0`,
 //! `r_j (z_j − lo_j) = 0`; the multipliers `r_j` are the contact reactions.
 
-/// Outcome statistics of one successful solve.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SolveInfo {
-    /// Iterations (active sets tried, Newton steps, ADMM iterations...), solver-specific.
-    pub iterations: u32,
-}
-
-/// Run-level statistics a solver keeps about its own answers, for `summary.json`. Solvers that
-/// audit their answers (see [`crate::audit`]) report the worst residuals seen.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
-pub struct SolverReport {
-    /// Worst optimality residuals over all steps, each with its ratio to its tolerance.
-    pub audit: crate::audit::AuditReport,
-    /// Steps accepted although OSQP reported "solved inaccurate" (`accept_inaccurate = true`);
-    /// `None` for solvers without that notion.
-    pub inaccurate_steps: Option<u64>,
-}
-
-/// Why a step solver produced no trustworthy answer.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum StepFailure {
-    #[error("non-finite value in the solution (right-hand side or data overflowed)")]
-    NonFinite,
-    #[error("solver status: {0}")]
-    Status(String),
-    /// The solver reported success but its answer fails an optimality condition checked
-    /// independently by [`crate::audit::KktAudit`].
-    #[error("audit failed: {what} = {value:e} exceeds its tolerance {tolerance:e}")]
-    AuditFailed {
-        what: &'static str,
-        value: f64,
-        tolerance: f64,
-    },
-}
+use crate::step::report::{SolveInfo, SolverReport, StepFailure};
 
 /// A solver for the step problem. Built once per run for a fixed `C` and a fixed list of
 /// constrained nodes; `solve` is called every step and must not allocate.
@@ -79,7 +46,7 @@ pub trait StepSolver {
         reactions: &mut [f64],
     ) -> Result<(SolveInfo, f64), StepFailure> {
         let info = self.solve(rhs, lower, z, reactions)?;
-        Ok((info, crate::tridiag::add_in_place(u, z)))
+        Ok((info, crate::linalg::tridiag::add_in_place(u, z)))
     }
 
     /// Statistics over all solves so far; `None` for solvers that keep none.

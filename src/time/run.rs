@@ -1,17 +1,13 @@
 //! Running a scene end to end: the step loop, the summary statistics and the output files
 //! (`summary.json`, `history.csv`, `displacement.csv`), written whole or not at all.
 
-use crate::error::RunError;
 use crate::scene::Scene;
-use crate::simulation::{Simulation, StepRecord};
+use crate::time::RunError;
+use crate::time::simulation::{CONTACT_GAP_TOL, Simulation, StepRecord};
 use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// A constrained node counts as in contact when its gap `u + a` is at most this: the exact
-/// solver puts active nodes on the obstacle up to the rounding of `u^n + z` (a few ulps of |u|).
-pub const CONTACT_GAP_TOL: f64 = 1e-12;
 
 /// Summary statistics of a run, as written to `summary.json`.
 #[derive(Clone, Debug, Serialize)]
@@ -45,16 +41,16 @@ pub struct Summary {
     pub contact_intervals: std::collections::BTreeMap<String, Vec<[f64; 2]>>,
     pub solver_iterations: Iterations,
     /// Worst optimality residuals of the solver's answers, for solvers that audit them
-    /// (`osqp`, `penalty`; see `viscobar::audit`).
+    /// (`osqp`, `penalty`; see `viscobar::step::audit`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub audit: Option<crate::audit::AuditReport>,
+    pub audit: Option<crate::step::AuditReport>,
     /// Steps where OSQP's "solved inaccurate" was accepted (`accept_inaccurate`; osqp only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub inaccurate_steps: Option<u64>,
 }
 
 /// Where the time of the steps goes, as fractions of the timed phases of the sampled steps
-/// (one in [`crate::simulation::TIMING_SAMPLE_EVERY`], see [`crate::simulation::PhaseTimes`]):
+/// (one in [`crate::time::simulation::TIMING_SAMPLE_EVERY`], see [`crate::time::simulation::PhaseTimes`]):
 /// `rhs` (load and right-hand side), `solver` (the step solver, including its copy of the
 /// right-hand side, and `u += z`), `diagnostics` (energy balance and contact state).
 /// `stepping` is the sampled phases' share of the wall time (the rest is set-up, start-up and
@@ -412,7 +408,7 @@ fn write_history_row(
 fn write_profile(
     w: &mut impl Write,
     t: f64,
-    disc: &crate::simulation::Discretisation,
+    disc: &crate::time::simulation::Discretisation,
     u: &[f64],
     v: &[f64],
 ) -> std::io::Result<()> {

@@ -1,0 +1,10 @@
+//! Linear algebra of the bar: symmetric tridiagonal matrices, their LDLᵀ factorisations and the
+//! O(n) streaming kernels of a step, with the CPU dispatch that runs them compiled for AVX.
+//!
+//! Bottom layer: imports nothing from the crate.
+
+pub mod dispatch;
+pub mod spectrum;
+pub mod tridiag;
+
+pub use tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};

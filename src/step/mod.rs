@@ -1,0 +1,21 @@
+//! One time step's bound-constrained quadratic programme and the solvers behind the
+//! [`StepSolver`] seam: exact enumeration, block pivoting, penalty and OSQP, with the
+//! independent KKT audit of their answers and a dense brute-force oracle for tests.
+//!
+//! Imports only [`crate::linalg`].
+
+pub mod audit;
+pub mod block_pivot;
+pub mod exact;
+pub mod oracle;
+pub mod osqp;
+pub mod penalty;
+pub mod report;
+pub mod solver;
+
+pub use block_pivot::BlockPivotSolver;
+pub use exact::ExactSolver;
+pub use osqp::{OsqpSettings, OsqpSolver};
+pub use penalty::PenaltySolver;
+pub use report::{AuditReport, SolveInfo, SolverReport, StepFailure};
+pub use solver::StepSolver;

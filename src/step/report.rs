@@ -1,0 +1,86 @@
+//! What a step solver reports: the outcome of one solve ([`SolveInfo`]) or why it produced
+//! no trustworthy answer ([`StepFailure`]), and its run-level statistics ([`SolverReport`],
+//! with the worst residuals of the independent audit, [`AuditReport`]).
+
+use serde::Serialize;
+
+/// Outcome statistics of one successful solve.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SolveInfo {
+    /// Iterations (active sets tried, Newton steps, ADMM iterations...), solver-specific.
+    pub iterations: u32,
+}
+
+/// Run-level statistics a solver keeps about its own answers, for `summary.json`. Solvers that
+/// audit their answers (see [`crate::step::audit`]) report the worst residuals seen.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct SolverReport {
+    /// Worst optimality residuals over all steps, each with its ratio to its tolerance.
+    pub audit: AuditReport,
+    /// Steps accepted although OSQP reported "solved inaccurate" (`accept_inaccurate = true`);
+    /// `None` for solvers without that notion.
+    pub inaccurate_steps: Option<u64>,
+}
+
+/// Why a step solver produced no trustworthy answer.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum StepFailure {
+    #[error("non-finite value in the solution (right-hand side or data overflowed)")]
+    NonFinite,
+    #[error("solver status: {0}")]
+    Status(String),
+    /// The solver reported success but its answer fails an optimality condition checked
+    /// independently by [`crate::step::audit::KktAudit`].
+    #[error("audit failed: {what} = {value:e} exceeds its tolerance {tolerance:e}")]
+    AuditFailed {
+        what: &'static str,
+        value: f64,
+        tolerance: f64,
+    },
+}
+
+/// The worst value of one audited quantity over a run, and its worst ratio to its tolerance
+/// (the audit fails when the ratio exceeds 1).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Worst {
+    pub max: f64,
+    pub max_over_tolerance: f64,
+}
+
+impl Worst {
+    pub(crate) fn observe(&mut self, value: f64, tolerance: f64) {
+        self.max = self.max.max(value);
+        let ratio = if tolerance > 0.0 {
+            value / tolerance
+        } else if value > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        };
+        self.max_over_tolerance = self.max_over_tolerance.max(ratio);
+    }
+}
+
+/// The worst audit residuals of a run (`summary.json`, field `audit`). Checks that do not apply
+/// to the law are absent: primal feasibility and complementarity for the penalty law, the
+/// penalty law for Signorini.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct AuditReport {
+    /// Steps audited.
+    pub steps: u64,
+    /// `max_j (lo_j − z_j)⁺`, displacement.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub primal_violation: Option<Worst>,
+    /// `max_j (−r_j)⁺`, force.
+    pub negative_reaction: Worst,
+    /// `max_j |r_j (z_j − lo_j)|`, force × displacement.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub complementarity: Option<Worst>,
+    /// `max_j |ε r_j − max(0, lo_j − z_j)|`, displacement.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub penalty_law: Option<Worst>,
+    /// `‖Cz − b − Σ r_j e_j‖_∞`, force.
+    pub stationarity: Worst,
+    /// `‖C⁻¹(Cz − b − Σ r_j e_j)‖_∞`, displacement.
+    pub stationarity_displacement: Worst,
+}

@@ -1,0 +1,13 @@
+//! The studies that verify the core: errors against closed forms, refinement and
+//! work-precision, solver agreement, the stiff and extreme case matrix, the talk's figures and
+//! the generated tables of VERIFICATION.md.
+//!
+//! Top layer: may import every other layer; nothing imports it.
+
+pub mod accuracy;
+pub mod agreement;
+pub mod compare;
+pub mod converge;
+pub mod figures;
+pub mod stiff;
+pub mod verify;

@@ -1,0 +1,75 @@
+//! [`RunError`]: a run that started but could not finish, and how each layer's set-up errors
+//! map onto it.
+
+use crate::linalg::NotPositiveDefinite;
+use crate::scene::SceneError;
+use crate::step::StepFailure;
+use crate::step::osqp::OsqpSetupError;
+use crate::step::penalty::PenaltySetupError;
+use std::path::PathBuf;
+
+/// A run that started but could not finish.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error("step {step} (t = {time}): solver `{solver}` failed: {failure}")]
+    Step {
+        step: usize,
+        time: f64,
+        solver: String,
+        failure: StepFailure,
+    },
+    #[error("the step matrix C is not positive definite ({0}); check dt, viscosity and matrices")]
+    Matrix(#[from] NotPositiveDefinite),
+    #[error("solver `{solver}` cannot be set up: {reason}")]
+    SolverSetup { solver: String, reason: String },
+    #[error("cannot write {path}: {source}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+impl RunError {
+    /// Process exit code: 2 for bad input, 1 for a failure during the run.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            RunError::Scene(_) => 2,
+            _ => 1,
+        }
+    }
+}
+
+impl From<OsqpSetupError> for RunError {
+    fn from(e: OsqpSetupError) -> Self {
+        match e {
+            OsqpSetupError::Matrix(m) => RunError::Matrix(m),
+            OsqpSetupError::Osqp(reason) => RunError::SolverSetup {
+                solver: "osqp".into(),
+                reason,
+            },
+        }
+    }
+}
+
+impl From<PenaltySetupError> for RunError {
+    fn from(e: PenaltySetupError) -> Self {
+        match e {
+            PenaltySetupError::Matrix(m) => RunError::Matrix(m),
+            PenaltySetupError::Epsilon(v) => RunError::Scene(SceneError::Invalid {
+                field: "solver.epsilon".into(),
+                value: v.to_string(),
+                allowed: "must be a finite number > 0".into(),
+            }),
+            PenaltySetupError::TooManyBounds(k) => RunError::Scene(SceneError::Invalid {
+                field: "solver.method".into(),
+                value: "\"penalty\"".into(),
+                allowed: format!(
+                    "the penalty solver handles the two Signorini ends only; this scene constrains \
+                     {k} nodes (use exact or osqp for an obstacle)"
+                ),
+            }),
+        }
+    }
+}

@@ -1,0 +1,12 @@
+//! The time loop: the discretisation of a scene, the scheme stepped with a step solver, the
+//! discrete energy balance of every step, and the run's outputs (summary, history, displacement).
+//!
+//! Imports every layer below it: [`crate::linalg`], [`crate::step`], [`crate::scene`], [`crate::bar`].
+
+pub mod error;
+pub mod run;
+pub mod simulation;
+
+pub use error::RunError;
+pub use run::{Summary, run_in_memory, run_to_dir};
+pub use simulation::{Discretisation, Simulation, StepRecord};
