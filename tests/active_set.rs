@@ -61,11 +61,11 @@ proptest! {
         let (z, r, _) = solve(&c, b, &nodes, &lo);
         let oracle = brute_force(&c.to_dense(), b, &nodes, &lo, 1e-12).unwrap().unwrap();
         let scale = 1.0 + z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for i in 0..n {
-            prop_assert!((z[i] - oracle.z[i]).abs() <= AGREEMENT_TOL * scale, "node {i}: {} vs {}", z[i], oracle.z[i]);
+        for (i, (zi, oi)) in z.iter().zip(&oracle.z).enumerate() {
+            prop_assert!((zi - oi).abs() <= AGREEMENT_TOL * scale, "node {i}: {zi} vs {oi}");
         }
-        for k in 0..nodes.len() {
-            prop_assert!((r[k] - oracle.reactions[k].max(0.0)).abs() <= AGREEMENT_TOL * scale * 10.0);
+        for (rk, ok) in r.iter().zip(&oracle.reactions) {
+            prop_assert!((rk - ok.max(0.0)).abs() <= AGREEMENT_TOL * scale * 10.0);
         }
     }
 

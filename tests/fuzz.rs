@@ -141,18 +141,17 @@ fn random_scenes_are_refused_or_run_finite() {
     let runs = std::cell::Cell::new(0u32);
     runner
         .run(&scene_text(), |text| {
-            if let Ok(scene) = Scene::from_toml(&text, &[]) {
-                if scene.mesh.elements < MAX_FUZZ_NODES {
-                    if let Ok(mut sim) = Simulation::new(&scene) {
-                        runs.set(runs.get() + 1);
-                        for _ in 1..scene.steps().min(MAX_FUZZ_STEPS) {
-                            match sim.step() {
-                                Ok(r) => prop_assert!(
-                                    r.energy.is_finite() && r.identity_residual.is_finite()
-                                ),
-                                Err(_) => break,
-                            }
+            if let Ok(scene) = Scene::from_toml(&text, &[])
+                && scene.mesh.elements < MAX_FUZZ_NODES
+                && let Ok(mut sim) = Simulation::new(&scene)
+            {
+                runs.set(runs.get() + 1);
+                for _ in 1..scene.steps().min(MAX_FUZZ_STEPS) {
+                    match sim.step() {
+                        Ok(r) => {
+                            prop_assert!(r.energy.is_finite() && r.identity_residual.is_finite())
                         }
+                        Err(_) => break,
                     }
                 }
             }

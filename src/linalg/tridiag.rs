@@ -115,8 +115,8 @@ impl SymTridiag {
     pub fn quad(&self, x: &[f64]) -> f64 {
         let n = self.dim();
         let mut q = 0.0;
-        for i in 0..n {
-            q += self.row_sums[i] * x[i] * x[i];
+        for (s, xi) in self.row_sums.iter().zip(&x[..n]) {
+            q += s * xi * xi;
         }
         for i in 0..n.saturating_sub(1) {
             let d = x[i + 1] - x[i];

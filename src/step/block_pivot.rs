@@ -133,9 +133,9 @@ impl BlockPivotSolver {
         }
         let mut t = z[0];
         z[0] = t * self.inv_d[0];
-        for i in 1..n {
-            t = z[i] - self.l[i - 1] * t;
-            z[i] = t * self.inv_d[i];
+        for ((zi, li), inv_d) in z[1..n].iter_mut().zip(&self.l).zip(&self.inv_d[1..]) {
+            t = *zi - li * t;
+            *zi = t * inv_d;
         }
         let mut next = z[n - 1];
         for i in (0..n - 1).rev() {
