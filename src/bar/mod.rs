@@ -4,6 +4,8 @@
 //! Imports [`crate::linalg`], [`crate::step`] and [`crate::scene`].
 
 pub mod closed_form;
+pub mod discretisation;
 pub mod matrices;
 
 pub use closed_form::ClosedForm;
+pub use discretisation::{Constraint, Discretisation};

@@ -10,25 +10,9 @@
 //! solver's own residuals. A solver that reports success with an answer failing the audit
 //! returns [`StepFailure::AuditFailed`] instead of a result.
 //!
-//! Scales. OSQP (Stellato et al. 2020, termination criteria; auxil.c) stops when, in ∞-norms
-//! on the unscaled problem, the primal residual is below `eps_abs + eps_rel·max(‖Az‖, ‖proj‖)`
-//! and the dual residual `‖Cz − b − Σ r_j e_j‖` below `eps_abs + eps_rel·max(‖b‖, ‖r‖, ‖Cz‖)`.
-//! The audit applies the same formulas (times [`AUDIT_MARGIN`]) to
-//!
-//! - primal feasibility `max_j (lo_j − z_j)⁺`, in displacement, scale `max_j max(|z_j|, |lo_j|)`;
-//! - multiplier sign `max_j (−r_j)⁺` and stationarity `‖Cz − b − Σ r_j e_j‖_∞`, in force,
-//!   scale `max(‖b‖_∞, ‖Cz‖_∞, max_j |r_j|)`;
-//! - complementarity `|r_j (z_j − lo_j)| <= tol_z |r_j| + tol_f |z_j − lo_j|`: either the gap is
-//!   zero to the primal tolerance or the reaction to the dual one;
-//!
-//! and adds one check OSQP does not make: the stationarity residual mapped to displacement,
-//! `‖C⁻¹(Cz − b − Σ r_j e_j)‖_∞`, the change of `z` that would make stationarity exact, with
-//! scale `‖z‖_∞`. A residual within OSQP's tolerance can hide an error in `z` up to `κ(C)` times
-//! larger; this check refuses such answers (the failure case in VERIFICATION.md, section "Step solvers").
-//!
-//! Each tolerance also has a round-off floor: the residual that an answer exact to the last bit
-//! still shows when recomputed in floating point (see [`ROUNDOFF_ULPS`]); with `eps = 0` (the
-//! penalty solver, which solves its problem directly) only the floors remain.
+//! The checks, their scales and their round-off floors follow OSQP's own termination test and
+//! add one it does not make (stationarity mapped to displacement):
+//! [docs/step-solvers.md](../docs/step-solvers.md#kkt-audit).
 
 use crate::linalg::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
 use crate::step::report::{AuditReport, StepFailure, Worst};

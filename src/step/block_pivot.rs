@@ -9,17 +9,9 @@
 //! complementarity problem `λ = C y − (b − C lo)`, `y ≥ 0`, `λ ≥ 0`, `yᵀλ = 0` restricted to `B`;
 //! `C` is a P-matrix, so the solution is unique.
 //!
-//! Method: block principal pivoting (J. J. Júdice and F. M. Pires, "A block principal pivoting
-//! algorithm for large-scale strictly monotone linear complementarity problems", Computers &
-//! Operations Research 21 (1994) 587–596), i.e. the primal-dual active-set / semismooth Newton
-//! iteration (Hintermüller, Ito & Kunisch, SIAM J. Optim. 13 (2002)) that flips every infeasible
-//! index at once, safeguarded by Murty's single principal pivoting rule (K. G. Murty, "Note on a
-//! Bard-type scheme for solving the complementarity problem", Opsearch 11 (1974) 123–130): when
-//! the number of infeasible indices has not decreased for `BLOCK_PATIENCE` iterations, only the
-//! largest infeasible index is flipped. Murty's rule terminates finitely on every P-matrix LCP,
-//! so the iteration cannot cycle (the 2-cycles observed for plain PDAS on non-M-matrices and
-//! near-ties are broken). Round-off ties are handled by counting an index as infeasible only
-//! beyond a round-off threshold ([`TIE_ULPS`]).
+//! Method: block principal pivoting (Júdice & Pires, Comput. Oper. Res. 21, 1994) safeguarded
+//! by Murty's single pivoting rule, finite on every P-matrix LCP
+//! ([docs/step-solvers.md](../docs/step-solvers.md#block-principal-pivoting)).
 //!
 //! Each iteration solves `C_FF z_F = b_F − C_FA lo_A` on the free set `F` with `z_A = lo_A`: one
 //! tridiagonal factorisation and solve of size `n` (active rows replaced by identity rows), O(n).

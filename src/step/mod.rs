@@ -11,6 +11,7 @@ pub mod oracle;
 pub mod osqp;
 pub mod penalty;
 pub mod report;
+pub mod schur;
 pub mod solver;
 
 pub use block_pivot::BlockPivotSolver;

@@ -11,38 +11,13 @@
 //! `z_j − lo_j = −ε r_j` is negative in contact: penetration ≈ ε × reaction, and
 //! complementarity holds only in the limit ε → 0.
 //!
-//! Solution, exact to round-off. As in [`crate::step::exact`], with `z⁰ = C⁻¹ b`, `c_j = C⁻¹ e_j`
-//! and `S_jk = (C⁻¹)_jk` on the constrained nodes, `z = z⁰ + Σ_j r_j c_j`, and the conditions
-//! become the linear complementarity problem in `r ∈ ℝᵏ` (k <= 2):
-//!
-//! ```text
-//!   w = (S + εI) r − (lo − z⁰_c) >= 0,   r >= 0,   wᵀ r = 0,     (w_j = z_j − lo_j + ε r_j)
-//! ```
-//!
-//! `S + εI` is symmetric positive definite (S is a principal block of `C⁻¹`), hence a
-//! P-matrix, so the LCP has exactly one solution for every right-hand side (Cottle, Pang &
-//! Stone, *The Linear Complementarity Problem*, Thm 3.3.7). Its support is one of the `2^k <= 4`
-//! subsets `A`, on which `(S + εI)_AA r_A = (lo − z⁰)_A` is linear. Trying the subsets in
-//! the order ∅, {first}, {second}, {both} and accepting the first whose `r_A >= 0` and
-//! `w >= 0` therefore terminates after at most four 1×1 or 2×2 solves; this is semismooth
-//! Newton on the piecewise-linear equation `ε r = (lo − z⁰ − S r)⁺` with every piece visited at
-//! most once. In floating point the candidates are ranked by their violation, as in the exact
-//! solver, so the choice is deterministic. `iterations` is the number of subsets tried.
-//!
-//! Direct solve. On the chosen support `A` the answer is computed, not superposed: `z` from
-//! `(C + Σ_{j∈A} e_j e_jᵀ/ε) z = b + Σ_{j∈A} lo_j e_j/ε` (the factorisations of these
-//! tridiagonal matrices are made once per run, sharing the unchanged halves), and `r_j` from
-//! the gap `(lo_j − z_j)/ε` or from stationarity `(C z − b)_j`, whichever the audit weighs at
-//! round-off ([`PenaltySolver::solve_on_support`]). This is backward stable: the superposition `z⁰ + Σ r_j c_j`
-//! cancels `max|z⁰| / max|z|` digits when contact stops a fast stiff bar, and failed the
-//! audit's stationarity and penalty-law checks there (the stiff case matrix). Warm start, as
-//! in [`crate::step::exact`]: the previous step's support is tried first by this direct solve and
-//! kept when it meets the conditions (`z_j <= lo_j` on it, `z_j >= lo_j` off it); the
-//! enumeration runs only when the support changes.
+//! Each step solves the LCP in the reactions by enumerating the at most four supports, then
+//! computes the answer by a direct solve on the chosen one; why this is exact and backward
+//! stable: [docs/step-solvers.md](../docs/step-solvers.md#penalty-solver).
 
 use crate::linalg::tridiag::{Ldlt, NotPositiveDefinite, RowChange, SymTridiag};
 use crate::step::audit::{KktAudit, Law};
-use crate::step::exact::{
+use crate::step::schur::{
     Column, constraint_rows, factor_each_subset, inverse_columns, least_violating, masked_solve,
     row_product, schur_complement,
 };

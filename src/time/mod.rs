@@ -3,10 +3,12 @@
 //!
 //! Imports every layer below it: [`crate::linalg`], [`crate::step`], [`crate::scene`], [`crate::bar`].
 
+pub mod energy;
 pub mod error;
+pub mod rhs;
 pub mod run;
 pub mod simulation;
 
 pub use error::RunError;
 pub use run::{Summary, run_in_memory, run_to_dir};
-pub use simulation::{Discretisation, Simulation, StepRecord};
+pub use simulation::{Simulation, StepRecord};

@@ -1,0 +1,199 @@
+//! The space discretisation of a scene: P1 elements on `J + 2` nodes, the matrices restricted
+//! to the nodes that move (clamped ends removed), the constrained nodes, the step matrix
+//! `C = M/Δt² + R/2 + αR/(2Δt)` and the initial data evaluated at the nodes.
+
+use crate::bar::matrices;
+use crate::linalg::tridiag::SymTridiag;
+use crate::scene::SceneError;
+use crate::scene::expr::Expression;
+use crate::scene::{Condition, Scene, Side};
+
+/// A constrained node: `u[node] >= -gap`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Constraint {
+    /// The end whose Signorini condition this is, or `None` for an obstacle node.
+    pub side: Option<Side>,
+    /// Global node index in `0..=J+1`.
+    pub node: usize,
+    pub gap: f64,
+}
+
+/// The space-time discretisation of a scene: the matrices restricted to the nodes that move
+/// (clamped end nodes are removed), and the step matrix `C = M/Δt² + R/2 + αR/(2Δt)`.
+#[derive(Clone, Debug)]
+pub struct Discretisation {
+    /// All nodes, `J + 2`.
+    pub nodes: usize,
+    pub dx: f64,
+    pub dt: f64,
+    pub alpha: f64,
+    /// Global index of the first unknown (1 when the left end is clamped).
+    pub first: usize,
+    /// Which matrices (the full-mesh mass matrix of a load is rebuilt from it when needed,
+    /// rather than kept: J doubles ×3 that most runs never read).
+    pub variant: matrices::MatrixVariant,
+    /// Mass and stiffness on the unknowns.
+    pub mass: SymTridiag,
+    pub stiffness: SymTridiag,
+    pub step_matrix: SymTridiag,
+    pub constraints: Vec<Constraint>,
+}
+
+impl Discretisation {
+    pub fn new(scene: &Scene) -> Result<Self, SceneError> {
+        // A scene built in code has not been through `Scene::from_toml`'s validation.
+        scene.validate()?;
+        let nodes = scene.elements() + 1;
+        let dx = scene.dx();
+        let dt = scene.time.step;
+        let alpha = scene.bar.viscosity;
+        let variant = scene.bar.matrices;
+        let first = usize::from(scene.left.condition == Condition::Clamped);
+        let last = nodes - 1 - usize::from(scene.right.condition == Condition::Clamped);
+        // In place: no second copy of the full-mesh matrices at set-up.
+        let mass = matrices::mass(variant, nodes, dx).into_sub(first, last);
+        let stiffness = matrices::stiffness(variant, nodes, dx).into_sub(first, last);
+        let step_matrix =
+            SymTridiag::combine(1.0 / (dt * dt), &mass, 0.5 + alpha / (2.0 * dt), &stiffness);
+        let node_of = |side: Side| if side == Side::Left { 0 } else { nodes - 1 };
+        let ends = scene.signorini_ends();
+        let end_gap = |node: usize| {
+            ends.iter()
+                .find(|(side, _)| node_of(*side) == node)
+                .copied()
+        };
+        let constraints = match &scene.obstacle {
+            None => ends
+                .iter()
+                .map(|&(side, gap)| Constraint {
+                    side: Some(side),
+                    node: node_of(side),
+                    gap,
+                })
+                .collect(),
+            Some(obstacle) => {
+                let g = obstacle.gap.expression("obstacle.gap")?;
+                (first..=last)
+                    .map(|node| {
+                        let obstacle_gap = g.eval(node as f64 * dx, 0.0)?;
+                        Ok(match end_gap(node) {
+                            Some((side, a)) => Constraint {
+                                side: Some(side),
+                                node,
+                                gap: a.min(obstacle_gap),
+                            },
+                            None => Constraint {
+                                side: None,
+                                node,
+                                gap: obstacle_gap,
+                            },
+                        })
+                    })
+                    .collect::<Result<Vec<_>, SceneError>>()?
+            }
+        };
+        Ok(Self {
+            nodes,
+            dx,
+            dt,
+            alpha,
+            first,
+            variant,
+            mass,
+            stiffness,
+            step_matrix,
+            constraints,
+        })
+    }
+
+    /// Indices into `constraints` of the Signorini ends (left first), at most two.
+    pub fn end_constraints(&self) -> Vec<usize> {
+        (0..self.constraints.len())
+            .filter(|&j| self.constraints[j].side.is_some())
+            .collect()
+    }
+
+    /// Whether only end nodes are constrained (at most two bounds).
+    pub fn ends_only(&self) -> bool {
+        self.constraints.iter().all(|c| c.side.is_some())
+    }
+
+    /// Number of unknowns.
+    pub fn unknowns(&self) -> usize {
+        self.mass.dim()
+    }
+
+    /// Local (unknown) index of global node `i`.
+    pub fn local(&self, node: usize) -> usize {
+        node - self.first
+    }
+
+    /// `x_i = i Δx`.
+    pub fn x(&self, node: usize) -> f64 {
+        node as f64 * self.dx
+    }
+
+    /// Local indices of the constrained nodes, in order.
+    pub fn constrained_locals(&self) -> Vec<usize> {
+        self.constraints
+            .iter()
+            .map(|c| self.local(c.node))
+            .collect()
+    }
+}
+
+/// Initial data at a clamped node must vanish up to this (expressions such as `(1-x)/2` at
+/// `x = 1` evaluate to exactly 0, but `sin(pi*x)` at `x = 1` gives 1.2e-16).
+pub const CLAMPED_START_TOL: f64 = 1e-12;
+
+/// The initial data of a scene: displacement and velocity expressions, and which ends are clamped.
+pub struct InitialData {
+    pub(crate) displacement: Expression,
+    pub(crate) velocity: Expression,
+    /// Left and right end clamped.
+    pub(crate) clamped: [bool; 2],
+}
+
+impl InitialData {
+    /// `u_0`, `u_1` at all nodes; at a clamped node they must vanish (up to
+    /// [`CLAMPED_START_TOL`]) and are set to 0.
+    pub fn eval_into(
+        &self,
+        disc: &Discretisation,
+        u: &mut [f64],
+        v: &mut [f64],
+    ) -> Result<(), SceneError> {
+        let nodes = disc.nodes;
+        for i in 0..nodes {
+            u[i] = self.displacement.eval(disc.x(i), 0.0)?;
+            v[i] = self.velocity.eval(disc.x(i), 0.0)?;
+        }
+        for (side, clamped, node) in [
+            (Side::Left, self.clamped[0], 0),
+            (Side::Right, self.clamped[1], nodes - 1),
+        ] {
+            if !clamped {
+                continue;
+            }
+            for (field, value) in [
+                ("initial.displacement", u[node]),
+                ("initial.velocity", v[node]),
+            ] {
+                if value.abs() > CLAMPED_START_TOL {
+                    return Err(SceneError::Invalid {
+                        field: field.into(),
+                        value: value.to_string(),
+                        allowed: format!(
+                            "must vanish at the clamped {} end (x = {})",
+                            side.name(),
+                            disc.x(node)
+                        ),
+                    });
+                }
+            }
+            u[node] = 0.0;
+            v[node] = 0.0;
+        }
+        Ok(())
+    }
+}
