@@ -3,7 +3,7 @@
 //! The build targets baseline x86-64 (SSE2, two doubles per vector) and uses no target-cpu
 //! flags. The right-hand side, the energy sums and the update `z += r c; u += z` are
 //! throughput bound, so on a CPU with AVX (four doubles per vector) they run as AVX code:
-//! the right-hand side through [`run`] (the compiler vectorises it), the other two as AVX
+//! the right-hand side through `run` (the compiler vectorises it), the other two as AVX
 //! intrinsics behind [`has_avx`] (the compiler does not vectorise them). The bits do not
 //! change: AVX without FMA performs the same IEEE operations in the same order (Rust never
 //! contracts `a * b + c` into a fused multiply-add), and every sum has its lane order fixed
@@ -38,7 +38,7 @@ pub(crate) fn baseline<K: Kernel>(kernel: K) -> K::Output {
     kernel.call()
 }
 
-/// Whether [`run`] takes the AVX path on this CPU.
+/// Whether `run` takes the AVX path on this CPU.
 pub fn has_avx() -> bool {
     #[cfg(target_arch = "x86_64")]
     {

@@ -271,7 +271,7 @@ impl SymTridiag {
     }
 }
 
-/// `u += z`, returning the new `max_i |u_i|`: [`add_columns_in_place`] with no column.
+/// `u += z`, returning the new `max_i |u_i|`: `add_columns_in_place` with no column.
 pub fn add_in_place(u: &mut [f64], z: &[f64]) -> f64 {
     #[cfg(target_arch = "x86_64")]
     if dispatch::has_avx() {

@@ -192,17 +192,17 @@ pub struct SolverSpec {
     /// OSQP solution polishing (default true).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polish: Option<bool>,
-    /// OSQP iteration limit per step (default [`OSQP_DEFAULT_MAX_ITER`]).
+    /// OSQP iteration limit per step (default [`OSQP_DEFAULT_MAX_ITER`](crate::step::osqp::OSQP_DEFAULT_MAX_ITER)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_iter: Option<u32>,
     /// OSQP iterations between step-size (rho) adaptations (default
-    /// [`OSQP_DEFAULT_ADAPTIVE_RHO_INTERVAL`]); fixed so that runs are bit-identical.
+    /// [`OSQP_DEFAULT_ADAPTIVE_RHO_INTERVAL`](crate::step::osqp::OSQP_DEFAULT_ADAPTIVE_RHO_INTERVAL)); fixed so that runs are bit-identical.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub adaptive_rho_interval: Option<u32>,
     /// Accept OSQP's "solved inaccurate" (default false), counted in `summary.json`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub accept_inaccurate: Option<bool>,
-    /// Penalty parameter ε of (PP) (default [`PENALTY_DEFAULT_EPSILON`]).
+    /// Penalty parameter ε of (PP) (default [`PENALTY_DEFAULT_EPSILON`](crate::step::penalty::PENALTY_DEFAULT_EPSILON)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub epsilon: Option<f64>,
 }

@@ -227,7 +227,7 @@ impl StepSolver for ExactSolver {
     }
 
     /// As [`StepSolver::solve`] then `u += z`, with the same bits, but when the cancellation
-    /// test cannot fire (see [`ExactSolver::superpose_and_add`]) the superposition and the
+    /// test cannot fire (see `ExactSolver::superpose_and_add`) the superposition and the
     /// addition are one pass over the bar instead of two.
     fn solve_and_advance(
         &mut self,

@@ -1,6 +1,6 @@
 //! The right-hand side of a step, `b = F + M w/Δt² + R ((½ − α/(2Δt)) w − u)`, in one pass
 //! with both products in difference form, and the load vector `F^n = M (l(x_i, t_n))_i`. The
-//! interior rows run through [`dispatch::run`] (AVX when the CPU has it, the same bits).
+//! interior rows run through `dispatch::run` (AVX when the CPU has it, the same bits).
 
 use crate::bar::discretisation::Discretisation;
 use crate::bar::matrices;
