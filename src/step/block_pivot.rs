@@ -202,9 +202,8 @@ impl StepSolver for BlockPivotSolver {
                 self.active[k] = !self.active[k];
             }
         }
-        Err(StepFailure::Status(format!(
-            "active-set iteration did not terminate in {} iterations",
-            self.max_iterations
-        )))
+        Err(StepFailure::IterationLimit {
+            iterations: self.max_iterations,
+        })
     }
 }

@@ -21,7 +21,7 @@
 
 use crate::linalg::tridiag::{NotPositiveDefinite, SymTridiag};
 use crate::step::audit::{INACCURATE_FACTOR, KktAudit, Law};
-use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
+use crate::step::{OsqpStatus, SolveInfo, SolverReport, StepFailure, StepSolver};
 use osqp::{CscMatrix, Problem, Settings, Status};
 use std::borrow::Cow;
 
@@ -174,18 +174,17 @@ pub fn raw_problem(
 }
 
 /// OSQP's status, as its C library spells it.
-fn status_name(status: &Status<'_>) -> &'static str {
+fn status_of(status: &Status<'_>) -> OsqpStatus {
     match status {
-        Status::Solved(_) => "solved",
-        Status::SolvedInaccurate(_) => "solved inaccurate",
-        Status::MaxIterationsReached(_) => "maximum iterations reached",
-        Status::TimeLimitReached(_) => "run time limit reached",
-        Status::PrimalInfeasible(_) => "primal infeasible",
-        Status::PrimalInfeasibleInaccurate(_) => "primal infeasible inaccurate",
-        Status::DualInfeasible(_) => "dual infeasible",
-        Status::DualInfeasibleInaccurate(_) => "dual infeasible inaccurate",
-        Status::NonConvex(_) => "problem non convex",
-        _ => "unknown status",
+        Status::SolvedInaccurate(_) => OsqpStatus::SolvedInaccurate,
+        Status::MaxIterationsReached(_) => OsqpStatus::MaxIterationsReached,
+        Status::TimeLimitReached(_) => OsqpStatus::TimeLimitReached,
+        Status::PrimalInfeasible(_) => OsqpStatus::PrimalInfeasible,
+        Status::PrimalInfeasibleInaccurate(_) => OsqpStatus::PrimalInfeasibleInaccurate,
+        Status::DualInfeasible(_) => OsqpStatus::DualInfeasible,
+        Status::DualInfeasibleInaccurate(_) => OsqpStatus::DualInfeasibleInaccurate,
+        Status::NonConvex(_) => OsqpStatus::NonConvex,
+        _ => OsqpStatus::Unknown,
     }
 }
 
@@ -267,15 +266,10 @@ impl StepSolver for OsqpSolver {
             Status::Solved(s) => (s, false),
             Status::SolvedInaccurate(s) if self.settings.accept_inaccurate => (s, true),
             other => {
-                let hint = if matches!(other, Status::SolvedInaccurate(_)) {
-                    " (solver.accept_inaccurate = true accepts it)"
-                } else {
-                    ""
-                };
-                return Err(StepFailure::Status(format!(
-                    "OSQP returned `{}` after {iterations} iterations{hint}",
-                    status_name(&other)
-                )));
+                return Err(StepFailure::Osqp {
+                    status: status_of(&other),
+                    iterations,
+                });
             }
         };
         z.copy_from_slice(solution.x());

@@ -4,6 +4,56 @@
 
 use serde::Serialize;
 
+/// OSQP's status when it is not "solved" (OSQP 0.6, `constants.h`); "solved inaccurate" is
+/// one only when the scene does not accept it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OsqpStatus {
+    /// Both residuals met only with the tolerances multiplied by 10.
+    SolvedInaccurate,
+    /// `max_iter` iterations without meeting the tolerances.
+    MaxIterationsReached,
+    /// The time limit was reached (never set by this crate).
+    TimeLimitReached,
+    /// A certificate of primal infeasibility (impossible for the step QP: a sign of bad data).
+    PrimalInfeasible,
+    /// Primal infeasibility to the relaxed tolerances.
+    PrimalInfeasibleInaccurate,
+    /// A certificate of dual infeasibility (impossible with `C` positive definite).
+    DualInfeasible,
+    /// Dual infeasibility to the relaxed tolerances.
+    DualInfeasibleInaccurate,
+    /// OSQP found `P` not positive semidefinite.
+    NonConvex,
+    /// A status this crate does not know.
+    Unknown,
+}
+
+impl OsqpStatus {
+    /// What the user can do about it, where the scene has a key for that.
+    fn hint(self) -> &'static str {
+        match self {
+            OsqpStatus::SolvedInaccurate => " (solver.accept_inaccurate = true accepts it)",
+            _ => "",
+        }
+    }
+}
+
+impl std::fmt::Display for OsqpStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            OsqpStatus::SolvedInaccurate => "solved inaccurate",
+            OsqpStatus::MaxIterationsReached => "maximum iterations reached",
+            OsqpStatus::TimeLimitReached => "run time limit reached",
+            OsqpStatus::PrimalInfeasible => "primal infeasible",
+            OsqpStatus::PrimalInfeasibleInaccurate => "primal infeasible inaccurate",
+            OsqpStatus::DualInfeasible => "dual infeasible",
+            OsqpStatus::DualInfeasibleInaccurate => "dual infeasible inaccurate",
+            OsqpStatus::NonConvex => "problem non convex",
+            OsqpStatus::Unknown => "unknown status",
+        })
+    }
+}
+
 /// Outcome statistics of one successful solve.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SolveInfo {
@@ -27,8 +77,13 @@ pub struct SolverReport {
 pub enum StepFailure {
     #[error("non-finite value in the solution (right-hand side or data overflowed)")]
     NonFinite,
-    #[error("solver status: {0}")]
-    Status(String),
+    /// OSQP stopped without an answer it may return.
+    #[error("solver status: OSQP returned `{status}` after {iterations} iterations{}", status.hint())]
+    Osqp { status: OsqpStatus, iterations: u32 },
+    /// An iterative exact method did not terminate within its iteration limit (which its
+    /// finite termination proof makes unreachable; kept as a guard).
+    #[error("solver status: active-set iteration did not terminate in {iterations} iterations")]
+    IterationLimit { iterations: u32 },
     /// The solver reported success but its answer fails an optimality condition checked
     /// independently by [`crate::step::audit::KktAudit`].
     #[error("audit failed: {what} = {value:e} exceeds its tolerance {tolerance:e}")]
