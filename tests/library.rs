@@ -60,3 +60,58 @@ fn with_solver_validates_its_scene() {
     let e = Simulation::with_solver(&bad, disc, solver).err().unwrap();
     assert_eq!(field_of(&e), "time.end");
 }
+
+/// A solver's settings are checked by the solver itself, not only by the scene: the error
+/// names the `[solver]` key.
+#[test]
+fn osqp_settings_are_validated_by_the_solver() {
+    use viscobar::linalg::SymTridiag;
+    use viscobar::step::{OsqpSettings, OsqpSolver, osqp::OsqpSetupError};
+    let c = SymTridiag::new(vec![2.0; 4], vec![-1.0; 3]);
+    let cases = [
+        (
+            "eps_abs",
+            OsqpSettings {
+                eps_abs: f64::NAN,
+                ..Default::default()
+            },
+        ),
+        (
+            "eps_rel",
+            OsqpSettings {
+                eps_rel: -1.0,
+                ..Default::default()
+            },
+        ),
+        (
+            "eps_abs",
+            OsqpSettings {
+                eps_abs: 0.0,
+                eps_rel: 0.0,
+                ..Default::default()
+            },
+        ),
+        (
+            "max_iter",
+            OsqpSettings {
+                max_iter: 0,
+                ..Default::default()
+            },
+        ),
+        (
+            "adaptive_rho_interval",
+            OsqpSettings {
+                adaptive_rho_interval: 0,
+                ..Default::default()
+            },
+        ),
+    ];
+    for (field, settings) in cases {
+        match OsqpSolver::new(&c, &[0], settings) {
+            Err(OsqpSetupError::Settings(e)) => assert_eq!(e.field, field),
+            Err(other) => panic!("{field}: expected a settings error, got {other}"),
+            Ok(_) => panic!("{field}: bad settings accepted"),
+        }
+    }
+    assert!(OsqpSolver::new(&c, &[0], OsqpSettings::default()).is_ok());
+}

@@ -1,6 +1,7 @@
 //! [`SceneError`]: a scene that cannot be run as written, kept apart from failures during a run
 //! ([`crate::time::RunError`]) and from a step solver's own outcome ([`crate::step::StepFailure`]).
 
+use crate::step::SettingsError;
 use std::path::PathBuf;
 
 /// A scene that cannot be run as written. Every variant names the offending field or item.
@@ -49,4 +50,14 @@ pub enum SceneError {
     },
     #[error("--set {assignment}: {reason}")]
     Override { assignment: String, reason: String },
+}
+
+impl From<SettingsError> for SceneError {
+    fn from(e: SettingsError) -> Self {
+        SceneError::Invalid {
+            field: format!("solver.{}", e.field),
+            value: e.value,
+            allowed: e.allowed.into(),
+        }
+    }
 }

@@ -5,7 +5,7 @@
 
 use crate::scene::SceneError;
 use crate::scene::expr::Expression;
-use crate::step::osqp::{OSQP_DEFAULT_EPS, OsqpSettings};
+use crate::step::osqp::OsqpSettings;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -183,10 +183,10 @@ impl SolverMethod {
 pub struct SolverSpec {
     #[serde(default)]
     pub method: SolverMethod,
-    /// OSQP absolute tolerance (default [`OSQP_DEFAULT_EPS`]).
+    /// OSQP absolute tolerance (default [`OSQP_DEFAULT_EPS`](crate::step::osqp::OSQP_DEFAULT_EPS)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub eps_abs: Option<f64>,
-    /// OSQP relative tolerance (default [`OSQP_DEFAULT_EPS`]).
+    /// OSQP relative tolerance (default [`OSQP_DEFAULT_EPS`](crate::step::osqp::OSQP_DEFAULT_EPS)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub eps_rel: Option<f64>,
     /// OSQP solution polishing (default true).
@@ -265,36 +265,8 @@ impl SolverSpec {
                 ),
             });
         }
-        for (name, v) in [("eps_abs", self.eps_abs), ("eps_rel", self.eps_rel)] {
-            if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
-                return Err(invalid(
-                    &format!("solver.{name}"),
-                    v,
-                    "must be a finite number >= 0",
-                ));
-            }
-        }
-        let (abs, rel) = (
-            self.eps_abs.unwrap_or(OSQP_DEFAULT_EPS),
-            self.eps_rel.unwrap_or(OSQP_DEFAULT_EPS),
-        );
-        if self.method == SolverMethod::Osqp && abs == 0.0 && rel == 0.0 {
-            return Err(invalid(
-                "solver.eps_abs",
-                abs,
-                "eps_abs and eps_rel cannot both be 0 (OSQP would never stop)",
-            ));
-        }
-        if let Some(0) = self.max_iter {
-            return Err(invalid("solver.max_iter", 0.0, "must be >= 1"));
-        }
-        if let Some(0) = self.adaptive_rho_interval {
-            return Err(invalid(
-                "solver.adaptive_rho_interval",
-                0.0,
-                "must be >= 1 (0 selects OSQP's time-based interval, which makes runs differ)",
-            ));
-        }
+        // Given values are checked whatever the method (a foreign one was refused above).
+        self.osqp_settings().validate()?;
         if let Some(e) = self.epsilon {
             positive("solver.epsilon", e)?;
         }

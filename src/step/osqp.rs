@@ -21,7 +21,7 @@
 
 use crate::linalg::tridiag::{NotPositiveDefinite, SymTridiag};
 use crate::step::audit::{INACCURATE_FACTOR, KktAudit, Law};
-use crate::step::{OsqpStatus, SolveInfo, SolverReport, StepFailure, StepSolver};
+use crate::step::{OsqpStatus, SettingsError, SolveInfo, SolverReport, StepFailure, StepSolver};
 use osqp::{CscMatrix, Problem, Settings, Status};
 use std::borrow::Cow;
 
@@ -63,6 +63,33 @@ impl Default for OsqpSettings {
 }
 
 impl OsqpSettings {
+    /// Checks every field against its range; the error names the field.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        for (field, v) in [("eps_abs", self.eps_abs), ("eps_rel", self.eps_rel)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(SettingsError::new(field, v, "must be a finite number >= 0"));
+            }
+        }
+        if self.eps_abs == 0.0 && self.eps_rel == 0.0 {
+            return Err(SettingsError::new(
+                "eps_abs",
+                self.eps_abs,
+                "eps_abs and eps_rel cannot both be 0 (OSQP would never stop)",
+            ));
+        }
+        if self.max_iter == 0 {
+            return Err(SettingsError::new("max_iter", 0, "must be >= 1"));
+        }
+        if self.adaptive_rho_interval == 0 {
+            return Err(SettingsError::new(
+                "adaptive_rho_interval",
+                0,
+                "must be >= 1 (0 selects OSQP's time-based interval, which makes runs differ)",
+            ));
+        }
+        Ok(())
+    }
+
     fn to_osqp(self) -> Settings {
         Settings::default()
             .verbose(false)
@@ -80,6 +107,8 @@ impl OsqpSettings {
 pub enum OsqpSetupError {
     #[error(transparent)]
     Matrix(#[from] NotPositiveDefinite),
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
     #[error("{0}")]
     Osqp(String),
 }
@@ -195,6 +224,7 @@ impl OsqpSolver {
         nodes: &[usize],
         settings: OsqpSettings,
     ) -> Result<Self, OsqpSetupError> {
+        settings.validate()?;
         let n = c.dim();
         let k = nodes.len();
         if let Some(&bad) = nodes.iter().find(|&&j| j >= n) {

@@ -139,3 +139,26 @@ pub struct AuditReport {
     /// `‖C⁻¹(Cz − b − Σ r_j e_j)‖_∞`, displacement.
     pub stationarity_displacement: Worst,
 }
+
+/// A solver setting outside its range, named by its key in the scene's `[solver]` table
+/// (Clarabel's `SettingsError::BadFieldValue`).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("`solver.{field}` = {value}: {allowed}")]
+pub struct SettingsError {
+    /// The key in `[solver]`.
+    pub field: &'static str,
+    /// The value given, as text.
+    pub value: String,
+    /// What is allowed.
+    pub allowed: &'static str,
+}
+
+impl SettingsError {
+    pub(crate) fn new(field: &'static str, value: impl ToString, allowed: &'static str) -> Self {
+        Self {
+            field,
+            value: value.to_string(),
+            allowed,
+        }
+    }
+}

@@ -45,6 +45,7 @@ impl From<OsqpSetupError> for RunError {
     fn from(e: OsqpSetupError) -> Self {
         match e {
             OsqpSetupError::Matrix(m) => RunError::Matrix(m),
+            OsqpSetupError::Settings(e) => RunError::Scene(e.into()),
             OsqpSetupError::Osqp(reason) => RunError::SolverSetup {
                 solver: "osqp".into(),
                 reason,
