@@ -12,10 +12,11 @@
 use crate::linalg::tridiag::{Ldlt, SymTridiag};
 use crate::scene::{self, Scene};
 use crate::step::StepSolver;
+use crate::step::audit::dual_tolerance;
 use crate::step::exact::ExactSolver;
 use crate::step::osqp::{OsqpSettings, OsqpSolver, raw_problem};
 use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
-use crate::study::accuracy::observed_order;
+use crate::study::accuracy::{max_abs, max_distance, observed_order};
 use crate::study::compare::{StepProblem, compare, start_up_problem};
 use crate::time::RunError;
 use crate::time::run::run_in_memory;
@@ -40,16 +41,6 @@ fn with_method(m: &str, extra: &[String]) -> Vec<String> {
     let mut o = vec![format!("solver.method=\"{m}\"")];
     o.extend(extra.iter().cloned());
     o
-}
-
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
-
-fn max_distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
 }
 
 /// The audit report of an OSQP or penalty run (both always audit).
@@ -187,7 +178,13 @@ fn raw_first_step(scene: &Scene, s: OsqpSettings) -> Result<String, RunError> {
     let x = sol.x();
     let r: Vec<f64> = sol.y().iter().map(|y| -y).collect();
     let mut res = c.mul(x);
-    let scale = max_abs(&res).max(max_abs(&b)).max(max_abs(&r));
+    let osqp_dual_tolerance = dual_tolerance(
+        s.eps_abs,
+        s.eps_rel,
+        max_abs(&res),
+        max_abs(&b),
+        max_abs(&r),
+    );
     for (ri, bi) in res.iter_mut().zip(&b) {
         *ri -= bi;
     }
@@ -201,7 +198,7 @@ fn raw_first_step(scene: &Scene, s: OsqpSettings) -> Result<String, RunError> {
          {:.1e}); max \\|z − z_exact\\| = {:.2e}; \\|C⁻¹(Cz − b − r)\\|∞ = {:.2e}",
         sol.polish_status(),
         sol.dua_res(),
-        s.eps_abs + s.eps_rel * scale,
+        osqp_dual_tolerance,
         r[0],
         r_exact[0],
         (r[0] - r_exact[0]).abs() / r_exact[0].abs(),
