@@ -252,23 +252,14 @@ fn falling_bar_section() -> Result<Section, crate::study::converge::ConvergeErro
         CONVERGENCE_LEVELS,
         None,
     )?;
-    let mut md = format!(
-        "Reference: {}.\n\n| elements | dt | L2 error | H1 error | energy error | contact time error |\n|---|---|---|---|---|---|\n",
-        st.reference
-    );
-    let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3e}"));
-    for r in &st.rows {
-        let _ = writeln!(
-            md,
-            "| {} | {} | {:.3e} | {:.3e} | {} | {} |",
-            r.elements,
-            r.dt,
-            r.l2_error,
-            r.h1_error,
-            opt(r.energy_error),
-            opt(r.contact_time_error)
-        );
-    }
+    let mut md = format!("Reference: {}.\n\n", st.reference);
+    md.push_str(&st.table(
+        &[
+            ("elements", |r| r.elements.to_string()),
+            ("dt", |r| r.dt.to_string()),
+        ],
+        &[],
+    ));
     let h: Vec<f64> = st.rows.iter().map(|r| r.dx).collect();
     let order = |f: fn(&crate::study::converge::Row) -> Option<f64>| {
         let e: Option<Vec<f64>> = st.rows.iter().map(f).collect();
