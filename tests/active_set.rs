@@ -3,6 +3,7 @@
 //! independent probe found for plain primal-dual active sets.
 
 mod common;
+use common::AGREEMENT_TOL;
 
 use proptest::prelude::*;
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
@@ -10,18 +11,11 @@ use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::block_pivot::BlockPivotSolver;
 use viscobar::step::oracle::brute_force;
-
-/// Agreement with the dense oracle and KKT residuals, relative: both are backward-stable
-/// solves of systems with condition number below 1e4 here.
-const AGREEMENT_TOL: f64 = 1e-9;
+use viscobar::study::accuracy::max_abs;
 
 /// KKT residuals of `(z, r)`, relative to the data: (stationarity, feasibility, sign, complementarity).
 fn kkt(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64], z: &[f64], r: &[f64]) -> f64 {
-    let scale = 1.0
-        + b.iter()
-            .chain(lo)
-            .chain(z)
-            .fold(0.0f64, |m, v| m.max(v.abs()));
+    let scale = 1.0 + max_abs(b.iter().chain(lo).chain(z));
     let mut stat = c.mul(z);
     for i in 0..z.len() {
         stat[i] -= b[i];
@@ -34,7 +28,7 @@ fn kkt(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64], z: &[f64], r: &[f
             .max(-r[k])
             .max((r[k] * (z[i] - lo[k])).abs() / scale);
     }
-    worst.max(stat.iter().fold(0.0f64, |m, v| m.max(v.abs()))) / scale
+    worst.max(max_abs(&stat)) / scale
 }
 
 fn solve(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64]) -> (Vec<f64>, Vec<f64>, u32) {
@@ -60,7 +54,7 @@ proptest! {
         let lo: Vec<f64> = nodes.iter().map(|&i| lo[i]).collect();
         let (z, r, _) = solve(&c, b, &nodes, &lo);
         let oracle = brute_force(&c.to_dense(), b, &nodes, &lo, 1e-12).unwrap().unwrap();
-        let scale = 1.0 + z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let scale = 1.0 + max_abs(&z);
         for (i, (zi, oi)) in z.iter().zip(&oracle.z).enumerate() {
             prop_assert!((zi - oi).abs() <= AGREEMENT_TOL * scale, "node {i}: {zi} vs {oi}");
         }

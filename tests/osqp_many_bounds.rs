@@ -33,14 +33,11 @@ use viscobar::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
 use viscobar::step::block_pivot::BlockPivotSolver;
 use viscobar::step::osqp::OSQP_DEFAULT_EPS;
 use viscobar::step::osqp::{OsqpSettings, OsqpSolver};
+use viscobar::study::accuracy::{max_abs, max_distance};
 
 /// Largest problem drawn: large enough for many simultaneous contact changes, small enough that
 /// 200 cases of two OSQP solves each stay within seconds.
 const MAX_UNKNOWNS: usize = 400;
-
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
 
 /// Round-off in a recomputed `(Cz − b)_i`: the audit's floor, [`ROUNDOFF_ULPS`] ulps of the
 /// magnitude of the terms.
@@ -174,7 +171,7 @@ proptest! {
             let (mut zo, mut ro) = (vec![0.0; n], vec![0.0; k]);
             osqp.solve(&b, &lo, &mut zo, &mut ro)
                 .map_err(|e| TestCaseError::fail(format!("osqp: {e}")))?;
-            let distance = zo.iter().zip(&ze).fold(0.0f64, |m, (a, s)| m.max((a - s).abs()));
+            let distance = max_distance(&zo, &ze);
             let bound = a_posteriori_bound(&c, &b, &nodes, &lo, &zo, &ze);
             prop_assert!(distance <= bound, "‖z_osqp − z_exact‖∞ = {distance:e} > bound {bound:e}");
             let tolerance = a_priori_tolerance(&c, &b, &nodes, &lo, &zo, &ro);
@@ -227,10 +224,7 @@ fn a_wrong_active_set_exceeds_the_tolerance() {
         wrong_z[i] += rj;
     }
     Ldlt::factor(&c).unwrap().solve_in_place(&mut wrong_z);
-    let distance = wrong_z
-        .iter()
-        .zip(&z)
-        .fold(0.0f64, |m, (a, s)| m.max((a - s).abs()));
+    let distance = max_distance(&wrong_z, &z);
     let bound = a_posteriori_bound(&c, &b, &nodes, &lo, &wrong_z, &z);
     let tolerance = a_priori_tolerance(&c, &b, &nodes, &lo, &wrong_z, &wrong_r);
     assert!(
