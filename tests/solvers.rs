@@ -550,62 +550,55 @@ fn osqp_refuses_non_finite_data_without_panicking() {
 
 #[test]
 fn solver_settings_of_another_method_or_out_of_range_are_refused() {
+    // Each case: its overrides, separated by spaces, and what the error must name.
     let refused = [
-        (&["solver.eps_abs=1e-6"][..], "solver.eps_abs"),
+        ("solver.eps_abs=1e-6", "solver.eps_abs"),
         (
-            &["solver.method=\"penalty\"", "solver.polish=false"][..],
+            "solver.method=\"penalty\" solver.polish=false",
             "solver.polish",
         ),
         (
-            &["solver.method=\"osqp\"", "solver.epsilon=1e-3"][..],
+            "solver.method=\"osqp\" solver.epsilon=1e-3",
             "solver.epsilon",
         ),
         (
-            &["solver.method=\"penalty\"", "solver.epsilon=0"][..],
+            "solver.method=\"penalty\" solver.epsilon=0",
             "solver.epsilon",
         ),
         (
-            &["solver.method=\"penalty\"", "solver.epsilon=-1"][..],
+            "solver.method=\"penalty\" solver.epsilon=-1",
             "solver.epsilon",
         ),
         (
-            &["solver.method=\"osqp\"", "solver.adaptive_rho_interval=0"][..],
+            "solver.method=\"osqp\" solver.adaptive_rho_interval=0",
             "adaptive_rho_interval",
         ),
         (
-            &["solver.method=\"osqp\"", "solver.max_iter=0"][..],
+            "solver.method=\"osqp\" solver.max_iter=0",
             "solver.max_iter",
         ),
         (
-            &["solver.method=\"osqp\"", "solver.eps_rel=-1e-3"][..],
+            "solver.method=\"osqp\" solver.eps_rel=-1e-3",
             "solver.eps_rel",
         ),
         (
-            &[
-                "solver.method=\"osqp\"",
-                "solver.eps_abs=0",
-                "solver.eps_rel=0",
-            ][..],
+            "solver.method=\"osqp\" solver.eps_abs=0 solver.eps_rel=0",
             "both be 0",
         ),
-        (&["solver.method=\"gurobi\""][..], "method"),
-        (&["solver.method=\"osqp\"", "solver.rho=0.1"][..], "rho"),
+        ("solver.method=\"gurobi\"", "method"),
+        ("solver.method=\"osqp\" solver.rho=0.1", "rho"),
     ];
-    let load_impact = |overrides: &[&str]| {
-        let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let load_impact = |overrides: &str| {
+        let o: Vec<String> = overrides.split(' ').map(str::to_string).collect();
         viscobar::scene::load("impact", &o)
     };
     for (overrides, needle) in refused {
         let err = load_impact(overrides).expect_err("refused");
-        assert!(err.to_string().contains(needle), "{overrides:?}: {err}");
+        assert!(err.to_string().contains(needle), "{overrides}: {err}");
     }
     for ok in [
-        &[
-            "solver.method=\"osqp\"",
-            "solver.eps_abs=1e-8",
-            "solver.polish=false",
-        ][..],
-        &["solver.method=\"penalty\"", "solver.epsilon=1e-4"][..],
+        "solver.method=\"osqp\" solver.eps_abs=1e-8 solver.polish=false",
+        "solver.method=\"penalty\" solver.epsilon=1e-4",
     ] {
         load_impact(ok).unwrap();
     }
