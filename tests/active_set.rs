@@ -3,7 +3,7 @@
 //! independent probe found for plain primal-dual active sets.
 
 mod common;
-use common::AGREEMENT_TOL;
+use common::{AGREEMENT_TOL, kkt};
 
 use proptest::prelude::*;
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
@@ -12,24 +12,6 @@ use viscobar::step::StepSolver;
 use viscobar::step::block_pivot::BlockPivotSolver;
 use viscobar::step::oracle::brute_force;
 use viscobar::study::accuracy::max_abs;
-
-/// KKT residuals of `(z, r)`, relative to the data: (stationarity, feasibility, sign, complementarity).
-fn kkt(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64], z: &[f64], r: &[f64]) -> f64 {
-    let scale = 1.0 + max_abs(b.iter().chain(lo).chain(z));
-    let mut stat = c.mul(z);
-    for i in 0..z.len() {
-        stat[i] -= b[i];
-    }
-    let mut worst = 0.0f64;
-    for (k, &i) in nodes.iter().enumerate() {
-        stat[i] -= r[k];
-        worst = worst
-            .max(lo[k] - z[i])
-            .max(-r[k])
-            .max((r[k] * (z[i] - lo[k])).abs() / scale);
-    }
-    worst.max(max_abs(&stat)) / scale
-}
 
 fn solve(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64]) -> (Vec<f64>, Vec<f64>, u32) {
     let mut s = BlockPivotSolver::new(c, nodes).unwrap();
@@ -69,8 +51,7 @@ proptest! {
         seed in any::<u64>(),
     ) {
         let n = c.dim();
-        let mut x = seed | 1;
-        let mut rnd = || { x ^= x << 13; x ^= x >> 7; x ^= x << 17; (x >> 11) as f64 / (1u64 << 53) as f64 };
+        let mut rnd = common::stream(seed);
         let b: Vec<f64> = (0..n).map(|_| 4.0 * rnd() - 2.0).collect();
         let nodes: Vec<usize> = (0..n).collect();
         let lo: Vec<f64> = (0..n).map(|_| 2.0 * rnd() - 1.0).collect();
