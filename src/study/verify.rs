@@ -6,7 +6,7 @@
 use crate::bar::closed_form;
 use crate::bar::matrices::{MatrixVariant, mass, stiffness};
 use crate::scene;
-use crate::study::accuracy::{error_against, observed_order, rigid_mode_drift};
+use crate::study::accuracy::{error_against, max_abs, observed_order, rigid_mode_drift};
 use crate::time::RunError;
 use crate::time::run::run_in_memory;
 use std::fmt::Write;
@@ -53,10 +53,7 @@ fn matrices_section() -> Section {
             let m = mass(variant, nodes, dx);
             let r = stiffness(variant, nodes, dx);
             let total: f64 = m.mul(&vec![1.0; nodes]).iter().sum();
-            let r1 = r
-                .mul(&vec![1.0; nodes])
-                .iter()
-                .fold(0.0f64, |a, v| a.max(v.abs()));
+            let r1 = max_abs(&r.mul(&vec![1.0; nodes]));
             let sym = |a: &crate::linalg::tridiag::SymTridiag| {
                 let d = a.to_dense();
                 d == d.transpose()
