@@ -288,6 +288,27 @@ fn failure_cases(md: &mut String) -> Result<(), RunError> {
     Ok(())
 }
 
+/// Smallest diagonal-dominance margin of the random step matrices (here and in the tests'
+/// `spd_tridiag`): keeps the condition number below about 1e4 for the sizes drawn.
+pub const MIN_MARGIN: f64 = 0.05;
+/// Largest diagonal-dominance margin of the random step matrices.
+pub const MAX_MARGIN: f64 = 3.0;
+
+/// The SPD tridiagonal matrix with off-diagonal `off` whose diagonal exceeds each row's
+/// off-diagonal magnitudes by `margin[i]` (off-diagonals of either sign: the step matrix C is
+/// not an M-matrix when the mass term dominates).
+pub fn diagonally_dominant(off: Vec<f64>, margin: &[f64]) -> SymTridiag {
+    let n = margin.len();
+    let diag = (0..n)
+        .map(|i| {
+            let l = if i > 0 { off[i - 1].abs() } else { 0.0 };
+            let r = if i + 1 < n { off[i].abs() } else { 0.0 };
+            l + r + margin[i]
+        })
+        .collect();
+    SymTridiag::new(diag, off)
+}
+
 /// A 64-bit linear congruential generator (Knuth's MMIX constants): a fixed, dependency-free
 /// sample.
 struct Lcg(u64);
@@ -307,14 +328,8 @@ fn random_problems(md: &mut String) -> Result<(), RunError> {
     for case in 0..count {
         let n = 2 + (g.uniform(0.0, 22.0) as usize);
         let off: Vec<f64> = (0..n - 1).map(|_| g.uniform(-1.0, 1.0)).collect();
-        let diag: Vec<f64> = (0..n)
-            .map(|i| {
-                let l = if i > 0 { off[i - 1].abs() } else { 0.0 };
-                let r = if i + 1 < n { off[i].abs() } else { 0.0 };
-                l + r + g.uniform(0.05, 3.0)
-            })
-            .collect();
-        let c = SymTridiag::new(diag, off);
+        let margin: Vec<f64> = (0..n).map(|_| g.uniform(MIN_MARGIN, MAX_MARGIN)).collect();
+        let c = diagonally_dominant(off, &margin);
         let b: Vec<f64> = (0..n).map(|_| g.uniform(-5.0, 5.0)).collect();
         let nodes = match case % 3 {
             0 => vec![0],

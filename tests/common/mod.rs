@@ -6,6 +6,7 @@ use viscobar::Scene;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::scene;
 use viscobar::study::accuracy::max_abs;
+use viscobar::study::agreement::{MAX_MARGIN, diagonally_dominant};
 
 // ---- tolerances shared by several test files -----------------------------------------------
 
@@ -37,9 +38,9 @@ pub fn builtin(name: &str, overrides: &[&str]) -> Scene {
     scene::load(name, &o).expect("built-in scene loads").1
 }
 
-/// Smallest diagonal-dominance margin of [`spd_tridiag`]: keeps the condition number below
-/// about 1e4 for the sizes the tests draw.
-pub const MIN_MARGIN: f64 = 0.05;
+/// Smallest diagonal-dominance margin of [`spd_tridiag`] (shared with the agreement study's
+/// random problems).
+pub use viscobar::study::agreement::MIN_MARGIN;
 
 /// Relative agreement with the dense oracle and KKT residuals on [`spd_tridiag`] problems: both
 /// sides are backward-stable solves of systems with condition number below 1e4, so 1e-9 leaves
@@ -53,18 +54,9 @@ pub fn spd_tridiag(max_n: usize) -> impl Strategy<Value = SymTridiag> {
     (2usize..=max_n).prop_flat_map(|n| {
         (
             prop::collection::vec(-1.0f64..1.0, n - 1),
-            prop::collection::vec(MIN_MARGIN..3.0, n),
+            prop::collection::vec(MIN_MARGIN..MAX_MARGIN, n),
         )
-            .prop_map(move |(off, margin)| {
-                let diag = (0..n)
-                    .map(|i| {
-                        let l = if i > 0 { off[i - 1].abs() } else { 0.0 };
-                        let r = if i + 1 < n { off[i].abs() } else { 0.0 };
-                        l + r + margin[i]
-                    })
-                    .collect();
-                SymTridiag::new(diag, off)
-            })
+            .prop_map(|(off, margin)| diagonally_dominant(off, &margin))
     })
 }
 
