@@ -18,6 +18,7 @@ use viscobar::step::osqp::{OSQP_INFTY, OsqpSettings, OsqpSolver, raw_problem};
 use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
 use viscobar::step::{StepFailure, StepSolver};
 use viscobar::study::accuracy::{max_abs, observed_order};
+use viscobar::study::agreement::stiff_impact_overrides;
 use viscobar::study::compare::{compare, start_up_problem};
 use viscobar::time::run::run_in_memory;
 use viscobar::time::simulation::Simulation;
@@ -285,13 +286,7 @@ fn raw_osqp(c: &SymTridiag, nodes: &[usize], b: &[f64], lo: &[f64], s: OsqpSetti
 /// The stiff scene of the failure cases: the impact scene with α = 1e6 on 64 elements, time
 /// step `ratio · dx`, 20 steps.
 fn stiff_impact(ratio: f64, extra: &[&str]) -> Scene {
-    let dt = ratio / 64.0;
-    let mut o = vec![
-        "bar.viscosity=1e6".to_string(),
-        "mesh.elements=64".into(),
-        format!("time.step={dt}"),
-        format!("time.end={}", 20.0 * dt),
-    ];
+    let mut o = stiff_impact_overrides(ratio);
     o.extend(extra.iter().map(|s| s.to_string()));
     let o: Vec<&str> = o.iter().map(String::as_str).collect();
     common::builtin("impact", &o)

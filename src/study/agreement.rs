@@ -214,6 +214,18 @@ fn outcome(name: &str, scene: &Scene) -> String {
     }
 }
 
+/// The overrides that make the impact scene the stiff scene of the OSQP failure cases (here and
+/// in tests/solvers.rs): α = 1e6, 64 elements, 20 steps of `dt = ratio · dx`.
+pub fn stiff_impact_overrides(ratio: f64) -> Vec<String> {
+    let dt = ratio / 64.0;
+    vec![
+        "bar.viscosity=1e6".to_string(),
+        "mesh.elements=64".into(),
+        format!("time.step={dt}"),
+        format!("time.end={}", 20.0 * dt),
+    ]
+}
+
 fn failure_cases(md: &mut String) -> Result<(), RunError> {
     let _ = writeln!(
         md,
@@ -237,13 +249,7 @@ fn failure_cases(md: &mut String) -> Result<(), RunError> {
         (100.0, loose_overrides, loose),
     ];
     for (ratio, extra, settings) in cases {
-        let dt = ratio / 64.0;
-        let base = vec![
-            "bar.viscosity=1e6".to_string(),
-            "mesh.elements=64".into(),
-            format!("time.step={dt}"),
-            format!("time.end={}", 20.0 * dt),
-        ];
+        let base = stiff_impact_overrides(ratio);
         let exact = load("impact", &base)?;
         let mut o = base.clone();
         o.push("solver.method=\"osqp\"".into());
