@@ -3,6 +3,7 @@
 //! independent probe found for plain primal-dual active sets.
 
 mod common;
+use common::{AGREEMENT_TOL, kkt};
 
 use proptest::prelude::*;
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
@@ -10,32 +11,7 @@ use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::block_pivot::BlockPivotSolver;
 use viscobar::step::oracle::brute_force;
-
-/// Agreement with the dense oracle and KKT residuals, relative: both are backward-stable
-/// solves of systems with condition number below 1e4 here.
-const AGREEMENT_TOL: f64 = 1e-9;
-
-/// KKT residuals of `(z, r)`, relative to the data: (stationarity, feasibility, sign, complementarity).
-fn kkt(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64], z: &[f64], r: &[f64]) -> f64 {
-    let scale = 1.0
-        + b.iter()
-            .chain(lo)
-            .chain(z)
-            .fold(0.0f64, |m, v| m.max(v.abs()));
-    let mut stat = c.mul(z);
-    for i in 0..z.len() {
-        stat[i] -= b[i];
-    }
-    let mut worst = 0.0f64;
-    for (k, &i) in nodes.iter().enumerate() {
-        stat[i] -= r[k];
-        worst = worst
-            .max(lo[k] - z[i])
-            .max(-r[k])
-            .max((r[k] * (z[i] - lo[k])).abs() / scale);
-    }
-    worst.max(stat.iter().fold(0.0f64, |m, v| m.max(v.abs()))) / scale
-}
+use viscobar::study::accuracy::max_abs;
 
 fn solve(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64]) -> (Vec<f64>, Vec<f64>, u32) {
     let mut s = BlockPivotSolver::new(c, nodes).unwrap();
@@ -60,7 +36,7 @@ proptest! {
         let lo: Vec<f64> = nodes.iter().map(|&i| lo[i]).collect();
         let (z, r, _) = solve(&c, b, &nodes, &lo);
         let oracle = brute_force(&c.to_dense(), b, &nodes, &lo, 1e-12).unwrap().unwrap();
-        let scale = 1.0 + z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let scale = 1.0 + max_abs(&z);
         for (i, (zi, oi)) in z.iter().zip(&oracle.z).enumerate() {
             prop_assert!((zi - oi).abs() <= AGREEMENT_TOL * scale, "node {i}: {zi} vs {oi}");
         }
@@ -75,8 +51,7 @@ proptest! {
         seed in any::<u64>(),
     ) {
         let n = c.dim();
-        let mut x = seed | 1;
-        let mut rnd = || { x ^= x << 13; x ^= x >> 7; x ^= x << 17; (x >> 11) as f64 / (1u64 << 53) as f64 };
+        let mut rnd = common::stream(seed);
         let b: Vec<f64> = (0..n).map(|_| 4.0 * rnd() - 2.0).collect();
         let nodes: Vec<usize> = (0..n).collect();
         let lo: Vec<f64> = (0..n).map(|_| 2.0 * rnd() - 1.0).collect();

@@ -5,16 +5,10 @@
 //! with L2 errors 2.10e-2 and 1.09e-2 at the scenes' own meshes.
 
 mod common;
+use common::{KINK_ORDER_BAND, MODAL_ORDER, MODAL_ORDER_TOL};
 use viscobar::bar::closed_form::{self, ClosedForm, FallingBar};
 use viscobar::study::accuracy::{error_against, observed_order};
 
-/// The scheme is second order in (dx, dt) for smooth solutions (the card asks for 2 ± 0.15).
-const MODAL_ORDER: f64 = 2.0;
-const MODAL_ORDER_TOL: f64 = 0.15;
-/// Non-smooth (kinked) solutions: the study measured 0.68-0.69 on five levels; the band is
-/// ±0.12 around it, wide enough for the three-level estimate here and narrow enough to fail if
-/// the contact handling degrades to first order in the kink position (order 1/2).
-const KINK_ORDER_BAND: (f64, f64) = (0.56, 0.80);
 /// Error bounds at the scenes' own meshes: 1.25x the measured L2 error, so that round-off
 /// changes pass and a regression of the contact step (wrong reaction, wrong start-up) fails.
 const IMPACT_L2_BOUND: f64 = 1.25 * 2.10e-2;

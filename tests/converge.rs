@@ -7,11 +7,9 @@
 //! relative energy loss ~ α^0.49.
 
 mod common;
+use common::{KINK_ORDER_BAND, MODAL_ORDER, MODAL_ORDER_TOL};
 use viscobar::study::converge::{self, SolverSetting};
 
-/// Second order in (dx, dt) for smooth solutions (the card asks for 2 ± 0.15).
-const MODAL_ORDER: f64 = 2.0;
-const MODAL_ORDER_TOL: f64 = 0.15;
 /// OSQP does ~50 ADMM iterations per step where the exact solver does one factorised solve
 /// and an enumeration; measured ~40x, required 3x so that a loaded test machine still passes.
 const OSQP_SLOWDOWN_MIN: f64 = 3.0;
@@ -117,8 +115,6 @@ fn bad_input_is_an_error_not_a_panic() {
 /// 0.09–0.10 (last), so the band covers any single ±1-step change; it fails for first order and
 /// for no convergence.
 const CONTACT_TIME_ORDER_BAND: (f64, f64) = (0.45, 0.87);
-/// The L2 order of a kinked solution, as in tests/closed_forms.rs (five levels: 0.683).
-const KINK_ORDER_BAND: (f64, f64) = (0.56, 0.80);
 
 #[test]
 fn falling_bar_converges_in_displacement_energy_and_contact_times() {

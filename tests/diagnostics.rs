@@ -4,11 +4,10 @@
 //! measured); the last step is always measured.
 
 mod common;
+use common::{ENERGY_RISE_TOL, IDENTITY_TOL};
 use viscobar::Simulation;
 use viscobar::scene::builtin_names;
 
-/// As in `energy_and_contact`: the identity is exact algebra, only round-off remains.
-const IDENTITY_TOL: f64 = 1e-12;
 /// A measured energy after unmeasured steps is computed from `u^{n−1} = u^n − w` rather than
 /// carried over: it differs from the every-step value by round-off in `E` (values of order 1).
 const ENERGY_ROUNDOFF_TOL: f64 = 1e-13;
@@ -71,7 +70,6 @@ fn thinning_leaves_the_trajectory_unchanged_and_measured_steps_close_the_identit
 /// identity telescopes, `E^{m+1/2} − E^{l−1/2} = Σ (−viscous + contact) ≤ 0`.
 #[test]
 fn thinned_energy_never_rises_without_load() {
-    const ENERGY_RISE_TOL: f64 = 1e-13;
     for name in builtin_names() {
         let scene = common::builtin(name, &["output.diagnostics_every=5"]);
         if scene.load.density.is_some() {

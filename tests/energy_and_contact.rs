@@ -2,20 +2,9 @@
 //! built-in scene.
 
 mod common;
+use common::{COMPLEMENTARITY_TOL, ENERGY_RISE_TOL, GAP_TOL, IDENTITY_TOL, REACTION_TOL};
 use viscobar::scene::builtin_names;
 use viscobar::time::run::run_in_memory;
-
-/// Relative residual of the energy identity: the identity is exact algebra, so only round-off
-/// remains (measured: below 1e-14 on every built-in scene, see VERIFICATION.md).
-const IDENTITY_TOL: f64 = 1e-12;
-/// A one-step energy increase of an unforced run, relative to E^{1/2}, that round-off can make.
-const ENERGY_RISE_TOL: f64 = 1e-13;
-/// Gap and reaction may be negative by round-off only: the exact solver puts an active node on
-/// the obstacle up to the rounding of `u^n + z` with |u| <= 1.
-const GAP_TOL: f64 = 1e-14;
-const REACTION_TOL: f64 = 1e-12;
-/// `|gap · reaction|`: round-off in the gap times a reaction of order 10.
-const COMPLEMENTARITY_TOL: f64 = 1e-12;
 
 #[test]
 fn energy_identity_holds_at_every_step_of_every_builtin_scene() {

@@ -33,14 +33,11 @@ use viscobar::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
 use viscobar::step::block_pivot::BlockPivotSolver;
 use viscobar::step::osqp::OSQP_DEFAULT_EPS;
 use viscobar::step::osqp::{OsqpSettings, OsqpSolver};
+use viscobar::study::accuracy::{max_abs, max_distance};
 
 /// Largest problem drawn: large enough for many simultaneous contact changes, small enough that
 /// 200 cases of two OSQP solves each stay within seconds.
 const MAX_UNKNOWNS: usize = 400;
-
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
 
 /// Round-off in a recomputed `(Cz − b)_i`: the audit's floor, [`ROUNDOFF_ULPS`] ulps of the
 /// magnitude of the terms.
@@ -116,34 +113,6 @@ fn a_priori_tolerance(
 /// with condition number below about 1e4 (the generator's margin) stay below this.
 const EXACT_KKT_TOL: f64 = 1e-9;
 
-fn exact_kkt(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64], z: &[f64], r: &[f64]) -> f64 {
-    let scale = 1.0 + max_abs(b).max(max_abs(lo)).max(max_abs(z));
-    let mut rho = c.mul(z);
-    for (ri, bi) in rho.iter_mut().zip(b) {
-        *ri -= bi;
-    }
-    for (&i, rj) in nodes.iter().zip(r) {
-        rho[i] -= rj;
-    }
-    let mut worst = max_abs(&rho);
-    for (j, &i) in nodes.iter().enumerate() {
-        let g = z[i] - lo[j];
-        worst = worst.max(-g).max(-r[j]).max((g * r[j]).abs() / scale);
-    }
-    worst / scale
-}
-
-/// xorshift64: reproducible data from one proptest-drawn seed, so that shrinking stays cheap.
-fn stream(seed: u64) -> impl FnMut() -> f64 {
-    let mut x = seed | 1;
-    move || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        (x >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 /// Slack on the dense check of the cited inequality: the dense inverse is computed by an LU
 /// with partial pivoting on matrices of condition below about 1e3, good to ~1e-13 relative.
 const DENSE_INVERSE_TOL: f64 = 1e-10;
@@ -158,7 +127,7 @@ proptest! {
         every_node in any::<bool>(),
     ) {
         let n = c.dim();
-        let mut rnd = stream(seed);
+        let mut rnd = common::stream(seed);
         let nodes: Vec<usize> = (0..n).filter(|_| every_node || rnd() < 0.5).collect();
         let k = nodes.len();
         let mut exact = BlockPivotSolver::new(&c, &nodes).unwrap();
@@ -170,11 +139,11 @@ proptest! {
             let lo: Vec<f64> = (0..k).map(|_| 2.0 * rnd() - 1.0).collect();
             let (mut ze, mut re) = (vec![0.0; n], vec![0.0; k]);
             exact.solve(&b, &lo, &mut ze, &mut re).unwrap();
-            prop_assert!(exact_kkt(&c, &b, &nodes, &lo, &ze, &re) <= EXACT_KKT_TOL);
+            prop_assert!(common::kkt(&c, &b, &nodes, &lo, &ze, &re) <= EXACT_KKT_TOL);
             let (mut zo, mut ro) = (vec![0.0; n], vec![0.0; k]);
             osqp.solve(&b, &lo, &mut zo, &mut ro)
                 .map_err(|e| TestCaseError::fail(format!("osqp: {e}")))?;
-            let distance = zo.iter().zip(&ze).fold(0.0f64, |m, (a, s)| m.max((a - s).abs()));
+            let distance = max_distance(&zo, &ze);
             let bound = a_posteriori_bound(&c, &b, &nodes, &lo, &zo, &ze);
             prop_assert!(distance <= bound, "‖z_osqp − z_exact‖∞ = {distance:e} > bound {bound:e}");
             let tolerance = a_priori_tolerance(&c, &b, &nodes, &lo, &zo, &ro);
@@ -227,10 +196,7 @@ fn a_wrong_active_set_exceeds_the_tolerance() {
         wrong_z[i] += rj;
     }
     Ldlt::factor(&c).unwrap().solve_in_place(&mut wrong_z);
-    let distance = wrong_z
-        .iter()
-        .zip(&z)
-        .fold(0.0f64, |m, (a, s)| m.max((a - s).abs()));
+    let distance = max_distance(&wrong_z, &z);
     let bound = a_posteriori_bound(&c, &b, &nodes, &lo, &wrong_z, &z);
     let tolerance = a_priori_tolerance(&c, &b, &nodes, &lo, &wrong_z, &wrong_r);
     assert!(

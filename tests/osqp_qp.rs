@@ -11,10 +11,7 @@ use viscobar::step::audit::AUDIT_MARGIN;
 use viscobar::step::exact::ExactSolver;
 use viscobar::step::osqp::OSQP_DEFAULT_EPS;
 use viscobar::step::osqp::{OsqpSettings, OsqpSolver};
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
+use viscobar::study::accuracy::max_abs;
 
 /// OSQP's tolerance carried to the answer. The audit accepts a displacement-unit stationarity
 /// error and a primal violation up to `t_z = AUDIT_MARGIN·eps·(1 + ‖z‖)` and a multiplier (sign
@@ -23,8 +20,8 @@ fn norm(v: &[f64]) -> f64 {
 /// tolerances for `z` and for `r` (`r_j = (Cz − b)_j`, so `‖C‖_∞` times the first plus `t_f`).
 fn tolerances(c: &SymTridiag, b: &[f64], z: &[f64], r: &[f64]) -> (f64, f64) {
     let eps = AUDIT_MARGIN * OSQP_DEFAULT_EPS;
-    let s_f = norm(b).max(norm(&c.mul(z))).max(norm(r));
-    let t_z = eps * (1.0 + norm(z));
+    let s_f = max_abs(b).max(max_abs(&c.mul(z))).max(max_abs(r));
+    let t_z = eps * (1.0 + max_abs(z));
     let t_f = eps * (1.0 + s_f);
     let tol_z = 2.0 * (t_z + t_f / common::MIN_MARGIN);
     let c_norm = c.inf_norm();

@@ -23,6 +23,7 @@ use insta::with_settings;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use viscobar::study::accuracy::max_abs;
 use viscobar::study::figures::{self, Sampling};
 
 mod common;
@@ -48,10 +49,6 @@ fn round_sig(x: f64, scale: f64) -> f64 {
         (x / q).round() * q
     };
     rounded + 0.0 // -0.0 -> 0.0
-}
-
-fn max_abs<'a>(values: impl IntoIterator<Item = &'a f64>) -> f64 {
-    values.into_iter().fold(0.0, |m, v| m.max(v.abs()))
 }
 
 #[derive(Serialize)]

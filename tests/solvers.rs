@@ -3,6 +3,7 @@
 //! solution converging to the exact one as ε → 0.
 
 mod common;
+use common::{COMPLEMENTARITY_TOL, GAP_TOL, IDENTITY_TOL, REACTION_TOL};
 
 use std::path::Path;
 use std::process::Command;
@@ -11,28 +12,22 @@ use osqp::Status;
 use viscobar::RunError;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::scene::{Scene, builtin_names};
-use viscobar::step::audit::AUDIT_MARGIN;
+use viscobar::step::audit::{AUDIT_MARGIN, dual_tolerance};
 use viscobar::step::osqp::OSQP_DEFAULT_EPS;
 use viscobar::step::osqp::{OSQP_INFTY, OsqpSettings, OsqpSolver, raw_problem};
 use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
 use viscobar::step::{StepFailure, StepSolver};
-use viscobar::study::accuracy::observed_order;
+use viscobar::study::accuracy::{max_abs, observed_order};
+use viscobar::study::agreement::stiff_impact_overrides;
 use viscobar::study::compare::{compare, start_up_problem};
 use viscobar::time::run::run_in_memory;
 use viscobar::time::simulation::Simulation;
 
 // ---- tolerances -------------------------------------------------------------------------
 
-/// Energy identity, exact and penalty: exact algebra given `C z = b + r` to round-off, which
-/// both solvers meet by a direct solve (measured below 1e-14, VERIFICATION.md, section "Step solvers").
-const IDENTITY_TOL: f64 = 1e-12;
 /// Energy identity, OSQP: it holds up to `½ ρ·δ` with `ρ` the stationarity residual, which the
 /// audit allows up to `AUDIT_MARGIN · eps_rel = 1e-9` relative to `‖Cz‖`.
 const OSQP_IDENTITY_TOL: f64 = AUDIT_MARGIN * OSQP_DEFAULT_EPS;
-/// Exact solver: gap and reaction negative by round-off only (as in energy_and_contact.rs).
-const GAP_TOL: f64 = 1e-14;
-const REACTION_TOL: f64 = 1e-12;
-const COMPLEMENTARITY_TOL: f64 = 1e-12;
 /// OSQP: the audit's primal tolerance `AUDIT_MARGIN (eps_abs + eps_rel · s)` with the scale
 /// `s = max(|z_j|, |lo_j|) <= 3` on the built-in scenes (|u| <= 2.7), plus the exact solver's
 /// rounding of `u + a`.
@@ -271,28 +266,27 @@ fn raw_osqp(c: &SymTridiag, nodes: &[usize], b: &[f64], lo: &[f64], s: OsqpSetti
     };
     let x = sol.x();
     let reaction: Vec<f64> = sol.y().iter().map(|y| -y).collect();
-    // OSQP's own criterion, eps_abs + eps_rel max(‖q‖, ‖Aᵀy‖, ‖Px‖) (auxil.c).
-    let cx = c.mul(x);
-    let norm = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let scale = norm(&cx).max(norm(b)).max(norm(&reaction));
+    // OSQP's own criterion (auxil.c), as the audit computes it.
+    let cz_norm = max_abs(&c.mul(x));
+    let tolerance = dual_tolerance(
+        s.eps_abs,
+        s.eps_rel,
+        cz_norm,
+        max_abs(b),
+        max_abs(&reaction),
+    );
     RawOsqp {
         solved,
         reaction,
         dual_residual: sol.dua_res(),
-        dual_tolerance: s.eps_abs + s.eps_rel * scale,
+        dual_tolerance: tolerance,
     }
 }
 
 /// The stiff scene of the failure cases: the impact scene with α = 1e6 on 64 elements, time
 /// step `ratio · dx`, 20 steps.
 fn stiff_impact(ratio: f64, extra: &[&str]) -> Scene {
-    let dt = ratio / 64.0;
-    let mut o = vec![
-        "bar.viscosity=1e6".to_string(),
-        "mesh.elements=64".into(),
-        format!("time.step={dt}"),
-        format!("time.end={}", 20.0 * dt),
-    ];
+    let mut o = stiff_impact_overrides(ratio);
     o.extend(extra.iter().map(|s| s.to_string()));
     let o: Vec<&str> = o.iter().map(String::as_str).collect();
     common::builtin("impact", &o)
@@ -315,27 +309,21 @@ fn step_failure(
     }
 }
 
-/// With default (tight) settings at dt = 1000 dx OSQP reports "solved" for the first step
-/// although its polished answer's dual residual is far above its own stopping tolerance (0.6's
-/// polish is accepted when the primal residual improves and the ADMM dual residual was below
-/// 1e-10, whatever the polished dual residual); the reaction is then off in the fifth digit.
-/// The audit's stationarity check refuses it.
-#[test]
-fn osqp_success_that_misses_its_own_tolerance_is_an_error() {
-    let exact_scene = stiff_impact(1000.0, &[]);
-    let f = start_up_problem(&exact_scene).unwrap();
-    let raw = raw_osqp(&f.c, &f.nodes, &f.b, &f.lo, OsqpSettings::default());
-    assert!(raw.solved, "OSQP reports solved");
-    assert!(
-        raw.dual_residual > 10.0 * raw.dual_tolerance,
-        "OSQP's dual residual {:e} vs its tolerance {:e}",
-        raw.dual_residual,
-        raw.dual_tolerance
-    );
+/// OSQP alone on the start-up step of [`stiff_impact`] at `ratio` with `settings`, and the
+/// relative error of its reaction against the exact solver's.
+fn raw_start_up(ratio: f64, settings: OsqpSettings) -> (RawOsqp, f64) {
+    let f = start_up_problem(&stiff_impact(ratio, &[])).unwrap();
+    let raw = raw_osqp(&f.c, &f.nodes, &f.b, &f.lo, settings);
     let reaction_error = (raw.reaction[0] - f.r[0]).abs() / f.r[0];
-    assert!(reaction_error > 1e-6, "reaction error {reaction_error:e}");
+    (raw, reaction_error)
+}
 
-    let scene = stiff_impact(1000.0, &["solver.method=\"osqp\""]);
+/// The audit failure that must stop the OSQP run of [`stiff_impact`] at `ratio` (with
+/// `overrides`) at step 1: what failed, its value and its tolerance.
+fn first_step_audit_failure(ratio: f64, overrides: &[&str]) -> (&'static str, f64, f64) {
+    let mut o = vec!["solver.method=\"osqp\""];
+    o.extend(overrides);
+    let scene = stiff_impact(ratio, &o);
     let (step, failure) = step_failure(run_in_memory("impact", &scene));
     assert_eq!(step, 1);
     match failure {
@@ -343,12 +331,31 @@ fn osqp_success_that_misses_its_own_tolerance_is_an_error() {
             what,
             value,
             tolerance,
-        } => {
-            assert!(what.starts_with("stationarity |Cz"), "{what}");
-            assert!(value > tolerance);
-        }
+        } => (what, value, tolerance),
         f => panic!("expected an audit failure, got {f}"),
     }
+}
+
+/// With default (tight) settings at dt = 1000 dx OSQP reports "solved" for the first step
+/// although its polished answer's dual residual is far above its own stopping tolerance (0.6's
+/// polish is accepted when the primal residual improves and the ADMM dual residual was below
+/// 1e-10, whatever the polished dual residual); the reaction is then off in the fifth digit.
+/// The audit's stationarity check refuses it.
+#[test]
+fn osqp_success_that_misses_its_own_tolerance_is_an_error() {
+    let (raw, reaction_error) = raw_start_up(1000.0, OsqpSettings::default());
+    assert!(raw.solved, "OSQP reports solved");
+    assert!(
+        raw.dual_residual > 10.0 * raw.dual_tolerance,
+        "OSQP's dual residual {:e} vs its tolerance {:e}",
+        raw.dual_residual,
+        raw.dual_tolerance
+    );
+    assert!(reaction_error > 1e-6, "reaction error {reaction_error:e}");
+
+    let (what, value, tolerance) = first_step_audit_failure(1000.0, &[]);
+    assert!(what.starts_with("stationarity |Cz"), "{what}");
+    assert!(value > tolerance);
 }
 
 /// The independent test's case (α = 1e6, dt = 100 dx, 64 elements) with OSQP's tolerances
@@ -362,35 +369,19 @@ fn osqp_loose_answer_far_from_exact_is_an_error() {
         "solver.eps_rel=1e-3",
         "solver.polish=false",
     ];
-    let exact_scene = stiff_impact(100.0, &[]);
-    let f = start_up_problem(&exact_scene).unwrap();
     let settings = OsqpSettings {
         eps_abs: 1e-3,
         eps_rel: 1e-3,
         polish: false,
         ..OsqpSettings::default()
     };
-    let raw = raw_osqp(&f.c, &f.nodes, &f.b, &f.lo, settings);
+    let (raw, reaction_error) = raw_start_up(100.0, settings);
     assert!(raw.solved && raw.dual_residual <= raw.dual_tolerance);
-    let reaction_error = (raw.reaction[0] - f.r[0]).abs() / f.r[0];
     assert!(reaction_error > 1e-2, "reaction error {reaction_error:e}");
 
-    let mut o = vec!["solver.method=\"osqp\""];
-    o.extend(loose);
-    let scene = stiff_impact(100.0, &o);
-    let (step, failure) = step_failure(run_in_memory("impact", &scene));
-    assert_eq!(step, 1);
-    match failure {
-        StepFailure::AuditFailed {
-            what,
-            value,
-            tolerance,
-        } => {
-            assert!(what.starts_with("stationarity in displacement"), "{what}");
-            assert!(value > 5.0 * tolerance, "{value:e} vs {tolerance:e}");
-        }
-        f => panic!("expected an audit failure, got {f}"),
-    }
+    let (what, value, tolerance) = first_step_audit_failure(100.0, &loose);
+    assert!(what.starts_with("stationarity in displacement"), "{what}");
+    assert!(value > 5.0 * tolerance, "{value:e} vs {tolerance:e}");
 }
 
 /// With default settings at dt = 100 dx OSQP does not converge within max_iter: a status
@@ -472,23 +463,25 @@ fn viscobar(args: &[&str]) -> std::process::Output {
         .expect("binary runs")
 }
 
+/// `viscobar run SCENE --solver SOLVER [--set SETTING]... --out OUT`, which must succeed.
+fn run_cli(scene: &str, solver: &str, settings: &[&str], out: &Path) -> std::process::Output {
+    let mut args = vec!["run", scene, "--solver", solver];
+    for s in settings {
+        args.extend(["--set", s]);
+    }
+    args.extend(["--out", out.to_str().unwrap()]);
+    let o = viscobar(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    o
+}
+
 #[test]
 fn osqp_runs_write_byte_identical_files() {
     let base = std::env::temp_dir().join(format!("viscobar-osqp-bits-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&base);
     let dirs = [base.join("a"), base.join("b")];
     for d in &dirs {
-        let o = viscobar(&[
-            "run",
-            "both-ends-forced",
-            "--solver",
-            "osqp",
-            "--set",
-            "time.end=4",
-            "--out",
-            d.to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        run_cli("both-ends-forced", "osqp", &["time.end=4"], d);
     }
     let read = |d: &Path, f: &str| std::fs::read(d.join(f)).unwrap();
     for f in ["history.csv", "displacement.csv"] {
@@ -552,62 +545,55 @@ fn osqp_refuses_non_finite_data_without_panicking() {
 
 #[test]
 fn solver_settings_of_another_method_or_out_of_range_are_refused() {
+    // Each case: its overrides, separated by spaces, and what the error must name.
     let refused = [
-        (&["solver.eps_abs=1e-6"][..], "solver.eps_abs"),
+        ("solver.eps_abs=1e-6", "solver.eps_abs"),
         (
-            &["solver.method=\"penalty\"", "solver.polish=false"][..],
+            "solver.method=\"penalty\" solver.polish=false",
             "solver.polish",
         ),
         (
-            &["solver.method=\"osqp\"", "solver.epsilon=1e-3"][..],
+            "solver.method=\"osqp\" solver.epsilon=1e-3",
             "solver.epsilon",
         ),
         (
-            &["solver.method=\"penalty\"", "solver.epsilon=0"][..],
+            "solver.method=\"penalty\" solver.epsilon=0",
             "solver.epsilon",
         ),
         (
-            &["solver.method=\"penalty\"", "solver.epsilon=-1"][..],
+            "solver.method=\"penalty\" solver.epsilon=-1",
             "solver.epsilon",
         ),
         (
-            &["solver.method=\"osqp\"", "solver.adaptive_rho_interval=0"][..],
+            "solver.method=\"osqp\" solver.adaptive_rho_interval=0",
             "adaptive_rho_interval",
         ),
         (
-            &["solver.method=\"osqp\"", "solver.max_iter=0"][..],
+            "solver.method=\"osqp\" solver.max_iter=0",
             "solver.max_iter",
         ),
         (
-            &["solver.method=\"osqp\"", "solver.eps_rel=-1e-3"][..],
+            "solver.method=\"osqp\" solver.eps_rel=-1e-3",
             "solver.eps_rel",
         ),
         (
-            &[
-                "solver.method=\"osqp\"",
-                "solver.eps_abs=0",
-                "solver.eps_rel=0",
-            ][..],
+            "solver.method=\"osqp\" solver.eps_abs=0 solver.eps_rel=0",
             "both be 0",
         ),
-        (&["solver.method=\"gurobi\""][..], "method"),
-        (&["solver.method=\"osqp\"", "solver.rho=0.1"][..], "rho"),
+        ("solver.method=\"gurobi\"", "method"),
+        ("solver.method=\"osqp\" solver.rho=0.1", "rho"),
     ];
-    let load_impact = |overrides: &[&str]| {
-        let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let load_impact = |overrides: &str| {
+        let o: Vec<String> = overrides.split(' ').map(str::to_string).collect();
         viscobar::scene::load("impact", &o)
     };
     for (overrides, needle) in refused {
         let err = load_impact(overrides).expect_err("refused");
-        assert!(err.to_string().contains(needle), "{overrides:?}: {err}");
+        assert!(err.to_string().contains(needle), "{overrides}: {err}");
     }
     for ok in [
-        &[
-            "solver.method=\"osqp\"",
-            "solver.eps_abs=1e-8",
-            "solver.polish=false",
-        ][..],
-        &["solver.method=\"penalty\"", "solver.epsilon=1e-4"][..],
+        "solver.method=\"osqp\" solver.eps_abs=1e-8 solver.polish=false",
+        "solver.method=\"penalty\" solver.epsilon=1e-4",
     ] {
         load_impact(ok).unwrap();
     }
@@ -618,15 +604,7 @@ fn cli_runs_osqp_and_penalty_and_reports_their_audit() {
     let base = std::env::temp_dir().join(format!("viscobar-cli-solvers-{}", std::process::id()));
     for solver in ["osqp", "penalty"] {
         let out = base.join(solver);
-        let o = viscobar(&[
-            "run",
-            "impact",
-            "--solver",
-            solver,
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        run_cli("impact", solver, &[], &out);
         let summary: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
                 .unwrap();
@@ -666,23 +644,13 @@ fn cli_runs_osqp_and_penalty_and_reports_their_audit() {
 #[test]
 fn cli_warns_about_accepted_inaccurate_steps() {
     let out = std::env::temp_dir().join(format!("viscobar-cli-inacc-{}", std::process::id()));
-    let o = viscobar(&[
-        "run",
-        "impact",
-        "--solver",
-        "osqp",
-        "--set",
+    let settings = [
         "solver.eps_abs=1e-8",
-        "--set",
         "solver.eps_rel=1e-8",
-        "--set",
         "solver.max_iter=75",
-        "--set",
         "solver.accept_inaccurate=true",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    ];
+    let o = run_cli("impact", "osqp", &settings, &out);
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stderr.contains("warning: 1 steps accepted"), "{stderr}");
     let _ = std::fs::remove_dir_all(&out);

@@ -33,6 +33,13 @@ pub const INACCURATE_FACTOR: f64 = 10.0;
 /// (`|L||D||Lᵀ| = |C|` for SPD tridiagonal matrices); 32 gives a margin of three.
 pub const ROUNDOFF_ULPS: f64 = 32.0;
 
+/// OSQP's dual-residual tolerance (auxil.c; the module doc): `eps_abs + eps_rel · max(‖Cz‖∞,
+/// ‖b‖∞, ‖r‖∞)`, from the three norms; the audit applies it with its margin, the studies and
+/// tests with OSQP's own `eps` to read OSQP's verdict.
+pub fn dual_tolerance(eps_abs: f64, eps_rel: f64, cz_norm: f64, b_norm: f64, r_norm: f64) -> f64 {
+    eps_abs + eps_rel * cz_norm.max(b_norm).max(r_norm)
+}
+
 /// The contact law an answer must satisfy.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Law {
@@ -141,7 +148,7 @@ impl KktAudit {
         }
         let res_norm = self.residual.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let floor_f = ulp * (self.c_norm * z_norm + b_norm + r_norm);
-        let tol_f = eps_abs + eps_rel * cz_norm.max(b_norm).max(r_norm) + floor_f;
+        let tol_f = dual_tolerance(eps_abs, eps_rel, cz_norm, b_norm, r_norm) + floor_f;
         self.factor.solve_in_place(&mut self.residual);
         let dz_norm = self.residual.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let tol_dz = eps_abs + eps_rel * z_norm + self.inv_norm * floor_f;

@@ -4,7 +4,7 @@ use crate::bar::closed_form::ClosedForm;
 use crate::linalg::tridiag::{Ldlt, SymTridiag};
 use crate::scene::Scene;
 use crate::time::RunError;
-use crate::time::simulation::{Discretisation, Simulation};
+use crate::time::simulation::{Discretisation, Simulation, StepRecord};
 
 /// Errors of a run against an exact solution, at the nodes and every time step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -13,6 +13,42 @@ pub struct ErrorNorms {
     pub l2: f64,
     /// `max_n max_i |u_i^n − u(x_i, t_n)|`.
     pub max: f64,
+}
+
+/// `max_i |v_i|`, the ∞-norm (0 for no values).
+pub fn max_abs<'a>(values: impl IntoIterator<Item = &'a f64>) -> f64 {
+    values.into_iter().fold(0.0f64, |m, v| m.max(v.abs()))
+}
+
+/// `max_i |a_i − b_i|`, the ∞-norm distance (over the shorter of the two).
+pub fn max_distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+}
+
+/// `max_i |u_i − t|`: the distance of a rigid translation's displacement from `u = t`.
+pub fn rigid_drift(u: &[f64], t: f64) -> f64 {
+    u.iter().fold(0.0f64, |m, v| m.max((v - t).abs()))
+}
+
+/// Steps `sims` together from the start-up state to `steps` states, calling `observe` with the
+/// simulations and the records of the step: once after the start-up (no records), then after
+/// every step. They step in slice order, so a failure is the first failing simulation's.
+pub fn lockstep(
+    sims: &mut [Simulation],
+    steps: usize,
+    mut observe: impl FnMut(&[Simulation], Vec<StepRecord>),
+) -> Result<(), RunError> {
+    observe(sims, Vec::new());
+    for _ in 1..steps {
+        let records = sims
+            .iter_mut()
+            .map(Simulation::step)
+            .collect::<Result<Vec<_>, _>>()?;
+        observe(sims, records);
+    }
+    Ok(())
 }
 
 /// Runs `scene` with the exact solver and measures its error against `exact`.
@@ -31,8 +67,9 @@ pub fn error_against(scene: &Scene, exact: &dyn ClosedForm) -> Result<ErrorNorms
         .collect();
     let mut u = vec![0.0; disc.nodes];
     let mut norms = ErrorNorms::default();
-    let mut measure = |sim: &Simulation, u: &mut Vec<f64>| {
-        sim.displacement_into(u);
+    lockstep(std::slice::from_mut(&mut sim), scene.steps(), |sims, _| {
+        let sim = &sims[0];
+        sim.displacement_into(&mut u);
         let t = sim.time();
         let mut l2 = 0.0;
         for i in 0..u.len() {
@@ -41,12 +78,7 @@ pub fn error_against(scene: &Scene, exact: &dyn ClosedForm) -> Result<ErrorNorms
             norms.max = norms.max.max(e.abs());
         }
         norms.l2 = norms.l2.max(l2.sqrt());
-    };
-    measure(&sim, &mut u);
-    for _ in 1..scene.steps() {
-        sim.step()?;
-        measure(&sim, &mut u);
-    }
+    })?;
     Ok(norms)
 }
 
@@ -76,13 +108,9 @@ pub fn rigid_mode_drift(elements: u64, steps: usize) -> Result<(f64, f64), RunEr
         end = (steps + 1) as f64 / elements as f64
     );
     let scene = Scene::from_toml(&text, &[])?;
-    let drift = |u: &[f64], t: f64| u.iter().fold(0.0f64, |m, v| m.max((v - t).abs()));
-
     let mut sim = Simulation::new(&scene)?;
-    while sim.step_index() < steps {
-        sim.step()?;
-    }
-    let increment = drift(&sim.displacement(), sim.time());
+    lockstep(std::slice::from_mut(&mut sim), steps, |_, _| {})?;
+    let increment = rigid_drift(&sim.displacement(), sim.time());
 
     let disc = Discretisation::new(&scene)?;
     let dt = disc.dt;
@@ -101,6 +129,6 @@ pub fn rigid_mode_drift(elements: u64, steps: usize) -> Result<(f64, f64), RunEr
         std::mem::swap(&mut u_prev, &mut u);
         std::mem::swap(&mut u, &mut next);
     }
-    let talk = drift(&u, steps as f64 * dt);
+    let talk = rigid_drift(&u, steps as f64 * dt);
     Ok((increment, talk))
 }

@@ -12,10 +12,11 @@
 use crate::linalg::tridiag::{Ldlt, SymTridiag};
 use crate::scene::{self, Scene};
 use crate::step::StepSolver;
+use crate::step::audit::dual_tolerance;
 use crate::step::exact::ExactSolver;
 use crate::step::osqp::{OsqpSettings, OsqpSolver, raw_problem};
 use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
-use crate::study::accuracy::observed_order;
+use crate::study::accuracy::{max_abs, max_distance, observed_order};
 use crate::study::compare::{StepProblem, compare, start_up_problem};
 use crate::time::RunError;
 use crate::time::run::run_in_memory;
@@ -40,16 +41,6 @@ fn with_method(m: &str, extra: &[String]) -> Vec<String> {
     let mut o = vec![format!("solver.method=\"{m}\"")];
     o.extend(extra.iter().cloned());
     o
-}
-
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
-}
-
-fn max_distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
 }
 
 /// The audit report of an OSQP or penalty run (both always audit).
@@ -187,7 +178,13 @@ fn raw_first_step(scene: &Scene, s: OsqpSettings) -> Result<String, RunError> {
     let x = sol.x();
     let r: Vec<f64> = sol.y().iter().map(|y| -y).collect();
     let mut res = c.mul(x);
-    let scale = max_abs(&res).max(max_abs(&b)).max(max_abs(&r));
+    let osqp_dual_tolerance = dual_tolerance(
+        s.eps_abs,
+        s.eps_rel,
+        max_abs(&res),
+        max_abs(&b),
+        max_abs(&r),
+    );
     for (ri, bi) in res.iter_mut().zip(&b) {
         *ri -= bi;
     }
@@ -201,7 +198,7 @@ fn raw_first_step(scene: &Scene, s: OsqpSettings) -> Result<String, RunError> {
          {:.1e}); max \\|z − z_exact\\| = {:.2e}; \\|C⁻¹(Cz − b − r)\\|∞ = {:.2e}",
         sol.polish_status(),
         sol.dua_res(),
-        s.eps_abs + s.eps_rel * scale,
+        osqp_dual_tolerance,
         r[0],
         r_exact[0],
         (r[0] - r_exact[0]).abs() / r_exact[0].abs(),
@@ -215,6 +212,18 @@ fn outcome(name: &str, scene: &Scene) -> String {
         Ok(_) => "run succeeded".to_string(),
         Err(e) => format!("error: {e}"),
     }
+}
+
+/// The overrides that make the impact scene the stiff scene of the OSQP failure cases (here and
+/// in tests/solvers.rs): α = 1e6, 64 elements, 20 steps of `dt = ratio · dx`.
+pub fn stiff_impact_overrides(ratio: f64) -> Vec<String> {
+    let dt = ratio / 64.0;
+    vec![
+        "bar.viscosity=1e6".to_string(),
+        "mesh.elements=64".into(),
+        format!("time.step={dt}"),
+        format!("time.end={}", 20.0 * dt),
+    ]
 }
 
 fn failure_cases(md: &mut String) -> Result<(), RunError> {
@@ -240,13 +249,7 @@ fn failure_cases(md: &mut String) -> Result<(), RunError> {
         (100.0, loose_overrides, loose),
     ];
     for (ratio, extra, settings) in cases {
-        let dt = ratio / 64.0;
-        let base = vec![
-            "bar.viscosity=1e6".to_string(),
-            "mesh.elements=64".into(),
-            format!("time.step={dt}"),
-            format!("time.end={}", 20.0 * dt),
-        ];
+        let base = stiff_impact_overrides(ratio);
         let exact = load("impact", &base)?;
         let mut o = base.clone();
         o.push("solver.method=\"osqp\"".into());
@@ -291,6 +294,27 @@ fn failure_cases(md: &mut String) -> Result<(), RunError> {
     Ok(())
 }
 
+/// Smallest diagonal-dominance margin of the random step matrices (here and in the tests'
+/// `spd_tridiag`): keeps the condition number below about 1e4 for the sizes drawn.
+pub const MIN_MARGIN: f64 = 0.05;
+/// Largest diagonal-dominance margin of the random step matrices.
+pub const MAX_MARGIN: f64 = 3.0;
+
+/// The SPD tridiagonal matrix with off-diagonal `off` whose diagonal exceeds each row's
+/// off-diagonal magnitudes by `margin[i]` (off-diagonals of either sign: the step matrix C is
+/// not an M-matrix when the mass term dominates).
+pub fn diagonally_dominant(off: Vec<f64>, margin: &[f64]) -> SymTridiag {
+    let n = margin.len();
+    let diag = (0..n)
+        .map(|i| {
+            let l = if i > 0 { off[i - 1].abs() } else { 0.0 };
+            let r = if i + 1 < n { off[i].abs() } else { 0.0 };
+            l + r + margin[i]
+        })
+        .collect();
+    SymTridiag::new(diag, off)
+}
+
 /// A 64-bit linear congruential generator (Knuth's MMIX constants): a fixed, dependency-free
 /// sample.
 struct Lcg(u64);
@@ -310,14 +334,8 @@ fn random_problems(md: &mut String) -> Result<(), RunError> {
     for case in 0..count {
         let n = 2 + (g.uniform(0.0, 22.0) as usize);
         let off: Vec<f64> = (0..n - 1).map(|_| g.uniform(-1.0, 1.0)).collect();
-        let diag: Vec<f64> = (0..n)
-            .map(|i| {
-                let l = if i > 0 { off[i - 1].abs() } else { 0.0 };
-                let r = if i + 1 < n { off[i].abs() } else { 0.0 };
-                l + r + g.uniform(0.05, 3.0)
-            })
-            .collect();
-        let c = SymTridiag::new(diag, off);
+        let margin: Vec<f64> = (0..n).map(|_| g.uniform(MIN_MARGIN, MAX_MARGIN)).collect();
+        let c = diagonally_dominant(off, &margin);
         let b: Vec<f64> = (0..n).map(|_| g.uniform(-5.0, 5.0)).collect();
         let nodes = match case % 3 {
             0 => vec![0],

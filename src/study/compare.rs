@@ -3,6 +3,7 @@
 
 use crate::scene::Scene;
 use crate::scene::SceneError;
+use crate::study::accuracy::{lockstep, max_abs, max_distance};
 use crate::time::RunError;
 use crate::time::run::{Summary, Tracker};
 use crate::time::simulation::{Simulation, StepRecord};
@@ -44,37 +45,32 @@ pub fn compare(name: &str, a: &Scene, b: &Scene) -> Result<Comparison, RunError>
         }
         .into());
     }
-    let mut sa = Simulation::new(a)?;
-    let mut sb = Simulation::new(b)?;
-    let mut tracker = Tracker::new(&sb, b.load.density.is_none());
-    let mut records = vec![sb.first_record()];
+    let mut sims = [Simulation::new(a)?, Simulation::new(b)?];
+    let mut tracker = Tracker::new(&sims[1], b.load.density.is_none());
+    let mut records = vec![sims[1].first_record()];
     let start = std::time::Instant::now();
-    let nodes = sa.discretisation().nodes;
+    let nodes = sims[0].discretisation().nodes;
     let (mut ua, mut ub) = (vec![0.0; nodes], vec![0.0; nodes]);
     let mut out = Agreement::default();
-    let mut measure = |sa: &Simulation, sb: &Simulation, out: &mut Agreement| {
+    lockstep(&mut sims, a.steps(), |sims, step| {
+        if let Some(&r) = step.get(1) {
+            tracker.observe(&r);
+            records.push(r);
+        }
+        let [sa, sb] = sims else {
+            unreachable!("two runs")
+        };
         sa.displacement_into(&mut ua);
         sb.displacement_into(&mut ub);
-        let diff = ua
-            .iter()
-            .zip(&ub)
-            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        let diff = max_distance(&ua, &ub);
         if diff > out.max_difference {
             out.max_difference = diff;
             out.worst_step = sa.step_index();
         }
-        out.max_displacement = ua.iter().fold(out.max_displacement, |m, x| m.max(x.abs()));
+        out.max_displacement = out.max_displacement.max(max_abs(&ua));
         out.steps = sa.step_index();
-    };
-    measure(&sa, &sb, &mut out);
-    for _ in 1..a.steps() {
-        sa.step()?;
-        let r = sb.step()?;
-        tracker.observe(&r);
-        records.push(r);
-        measure(&sa, &sb, &mut out);
-    }
-    let summary = tracker.finish(name, &sb, start.elapsed().as_secs_f64());
+    })?;
+    let summary = tracker.finish(name, &sims[1], start.elapsed().as_secs_f64());
     Ok(Comparison {
         agreement: out,
         records,

@@ -449,6 +449,9 @@ fn settings_of(rows: &[Row]) -> Vec<SolverSetting> {
     out
 }
 
+/// A column of [`Study::table`]: its header and the cell of a row.
+pub type Column = (&'static str, fn(&Row) -> String);
+
 impl Study {
     /// Observed orders (L2, H1) per setting: least-squares slopes of log error against log dx.
     pub fn orders(&self) -> Vec<(SolverSetting, f64, f64)> {
@@ -489,27 +492,46 @@ impl Study {
         out
     }
 
-    pub fn markdown(&self) -> String {
-        let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3e}"));
-        let mut md = format!(
-            "Scene `{}`, reference: {}\n\n| solver | setting | elements | dt | L2 error | H1 error | energy error | contact time error | wall time (s) |\n|---|---|---|---|---|---|---|---|---|\n",
-            self.scene, self.reference
-        );
-        for r in &self.rows {
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} | {:.3e} | {:.3e} | {:.3e} | {} | {} | {:.2e} |",
-                r.setting.solver(),
-                r.setting.setting(),
-                r.elements,
-                r.dt,
-                r.l2_error,
-                r.h1_error,
-                opt(r.energy_error),
-                opt(r.contact_time_error),
-                r.wall_time_s
-            );
+    /// The Markdown table of the runs, one row each: the `lead` columns, the four errors
+    /// (`-` where one does not apply), then the `trail` columns. `viscobar converge` and
+    /// VERIFICATION.md (section "Falling bar") both render through it.
+    pub fn table(&self, lead: &[Column], trail: &[Column]) -> String {
+        fn opt(v: Option<f64>) -> String {
+            v.map_or("-".to_string(), |v| format!("{v:.3e}"))
         }
+        let errors: [Column; 4] = [
+            ("L2 error", |r| format!("{:.3e}", r.l2_error)),
+            ("H1 error", |r| format!("{:.3e}", r.h1_error)),
+            ("energy error", |r| opt(r.energy_error)),
+            ("contact time error", |r| opt(r.contact_time_error)),
+        ];
+        let columns: Vec<&Column> = lead.iter().chain(&errors).chain(trail).collect();
+        let mut md = String::from("|");
+        for (header, _) in &columns {
+            let _ = write!(md, " {header} |");
+        }
+        let _ = writeln!(md, "\n|{}", "---|".repeat(columns.len()));
+        for r in &self.rows {
+            md.push('|');
+            for (_, cell) in &columns {
+                let _ = write!(md, " {} |", cell(r));
+            }
+            md.push('\n');
+        }
+        md
+    }
+
+    pub fn markdown(&self) -> String {
+        let mut md = format!("Scene `{}`, reference: {}\n\n", self.scene, self.reference);
+        md.push_str(&self.table(
+            &[
+                ("solver", |r| r.setting.solver().to_string()),
+                ("setting", |r| r.setting.setting()),
+                ("elements", |r| r.elements.to_string()),
+                ("dt", |r| format!("{:.3e}", r.dt)),
+            ],
+            &[("wall time (s)", |r| format!("{:.2e}", r.wall_time_s))],
+        ));
         md.push_str("\n| solver | setting | observed order (L2) | observed order (H1) |\n|---|---|---|---|\n");
         for (s, p2, p1) in self.orders() {
             let _ = writeln!(

@@ -28,7 +28,9 @@ use crate::step::audit::{AUDIT_MARGIN, KktAudit, Law, ROUNDOFF_ULPS};
 use crate::step::osqp::OSQP_DEFAULT_EPS;
 use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
 use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
+use crate::study::accuracy::{max_abs, max_distance, rigid_drift};
 use crate::time::RunError;
+use crate::time::run::Tracker;
 use crate::time::simulation::{Discretisation, Simulation, make_solver};
 use rayon::prelude::*;
 use std::fmt::Write;
@@ -463,10 +465,11 @@ fn short_error(e: &RunError) -> (String, bool) {
 /// One solver's run state while stepping in lockstep with the others.
 struct Live {
     sim: Option<Simulation>,
+    /// The run's summary statistics (identity residual, penetration, first and last energy),
+    /// taken into `out` by [`Live::settle`] when the run ends.
+    tracker: Option<Tracker>,
     out: SolverRun,
     u: Vec<f64>,
-    energy_first: f64,
-    energy_last: f64,
     energy_max: f64,
     balance: f64,
     magnitude: f64,
@@ -477,30 +480,51 @@ impl Live {
         let (msg, located) = short_error(e);
         self.out.error = Some(msg);
         self.out.error_located = located;
+        self.settle();
         self.sim = None;
+    }
+
+    /// A run just built: the tracker takes its start-up record.
+    fn start(&mut self, sim: Simulation) {
+        // Unforced or not: the energy rise is not read here.
+        self.tracker = Some(Tracker::new(&sim, false));
+        let first = sim.first_record();
+        self.sim = Some(sim);
+        self.observe(&first, true);
     }
 
     fn observe(&mut self, r: &crate::time::simulation::StepRecord, first: bool) {
         let o = &mut self.out;
         o.steps_done = r.step;
-        o.max_violation = o.max_violation.max(-r.min_gap);
         if !first {
-            o.max_identity_residual = o.max_identity_residual.max(r.identity_residual);
+            if let Some(t) = self.tracker.as_mut() {
+                t.observe(r);
+            }
             self.balance += r.work - r.viscous_dissipation - r.contact_dissipation;
             self.magnitude += r.work.abs() + r.viscous_dissipation + r.contact_dissipation.abs();
-        } else {
-            self.energy_first = r.energy;
         }
-        self.energy_last = r.energy;
         self.energy_max = self.energy_max.max(r.energy.abs());
         if let Some(sim) = &self.sim {
             sim.displacement_into(&mut self.u);
-            let m = self.u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             o.all_finite &= self.u.iter().all(|v| v.is_finite());
-            o.max_displacement = o.max_displacement.max(m);
-            let rmax = sim.reactions().iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            o.max_reaction = o.max_reaction.max(rmax);
+            o.max_displacement = o.max_displacement.max(max_abs(&self.u));
+            o.max_reaction = o.max_reaction.max(max_abs(sim.reactions()));
         }
+    }
+
+    /// The run has ended (completed or failed): the tracker's statistics and the energy drift
+    /// into `out`.
+    fn settle(&mut self) {
+        let (Some(tracker), Some(sim)) = (self.tracker.take(), &self.sim) else {
+            return;
+        };
+        let s = tracker.finish("", sim, 0.0);
+        let o = &mut self.out;
+        o.max_identity_residual = s.max_identity_residual;
+        o.max_violation = s.max_violation;
+        let scale = self.energy_max.max(self.magnitude);
+        let drift = (s.energy_final - s.energy_initial - self.balance).abs();
+        o.energy_drift = if scale > 0.0 { drift / scale } else { 0.0 };
     }
 }
 
@@ -531,9 +555,8 @@ pub fn run_case(case: &Case) -> CaseResult {
                     rigid_drift: None,
                     all_finite: true,
                 },
+                tracker: None,
                 u: vec![0.0; nodes],
-                energy_first: 0.0,
-                energy_last: 0.0,
                 energy_max: 0.0,
                 balance: 0.0,
                 magnitude: 0.0,
@@ -546,9 +569,7 @@ pub fn run_case(case: &Case) -> CaseResult {
                         max_gap = d.constraints.iter().fold(0.0, |m, c| m.max(c.gap));
                         schur = d.ends_only().then(|| inverse_diagonal_range(d)).flatten();
                     }
-                    let first = sim.first_record();
-                    l.sim = Some(sim);
-                    l.observe(&first, true);
+                    l.start(sim);
                 }
                 Err(e) => l.fail(&e),
             }
@@ -572,16 +593,13 @@ pub fn run_case(case: &Case) -> CaseResult {
     let runs = live
         .into_iter()
         .map(|mut l| {
-            let scale = l.energy_max.max(l.magnitude);
-            let drift = (l.energy_last - l.energy_first - l.balance).abs();
-            l.out.energy_drift = if scale > 0.0 { drift / scale } else { 0.0 };
+            l.settle();
             if let Some(sim) = &l.sim {
                 l.out.audit_ratio = (l.out.solver == "exact")
                     .then(|| sim.solver_report().map_or(0.0, |r| worst_ratio(&r.audit)));
                 if case.family == Family::Rigid {
                     let t = sim.time();
-                    let d = l.u.iter().fold(0.0f64, |m, v| m.max((v - t).abs()));
-                    l.out.rigid_drift = Some(d);
+                    l.out.rigid_drift = Some(rigid_drift(&l.u, t));
                 }
             }
             l.out
@@ -624,10 +642,7 @@ fn compare_with_exact(live: &mut [Live]) {
         return;
     }
     for l in others.iter_mut().filter(|l| l.sim.is_some()) {
-        let d =
-            l.u.iter()
-                .zip(&exact.u)
-                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        let d = max_distance(&l.u, &exact.u);
         if let Some(dist) = l.out.distance.as_mut() {
             *dist = dist.max(d);
         }

@@ -6,7 +6,7 @@
 use crate::bar::closed_form;
 use crate::bar::matrices::{MatrixVariant, mass, stiffness};
 use crate::scene;
-use crate::study::accuracy::{error_against, observed_order, rigid_mode_drift};
+use crate::study::accuracy::{error_against, max_abs, observed_order, rigid_mode_drift};
 use crate::time::RunError;
 use crate::time::run::run_in_memory;
 use std::fmt::Write;
@@ -53,10 +53,7 @@ fn matrices_section() -> Section {
             let m = mass(variant, nodes, dx);
             let r = stiffness(variant, nodes, dx);
             let total: f64 = m.mul(&vec![1.0; nodes]).iter().sum();
-            let r1 = r
-                .mul(&vec![1.0; nodes])
-                .iter()
-                .fold(0.0f64, |a, v| a.max(v.abs()));
+            let r1 = max_abs(&r.mul(&vec![1.0; nodes]));
             let sym = |a: &crate::linalg::tridiag::SymTridiag| {
                 let d = a.to_dense();
                 d == d.transpose()
@@ -252,23 +249,14 @@ fn falling_bar_section() -> Result<Section, crate::study::converge::ConvergeErro
         CONVERGENCE_LEVELS,
         None,
     )?;
-    let mut md = format!(
-        "Reference: {}.\n\n| elements | dt | L2 error | H1 error | energy error | contact time error |\n|---|---|---|---|---|---|\n",
-        st.reference
-    );
-    let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3e}"));
-    for r in &st.rows {
-        let _ = writeln!(
-            md,
-            "| {} | {} | {:.3e} | {:.3e} | {} | {} |",
-            r.elements,
-            r.dt,
-            r.l2_error,
-            r.h1_error,
-            opt(r.energy_error),
-            opt(r.contact_time_error)
-        );
-    }
+    let mut md = format!("Reference: {}.\n\n", st.reference);
+    md.push_str(&st.table(
+        &[
+            ("elements", |r| r.elements.to_string()),
+            ("dt", |r| r.dt.to_string()),
+        ],
+        &[],
+    ));
     let h: Vec<f64> = st.rows.iter().map(|r| r.dx).collect();
     let order = |f: fn(&crate::study::converge::Row) -> Option<f64>| {
         let e: Option<Vec<f64>> = st.rows.iter().map(f).collect();
