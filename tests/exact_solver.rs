@@ -5,11 +5,11 @@ mod common;
 use common::AGREEMENT_TOL;
 
 use proptest::prelude::*;
+use viscobar::linalg::norms::max_abs;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::exact::ExactSolver;
 use viscobar::step::oracle::brute_force;
-use viscobar::study::accuracy::max_abs;
 
 /// KKT residuals of `(z, r)` and its distance to the dense brute-force oracle.
 fn check_against_oracle(

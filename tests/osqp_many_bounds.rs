@@ -27,13 +27,13 @@
 mod common;
 
 use proptest::prelude::*;
+use viscobar::linalg::norms::{max_abs, max_distance};
 use viscobar::linalg::tridiag::{Ldlt, SymTridiag};
 use viscobar::step::StepSolver;
 use viscobar::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
 use viscobar::step::block_pivot::BlockPivotSolver;
 use viscobar::step::osqp::OSQP_DEFAULT_EPS;
 use viscobar::step::osqp::{OsqpSettings, OsqpSolver};
-use viscobar::study::accuracy::{max_abs, max_distance};
 
 /// Largest problem drawn: large enough for many simultaneous contact changes, small enough that
 /// 200 cases of two OSQP solves each stay within seconds.

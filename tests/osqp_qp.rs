@@ -5,13 +5,13 @@
 mod common;
 
 use proptest::prelude::*;
+use viscobar::linalg::norms::max_abs;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::audit::AUDIT_MARGIN;
 use viscobar::step::exact::ExactSolver;
 use viscobar::step::osqp::OSQP_DEFAULT_EPS;
 use viscobar::step::osqp::{OsqpSettings, OsqpSolver};
-use viscobar::study::accuracy::max_abs;
 
 /// OSQP's tolerance carried to the answer. The audit accepts a displacement-unit stationarity
 /// error and a primal violation up to `t_z = AUDIT_MARGIN·eps·(1 + ‖z‖)` and a multiplier (sign

@@ -23,7 +23,7 @@ use insta::with_settings;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use viscobar::study::accuracy::max_abs;
+use viscobar::linalg::norms::max_abs;
 use viscobar::study::figures::{self, Sampling};
 
 mod common;

@@ -10,6 +10,7 @@ use std::process::Command;
 
 use osqp::Status;
 use viscobar::RunError;
+use viscobar::linalg::norms::max_abs;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::scene::{Scene, builtin_names};
 use viscobar::step::audit::{AUDIT_MARGIN, dual_tolerance};
@@ -17,7 +18,7 @@ use viscobar::step::osqp::OSQP_DEFAULT_EPS;
 use viscobar::step::osqp::{OSQP_INFTY, OsqpSettings, OsqpSolver, raw_problem};
 use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
 use viscobar::step::{StepFailure, StepSolver};
-use viscobar::study::accuracy::{max_abs, observed_order};
+use viscobar::study::accuracy::observed_order;
 use viscobar::study::agreement::stiff_impact_overrides;
 use viscobar::study::compare::{compare, start_up_problem};
 use viscobar::time::run::run_in_memory;

@@ -4,7 +4,9 @@
 //! Bottom layer: imports nothing from the crate.
 
 pub mod dispatch;
+pub mod norms;
 pub mod spectrum;
 pub mod tridiag;
 
+pub use norms::{max_abs, max_distance};
 pub use tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};

@@ -14,6 +14,7 @@
 //! add one it does not make (stationarity mapped to displacement):
 //! [docs/step-solvers.md](../docs/step-solvers.md#kkt-audit).
 
+use crate::linalg::norms::max_abs;
 use crate::linalg::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
 use crate::step::report::{AuditReport, StepFailure, Worst};
 
@@ -146,11 +147,11 @@ impl KktAudit {
             self.residual[node] -= r[j];
             r_norm = r_norm.max(r[j].abs());
         }
-        let res_norm = self.residual.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let res_norm = max_abs(&self.residual);
         let floor_f = ulp * (self.c_norm * z_norm + b_norm + r_norm);
         let tol_f = dual_tolerance(eps_abs, eps_rel, cz_norm, b_norm, r_norm) + floor_f;
         self.factor.solve_in_place(&mut self.residual);
-        let dz_norm = self.residual.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let dz_norm = max_abs(&self.residual);
         let tol_dz = eps_abs + eps_rel * z_norm + self.inv_norm * floor_f;
 
         let mut p_scale = 0.0f64;

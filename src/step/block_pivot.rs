@@ -18,6 +18,7 @@
 //! The active set is warm-started from the previous step; when it is empty, the factorisation
 //! of `C` computed once per run is used.
 
+use crate::linalg::norms::max_abs;
 use crate::linalg::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
 use crate::step::{SolveInfo, StepFailure, StepSolver};
 
@@ -150,14 +151,14 @@ impl StepSolver for BlockPivotSolver {
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
         let eps = f64::EPSILON;
-        let b_max = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let lo_max = lower.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let b_max = max_abs(rhs);
+        let lo_max = max_abs(lower);
         let mut best_count = usize::MAX;
         let mut patience = BLOCK_PATIENCE;
         for iteration in 1..=self.max_iterations {
             self.solve_reduced(rhs, lower, z);
             self.c.mul_into(z, &mut self.cz);
-            let z_max = z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let z_max = max_abs(z.iter());
             if !z_max.is_finite() {
                 return Err(StepFailure::NonFinite);
             }

@@ -529,6 +529,7 @@ pub(crate) fn rigid_flight() -> (SymTridiag, Vec<f64>) {
 mod tests {
     use super::*;
     use crate::bar::matrices::{MatrixVariant, mass, stiffness};
+    use crate::linalg::norms::max_abs;
     use crate::step::audit::{KktAudit, Law};
 
     /// Two direct solves of the same reduced system, each a few ulps of `max|z|` off, agree to
@@ -603,7 +604,7 @@ mod tests {
             let nodes = c.dim();
             let ends = [0, nodes - 1];
             let u0: Vec<f64> = (0..nodes).map(|i| state * (1.0 + i as f64)).collect();
-            let scale = u0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let scale = max_abs(&u0);
             let mut two_pass = ExactSolver::new(c, &ends).unwrap();
             two_pass.set_state_scale(scale);
             let (s0, s1) = (&two_pass.columns[0].support, &two_pass.columns[1].support);
@@ -715,7 +716,7 @@ mod tests {
                 eps_rel: 0.0,
             };
             audit.check(law, b, &both, &z, &r).unwrap();
-            let z_max = z_enum.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let z_max = max_abs(&z_enum);
             // The direct solve against the enumeration's answer (direct too on the stiff bar,
             // superposed on the mild one): both to a few ulps of |z|.
             let tol = DIRECT_SOLVES_AGREE_ULPS * f64::EPSILON * z_max;

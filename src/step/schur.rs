@@ -3,6 +3,7 @@
 //! the ranking of candidate sets by KKT violation, and the factorisations of `C` with the rows
 //! of each subset of constrained nodes changed (for the direct solves).
 
+use crate::linalg::norms::max_abs;
 use crate::linalg::tridiag::{Ldlt, NotPositiveDefinite, RowChange, SymTridiag, max4};
 
 /// Column `C⁻¹ e_j`, truncated to where it is a normal floating-point number. Shared with the
@@ -127,7 +128,7 @@ pub(crate) fn inverse_columns(factor: &Ldlt, nodes: &[usize]) -> Vec<Column> {
             let end = values.iter().rposition(|v| *v != 0.0).map_or(0, |e| e + 1);
             Column {
                 node,
-                max_abs: values.iter().fold(0.0f64, |m, v| m.max(v.abs())),
+                max_abs: max_abs(&values),
                 values: values.get(start..end).unwrap_or_default().to_vec(),
                 support: start..end,
             }

@@ -15,18 +15,6 @@ pub struct ErrorNorms {
     pub max: f64,
 }
 
-/// `max_i |v_i|`, the ∞-norm (0 for no values).
-pub fn max_abs<'a>(values: impl IntoIterator<Item = &'a f64>) -> f64 {
-    values.into_iter().fold(0.0f64, |m, v| m.max(v.abs()))
-}
-
-/// `max_i |a_i − b_i|`, the ∞-norm distance (over the shorter of the two).
-pub fn max_distance(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
-}
-
 /// `max_i |u_i − t|`: the distance of a rigid translation's displacement from `u = t`.
 pub fn rigid_drift(u: &[f64], t: f64) -> f64 {
     u.iter().fold(0.0f64, |m, v| m.max((v - t).abs()))

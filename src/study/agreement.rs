@@ -9,6 +9,7 @@
 //!
 //! Everything is deterministic (no timings): the same build prints the same numbers.
 
+use crate::linalg::norms::{max_abs, max_distance};
 use crate::linalg::tridiag::{Ldlt, SymTridiag};
 use crate::scene::{self, Scene};
 use crate::step::StepSolver;
@@ -16,7 +17,7 @@ use crate::step::audit::dual_tolerance;
 use crate::step::exact::ExactSolver;
 use crate::step::osqp::{OsqpSettings, OsqpSolver, raw_problem};
 use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
-use crate::study::accuracy::{max_abs, max_distance, observed_order};
+use crate::study::accuracy::observed_order;
 use crate::study::compare::{StepProblem, compare, start_up_problem};
 use crate::time::RunError;
 use crate::time::run::run_in_memory;

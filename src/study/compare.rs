@@ -1,9 +1,10 @@
 //! Two runs of the same discretisation side by side, e.g. one scene with two step solvers:
 //! the largest difference of the displacements over all nodes and steps.
 
+use crate::linalg::norms::{max_abs, max_distance};
 use crate::scene::Scene;
 use crate::scene::SceneError;
-use crate::study::accuracy::{lockstep, max_abs, max_distance};
+use crate::study::accuracy::lockstep;
 use crate::time::RunError;
 use crate::time::run::{Summary, Tracker};
 use crate::time::simulation::{Simulation, StepRecord};

@@ -23,12 +23,13 @@
 //! apart by `ROUNDOFF_ULPS·ε·κ(C)·|u|` per step; the stable scheme carries such a
 //! perturbation forward without growth, so over `N` steps `N` times that ([`roundoff_distance`]).
 
+use crate::linalg::norms::{max_abs, max_distance};
 use crate::scene::Scene;
 use crate::step::audit::{AUDIT_MARGIN, KktAudit, Law, ROUNDOFF_ULPS};
 use crate::step::osqp::OSQP_DEFAULT_EPS;
 use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
 use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
-use crate::study::accuracy::{max_abs, max_distance, rigid_drift};
+use crate::study::accuracy::rigid_drift;
 use crate::time::RunError;
 use crate::time::run::Tracker;
 use crate::time::simulation::{Discretisation, Simulation, make_solver};

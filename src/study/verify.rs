@@ -5,8 +5,9 @@
 
 use crate::bar::closed_form;
 use crate::bar::matrices::{MatrixVariant, mass, stiffness};
+use crate::linalg::norms::max_abs;
 use crate::scene;
-use crate::study::accuracy::{error_against, max_abs, observed_order, rigid_mode_drift};
+use crate::study::accuracy::{error_against, observed_order, rigid_mode_drift};
 use crate::time::RunError;
 use crate::time::run::run_in_memory;
 use std::fmt::Write;

@@ -23,6 +23,7 @@
 pub use crate::bar::discretisation::Discretisation;
 use crate::bar::discretisation::InitialData;
 use crate::bar::matrices;
+use crate::linalg::norms::max_abs;
 use crate::linalg::tridiag::{Ldlt, SymTridiag, Uniform, add_in_place, dot};
 use crate::scene::expr::Expression;
 use crate::scene::{Condition, Scene, SceneError, SolverMethod};
@@ -368,8 +369,7 @@ impl Simulation {
         for (j, c) in self.disc.constraints.iter().enumerate() {
             self.lower[j] = -c.gap - self.u[self.locals[j]];
         }
-        self.solver
-            .set_state_scale(self.u.iter().fold(0.0f64, |m, v| m.max(v.abs())));
+        self.solver.set_state_scale(max_abs(&self.u));
         let info = self
             .solver
             .solve(&self.rhs, &self.lower, &mut self.z, &mut self.reactions)

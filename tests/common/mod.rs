@@ -3,9 +3,9 @@
 
 use proptest::prelude::*;
 use viscobar::Scene;
+use viscobar::linalg::norms::max_abs;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::scene;
-use viscobar::study::accuracy::max_abs;
 use viscobar::study::agreement::{MAX_MARGIN, diagonally_dominant};
 
 // ---- tolerances shared by several test files -----------------------------------------------
