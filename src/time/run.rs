@@ -246,7 +246,8 @@ pub fn run_in_memory(
 
 /// Runs a scene and writes `summary.json`, `history.csv` and `displacement.csv` into `out`.
 /// The files are written into a temporary folder inside `out` and moved into place only when
-/// the run has succeeded, so a failed run leaves earlier results untouched.
+/// the run has succeeded, so a failed run leaves earlier results untouched. `progress` shows a
+/// progress bar on stderr for long runs (with the `progress` feature).
 pub fn run_to_dir(
     name: &str,
     scene: &Scene,
@@ -271,6 +272,55 @@ pub fn run_to_dir(
     });
     let _ = std::fs::remove_dir_all(&tmp);
     outcome
+}
+
+/// Runs below this many node-steps finish in seconds: no progress bar.
+#[cfg(feature = "progress")]
+const PROGRESS_MIN_NODE_STEPS: f64 = 2e8;
+/// The progress bar is moved every this many steps (cheap next to a step of a large run).
+#[cfg(feature = "progress")]
+const PROGRESS_EVERY_STEPS: usize = 1024;
+
+/// A progress bar on stderr for long runs; nothing without the `progress` feature.
+struct Progress {
+    #[cfg(feature = "progress")]
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl Progress {
+    #[cfg_attr(not(feature = "progress"), expect(unused_variables))]
+    fn new(show: bool, steps: usize, nodes: usize) -> Self {
+        #[cfg(feature = "progress")]
+        let bar = (show && steps as f64 * nodes as f64 > PROGRESS_MIN_NODE_STEPS).then(|| {
+            let bar = indicatif::ProgressBar::new(steps as u64);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} steps, eta {eta}")
+                    .expect("static template"),
+            );
+            bar
+        });
+        Self {
+            #[cfg(feature = "progress")]
+            bar,
+        }
+    }
+
+    #[cfg_attr(not(feature = "progress"), expect(unused_variables))]
+    fn step(&self, step: usize) {
+        #[cfg(feature = "progress")]
+        if let Some(b) = &self.bar
+            && step.is_multiple_of(PROGRESS_EVERY_STEPS)
+        {
+            b.set_position(step as u64);
+        }
+    }
+
+    fn finish(self) {
+        #[cfg(feature = "progress")]
+        if let Some(b) = self.bar {
+            b.finish_and_clear();
+        }
+    }
 }
 
 fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Summary, RunError> {
@@ -322,14 +372,7 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
     write_profile(&mut disp, 0.0, disc, &u, &v).map_err(io(&disp_path))?;
     let steps = scene.steps();
     let every = scene.output.every as usize;
-    let bar = (progress && steps as f64 * nodes as f64 > 2e8).then(|| {
-        let bar = indicatif::ProgressBar::new(steps as u64);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} steps, eta {eta}")
-                .expect("static template"),
-        );
-        bar
-    });
+    let bar = Progress::new(progress, steps, nodes);
     let keep = |n: usize| n.is_multiple_of(every) || n == steps;
     if keep(1) {
         sim.displacement_into(&mut u);
@@ -347,15 +390,9 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
             write_profile(&mut disp, sim.time(), sim.discretisation(), &u, &v)
                 .map_err(io(&disp_path))?;
         }
-        if let Some(b) = &bar
-            && r.step.is_multiple_of(1024)
-        {
-            b.set_position(r.step as u64);
-        }
+        bar.step(r.step);
     }
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
+    bar.finish();
     hist.flush().map_err(io(&hist_path))?;
     disp.flush().map_err(io(&disp_path))?;
     let summary = tracker.finish(name, &sim, start.elapsed().as_secs_f64());
