@@ -245,9 +245,11 @@ pub fn run_in_memory(
 }
 
 /// Runs a scene and writes `summary.json`, `history.csv` and `displacement.csv` into `out`.
-/// The files are written into a temporary folder inside `out` and moved into place only when
-/// the run has succeeded, so a failed run leaves earlier results untouched. `progress` shows a
-/// progress bar on stderr for long runs (with the `progress` feature).
+/// The scene is set up (discretised, its initial data evaluated) before anything is created, so
+/// a refused scene leaves no trace on disk. The files are written into a temporary folder
+/// inside `out` and moved into place only when the run has succeeded, so a failed run leaves
+/// earlier results untouched; folders it created for `out` are removed again when it fails.
+/// `progress` shows a progress bar on stderr for long runs (with the `progress` feature).
 pub fn run_to_dir(
     name: &str,
     scene: &Scene,
@@ -258,20 +260,42 @@ pub fn run_to_dir(
         let path = path.to_path_buf();
         move |source| RunError::Write { path, source }
     };
-    std::fs::create_dir_all(out).map_err(write_err(out))?;
-    remove_stale_partials(out);
-    let tmp = out.join(format!(".viscobar-partial-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&tmp);
-    std::fs::create_dir_all(&tmp).map_err(write_err(&tmp))?;
-    let result = write_run(name, scene, &tmp, progress);
-    let outcome = result.and_then(|summary| {
-        for file in ["history.csv", "displacement.csv", "summary.json"] {
-            std::fs::rename(tmp.join(file), out.join(file)).map_err(write_err(&out.join(file)))?;
+    let start = Instant::now();
+    let sim = Simulation::new(scene)?;
+    let created = missing_folders(out);
+    let outcome = (|| {
+        std::fs::create_dir_all(out).map_err(write_err(out))?;
+        remove_stale_partials(out);
+        let tmp = out.join(format!(".viscobar-partial-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&tmp);
+        std::fs::create_dir_all(&tmp).map_err(write_err(&tmp))?;
+        let result = write_run(name, scene, sim, start, &tmp, progress);
+        let outcome = result.and_then(|summary| {
+            for file in ["history.csv", "displacement.csv", "summary.json"] {
+                std::fs::rename(tmp.join(file), out.join(file))
+                    .map_err(write_err(&out.join(file)))?;
+            }
+            Ok(summary)
+        });
+        let _ = std::fs::remove_dir_all(&tmp);
+        outcome
+    })();
+    if outcome.is_err() {
+        // Deepest first; `remove_dir` leaves a folder that is not empty.
+        for folder in &created {
+            let _ = std::fs::remove_dir(folder);
         }
-        Ok(summary)
-    });
-    let _ = std::fs::remove_dir_all(&tmp);
+    }
     outcome
+}
+
+/// `out` and those of its parents that do not exist yet, deepest first.
+fn missing_folders(out: &Path) -> Vec<PathBuf> {
+    out.ancestors()
+        .filter(|p| !p.as_os_str().is_empty())
+        .take_while(|p| !p.exists())
+        .map(Path::to_path_buf)
+        .collect()
 }
 
 /// Runs below this many node-steps finish in seconds: no progress bar.
@@ -323,7 +347,14 @@ impl Progress {
     }
 }
 
-fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Summary, RunError> {
+fn write_run(
+    name: &str,
+    scene: &Scene,
+    mut sim: Simulation,
+    start: Instant,
+    dir: &Path,
+    progress: bool,
+) -> Result<Summary, RunError> {
     let open = |file: &str| -> Result<(PathBuf, std::io::BufWriter<std::fs::File>), RunError> {
         let path = dir.join(file);
         let f = std::fs::File::create(&path).map_err(|source| RunError::Write {
@@ -339,8 +370,6 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
         move |source| RunError::Write { path, source }
     };
 
-    let start = Instant::now();
-    let mut sim = Simulation::new(scene)?;
     let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
     let sides: Vec<&str> = sim
         .discretisation()
