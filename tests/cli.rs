@@ -68,6 +68,80 @@ fn run_writes_summary_history_and_displacement() {
     );
 }
 
+/// `viscobar scenes`: one entry per built-in scene, its name in a column as wide as the longest
+/// name, then the first sentence of its description whole (continuation lines indented to the
+/// description column).
+#[test]
+fn scenes_lists_every_builtin_with_a_whole_first_sentence() {
+    let o = viscobar(&["scenes"]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    let names = viscobar::scene::builtin_names();
+    let longest = names.iter().map(|n| n.len()).max().unwrap();
+    let indent = |line: &str| line.len() - line.trim_start().len();
+    // Entries: a line starting with a name, then its indented continuation lines; every
+    // description line starts in the same column, right of the longest name.
+    let mut entries: Vec<(String, String)> = Vec::new();
+    let mut columns = Vec::new();
+    for line in text.lines() {
+        if line.starts_with(' ') {
+            let (_, description) = entries.last_mut().expect("a name line comes first");
+            columns.push(indent(line));
+            description.push(' ');
+            description.push_str(line.trim());
+        } else {
+            let (name, rest) = line.split_once(' ').expect("name and description");
+            columns.push(name.len() + 1 + indent(rest));
+            entries.push((name.to_string(), rest.trim().to_string()));
+        }
+    }
+    assert!(
+        columns.iter().all(|c| *c == columns[0] && *c > longest),
+        "descriptions not in one column right of the longest name:\n{text}"
+    );
+    let listed: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(listed, names);
+    for (name, description) in &entries {
+        assert!(
+            description.ends_with('.') || description.ends_with(')'),
+            "{name}: description cut mid-sentence: {description:?}"
+        );
+        let full = viscobar::Scene::from_toml(viscobar::scene::builtin_text(name).unwrap(), &[])
+            .unwrap()
+            .description
+            .unwrap();
+        let full = full.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(
+            full.starts_with(description.as_str()),
+            "{name}: not the description's opening: {description:?}"
+        );
+    }
+}
+
+/// The positional arguments a newcomer meets first are described in `--help`.
+#[test]
+fn help_describes_the_scene_arguments() {
+    for (command, argument) in [
+        ("run", "<SCENE>"),
+        ("converge", "<SCENE>"),
+        ("show", "<NAME>"),
+    ] {
+        let o = viscobar(&[command, "--help"]);
+        assert!(o.status.success());
+        let help = String::from_utf8_lossy(&o.stdout);
+        let line = help
+            .lines()
+            .find(|l| l.trim_start().starts_with(argument))
+            .unwrap_or_else(|| panic!("`{command} --help` lists no {argument}: {help}"));
+        assert!(
+            line.contains("viscobar scenes"),
+            "`{command} --help` does not describe {argument}: {help}"
+        );
+    }
+    let run = String::from_utf8_lossy(&viscobar(&["run", "--help"]).stdout).into_owned();
+    assert!(run.contains("TOML scene file"), "{run}");
+}
+
 #[test]
 fn scenes_and_show_list_the_builtins() {
     let o = viscobar(&["scenes"]);
