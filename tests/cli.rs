@@ -194,3 +194,42 @@ fn two_runs_give_byte_identical_outputs() {
     };
     assert_eq!(strip(&a), strip(&b));
 }
+
+/// The crates only the command line, its progress bar and the figures need: optional, so that
+/// a library user depending on viscobar with `default-features = false` builds none of them.
+const OPTIONAL_CRATES: [&str; 5] = ["clap", "indicatif", "plotters", "plotters-svg", "dejavu"];
+
+/// The normal dependencies of the library, as `cargo tree` lists them, with `extra` flags.
+fn dependency_names(extra: &[&str]) -> Vec<String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let manifest = concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.toml");
+    let o = Command::new(cargo)
+        .args([
+            "tree",
+            "--offline",
+            "--manifest-path",
+            manifest,
+            "-p",
+            "viscobar",
+        ])
+        .args(["-e", "normal", "--prefix", "none"])
+        .args(extra)
+        .output()
+        .expect("cargo runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+        .collect()
+}
+
+#[test]
+fn without_default_features_the_library_needs_no_cli_or_plotting_crate() {
+    let full = dependency_names(&[]);
+    let bare = dependency_names(&["--no-default-features"]);
+    for name in OPTIONAL_CRATES {
+        assert!(full.iter().any(|n| n == name), "{name} is not a dependency");
+        assert!(!bare.iter().any(|n| n == name), "{name} is not optional");
+    }
+    assert!(bare.iter().any(|n| n == "nalgebra"), "{bare:?}");
+}
