@@ -21,6 +21,7 @@ enum Command {
     /// Run a scene (built-in name or TOML file) and write summary.json, history.csv and
     /// displacement.csv.
     Run {
+        /// A built-in scene (a name from `viscobar scenes`) or the path of a TOML scene file.
         scene: String,
         /// Output folder [default: out/<scene>].
         #[arg(long)]
@@ -45,6 +46,7 @@ enum Command {
     /// Refinement study of the step solvers (convergence.csv, work-precision.png/.svg), or
     /// with --viscosity-sweep the alpha -> 0 study of the impact scene.
     Converge {
+        /// A built-in scene (a name from `viscobar scenes`) or the path of a TOML scene file.
         scene: String,
         /// Comma-separated solvers: exact, osqp (eps 1e-4, 1e-7, 1e-10), penalty (epsilon 1e-3,
         /// 1e-5, 1e-7).
@@ -66,7 +68,10 @@ enum Command {
     /// List the built-in scenes.
     Scenes,
     /// Print a built-in scene as TOML.
-    Show { name: String },
+    Show {
+        /// A built-in scene's name (as listed by `viscobar scenes`).
+        name: String,
+    },
     /// Recompute the measured figures of VERIFICATION.md and print them as Markdown.
     Verify {
         /// Rewrite the generated blocks of this file in place instead of printing.
@@ -82,14 +87,7 @@ fn main() {
     let cli = Cli::parse();
     let code = match cli.command {
         Command::Scenes => {
-            for (name, text) in scene::BUILTIN {
-                let first = scene::Scene::from_toml(text, &[])
-                    .ok()
-                    .and_then(|s| s.description)
-                    .and_then(|d| d.lines().find(|l| !l.trim().is_empty()).map(str::to_string))
-                    .unwrap_or_default();
-                println!("{name:16} {first}");
-            }
+            print!("{}", scene_list());
             0
         }
         Command::Show { name } => match scene::builtin_text(&name) {
@@ -157,6 +155,71 @@ fn main() {
         }
     };
     std::process::exit(code);
+}
+
+/// Width of the `scenes` listing: the width of the source text and of the help texts.
+const LIST_WIDTH: usize = 100;
+/// Spaces between the name column and the descriptions of the `scenes` listing.
+const LIST_GAP: usize = 2;
+
+/// The `scenes` listing: each built-in name, in a column as wide as the longest, beside the
+/// first sentence of its description, wrapped onto indented continuation lines.
+fn scene_list() -> String {
+    let width = scene::BUILTIN
+        .iter()
+        .map(|(name, _)| name.chars().count())
+        .max()
+        .unwrap_or(0);
+    let indent = width + LIST_GAP;
+    let mut list = String::new();
+    for (name, text) in scene::BUILTIN {
+        let sentence = scene::Scene::from_toml(text, &[])
+            .ok()
+            .and_then(|s| s.description)
+            .map(|d| first_sentence(&d))
+            .unwrap_or_default();
+        let mut line = format!("{name:width$}");
+        let mut empty = true;
+        for word in sentence.split_whitespace() {
+            if !empty && line.chars().count() + 1 + word.chars().count() > LIST_WIDTH {
+                list.push_str(line.trim_end());
+                list.push('\n');
+                line = " ".repeat(indent);
+                empty = true;
+            }
+            if empty {
+                line = format!("{line:indent$}");
+            } else {
+                line.push(' ');
+            }
+            line.push_str(word);
+            empty = false;
+        }
+        list.push_str(line.trim_end());
+        list.push('\n');
+    }
+    list
+}
+
+/// The first sentence of `text`, its lines joined: up to the first `.` outside parentheses
+/// that ends the text or comes before white space (so `0.5` and `f(x). ` inside brackets do
+/// not end it). The whole text when it has no such full stop.
+fn first_sentence(text: &str) -> String {
+    let words: Vec<&str> = text.split_whitespace().collect();
+    let joined = words.join(" ");
+    let mut depth = 0i32;
+    let mut chars = joined.char_indices().peekable();
+    while let Some((i, c)) = chars.next() {
+        match c {
+            '(' | '[' => depth += 1,
+            ')' | ']' => depth -= 1,
+            '.' if depth <= 0 && chars.peek().is_none_or(|(_, n)| n.is_whitespace()) => {
+                return joined[..=i].to_string();
+            }
+            _ => {}
+        }
+    }
+    joined
 }
 
 fn run(name: &str, out: Option<PathBuf>, set: &[String]) -> Result<(), viscobar::RunError> {
@@ -253,5 +316,20 @@ fn verify(update: Option<PathBuf>, stiff: bool) -> i32 {
             eprintln!("error: {e}");
             1
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::first_sentence;
+
+    #[test]
+    fn first_sentence_stops_at_a_full_stop_outside_brackets_before_a_space() {
+        assert_eq!(
+            first_sentence("Gap a0 = 0.1\nbelow (see f. 2) the end. Then more."),
+            "Gap a0 = 0.1 below (see f. 2) the end."
+        );
+        assert_eq!(first_sentence("Ends here."), "Ends here.");
+        assert_eq!(first_sentence("  no full stop "), "no full stop");
     }
 }

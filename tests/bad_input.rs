@@ -217,11 +217,53 @@ fn bad_scenes_exit_2_and_name_the_problem() {
             "{what}: message should contain `{needle}`: {err}"
         );
         assert!(!err.contains("panicked"), "{what}: panic: {err}");
-        assert!(
-            !out.join("summary.json").exists(),
-            "{what}: a result was written"
-        );
+        assert!(!out.exists(), "{what}: the output folder was created");
     }
+}
+
+/// A scene whose initial data cannot be evaluated (NaN on the whole bar) passes the checks of
+/// its TOML and is refused while the run is set up: nothing may be created then, not even an
+/// empty output folder, and no folder above it.
+#[test]
+fn a_scene_refused_during_set_up_creates_nothing() {
+    let dir = fresh_dir("set-up");
+    let scene = dir.join("nan-start.toml");
+    let base = viscobar::scene::builtin_text("impact").unwrap();
+    let text = base.replacen("displacement = \"0\"", "displacement = \"sqrt(x-100)\"", 1);
+    assert_ne!(text, base, "the edit applies");
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.join("results").join("nan-start");
+    let o = viscobar(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("initial.displacement"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!dir.join("results").exists(), "created {}", out.display());
+}
+
+/// A run that fails at a step (exit 1) into a folder that did not exist removes the folders it
+/// created; what was there before stays.
+#[test]
+fn a_failed_run_into_a_new_folder_leaves_no_folder() {
+    let dir = fresh_dir("new-folder");
+    let out = dir.join("a").join("b");
+    let o = viscobar(&[
+        "run",
+        "impact",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "load.density=\"1e300*t*t\"",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(!dir.join("a").exists(), "left {}", dir.join("a").display());
+    assert!(dir.exists());
 }
 
 #[test]

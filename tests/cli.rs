@@ -68,6 +68,80 @@ fn run_writes_summary_history_and_displacement() {
     );
 }
 
+/// `viscobar scenes`: one entry per built-in scene, its name in a column as wide as the longest
+/// name, then the first sentence of its description whole (continuation lines indented to the
+/// description column).
+#[test]
+fn scenes_lists_every_builtin_with_a_whole_first_sentence() {
+    let o = viscobar(&["scenes"]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    let names = viscobar::scene::builtin_names();
+    let longest = names.iter().map(|n| n.len()).max().unwrap();
+    let indent = |line: &str| line.len() - line.trim_start().len();
+    // Entries: a line starting with a name, then its indented continuation lines; every
+    // description line starts in the same column, right of the longest name.
+    let mut entries: Vec<(String, String)> = Vec::new();
+    let mut columns = Vec::new();
+    for line in text.lines() {
+        if line.starts_with(' ') {
+            let (_, description) = entries.last_mut().expect("a name line comes first");
+            columns.push(indent(line));
+            description.push(' ');
+            description.push_str(line.trim());
+        } else {
+            let (name, rest) = line.split_once(' ').expect("name and description");
+            columns.push(name.len() + 1 + indent(rest));
+            entries.push((name.to_string(), rest.trim().to_string()));
+        }
+    }
+    assert!(
+        columns.iter().all(|c| *c == columns[0] && *c > longest),
+        "descriptions not in one column right of the longest name:\n{text}"
+    );
+    let listed: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(listed, names);
+    for (name, description) in &entries {
+        assert!(
+            description.ends_with('.') || description.ends_with(')'),
+            "{name}: description cut mid-sentence: {description:?}"
+        );
+        let full = viscobar::Scene::from_toml(viscobar::scene::builtin_text(name).unwrap(), &[])
+            .unwrap()
+            .description
+            .unwrap();
+        let full = full.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(
+            full.starts_with(description.as_str()),
+            "{name}: not the description's opening: {description:?}"
+        );
+    }
+}
+
+/// The positional arguments a newcomer meets first are described in `--help`.
+#[test]
+fn help_describes_the_scene_arguments() {
+    for (command, argument) in [
+        ("run", "<SCENE>"),
+        ("converge", "<SCENE>"),
+        ("show", "<NAME>"),
+    ] {
+        let o = viscobar(&[command, "--help"]);
+        assert!(o.status.success());
+        let help = String::from_utf8_lossy(&o.stdout);
+        let line = help
+            .lines()
+            .find(|l| l.trim_start().starts_with(argument))
+            .unwrap_or_else(|| panic!("`{command} --help` lists no {argument}: {help}"));
+        assert!(
+            line.contains("viscobar scenes"),
+            "`{command} --help` does not describe {argument}: {help}"
+        );
+    }
+    let run = String::from_utf8_lossy(&viscobar(&["run", "--help"]).stdout).into_owned();
+    assert!(run.contains("TOML scene file"), "{run}");
+}
+
 #[test]
 fn scenes_and_show_list_the_builtins() {
     let o = viscobar(&["scenes"]);
@@ -119,4 +193,43 @@ fn two_runs_give_byte_identical_outputs() {
         v
     };
     assert_eq!(strip(&a), strip(&b));
+}
+
+/// The crates only the command line, its progress bar and the figures need: optional, so that
+/// a library user depending on viscobar with `default-features = false` builds none of them.
+const OPTIONAL_CRATES: [&str; 5] = ["clap", "indicatif", "plotters", "plotters-svg", "dejavu"];
+
+/// The normal dependencies of the library, as `cargo tree` lists them, with `extra` flags.
+fn dependency_names(extra: &[&str]) -> Vec<String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let manifest = concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.toml");
+    let o = Command::new(cargo)
+        .args([
+            "tree",
+            "--offline",
+            "--manifest-path",
+            manifest,
+            "-p",
+            "viscobar",
+        ])
+        .args(["-e", "normal", "--prefix", "none"])
+        .args(extra)
+        .output()
+        .expect("cargo runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
+        .collect()
+}
+
+#[test]
+fn without_default_features_the_library_needs_no_cli_or_plotting_crate() {
+    let full = dependency_names(&[]);
+    let bare = dependency_names(&["--no-default-features"]);
+    for name in OPTIONAL_CRATES {
+        assert!(full.iter().any(|n| n == name), "{name} is not a dependency");
+        assert!(!bare.iter().any(|n| n == name), "{name} is not optional");
+    }
+    assert!(bare.iter().any(|n| n == "nalgebra"), "{bare:?}");
 }

@@ -286,3 +286,83 @@ fn no_system_font_library_is_in_the_dependency_graph() {
         );
     }
 }
+
+/// The work-precision diagram of `viscobar converge` (drawn in `figures`): PNG and SVG, whole,
+/// byte-for-byte reproducible, with the title and one legend entry per line.
+#[test]
+fn work_precision_diagram_is_written_whole_and_reproducibly() {
+    let lines = vec![
+        (
+            "exact".to_string(),
+            vec![(1e-3, 1e-2), (4e-3, 2.5e-3), (1.6e-2, 6.25e-4)],
+        ),
+        (
+            "osqp eps 1e-4".to_string(),
+            vec![(2e-3, 1.1e-2), (9e-3, 3e-3), (4e-2, 1e-3)],
+        ),
+    ];
+    let title = "modal: L2 error against wall time";
+    let mut bytes = Vec::new();
+    for run in ["a", "b"] {
+        let dir = tmpdir(&format!("work-precision-{run}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut files = Vec::new();
+        for ext in ["png", "svg"] {
+            let path = dir.join(format!("work-precision.{ext}"));
+            figures::write_work_precision(&path, title, &lines).unwrap();
+            files.push(std::fs::read(&path).unwrap());
+        }
+        let names: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names.len(), 2, "no temporary file left: {names:?}");
+        bytes.push(files);
+    }
+    assert_eq!(bytes[0], bytes[1], "reproducible");
+    let [png, svg] = &bytes[0][..] else {
+        unreachable!()
+    };
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "PNG signature");
+    let svg = String::from_utf8_lossy(svg);
+    for text in [
+        title,
+        "exact",
+        "osqp eps 1e-4",
+        "wall time of the steps (s)",
+    ] {
+        assert!(svg.contains(text), "SVG lacks {text:?}");
+    }
+}
+
+/// `viscobar converge` writes the table and both diagrams.
+#[test]
+fn converge_writes_the_table_and_the_work_precision_diagrams() {
+    let out = tmpdir("converge");
+    let o = viscobar(&[
+        "converge",
+        "modal",
+        "--solvers",
+        "exact",
+        "--levels",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut names: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "convergence.csv",
+            "work-precision.png",
+            "work-precision.svg"
+        ]
+    );
+    let svg = std::fs::read_to_string(out.join("work-precision.svg")).unwrap();
+    assert!(svg.contains("modal: L2 error against wall time"), "{svg}");
+}

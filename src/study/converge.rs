@@ -544,7 +544,8 @@ impl Study {
         md
     }
 
-    /// Writes `convergence.csv`, `work-precision.png` and `work-precision.svg` into `out`.
+    /// Writes `convergence.csv`, and with the `plots` feature `work-precision.png` and
+    /// `work-precision.svg`, into `out`.
     pub fn write(&self, out: &Path) -> Result<Vec<PathBuf>, ConvergeError> {
         std::fs::create_dir_all(out).map_err(|source| ConvergeError::Write {
             path: out.to_path_buf(),
@@ -555,24 +556,39 @@ impl Study {
             path: csv.clone(),
             source,
         })?;
+        #[cfg_attr(not(feature = "plots"), expect(unused_mut))]
         let mut files = vec![csv];
+        #[cfg(feature = "plots")]
         for ext in ["png", "svg"] {
+            use crate::study::figures::{self, FigureError};
             let path = out.join(format!("work-precision.{ext}"));
-            write_plot(&path, &self.title(), &self.lines())?;
+            figures::write_work_precision(&path, &self.title(), &self.lines()).map_err(
+                |e| match e {
+                    FigureError::Write { path, source } => ConvergeError::Write { path, source },
+                    e => ConvergeError::Draw {
+                        path: path.clone(),
+                        message: match e {
+                            FigureError::Draw { message, .. } => message,
+                            e => e.to_string(),
+                        },
+                    },
+                },
+            )?;
             files.push(path);
         }
         Ok(files)
     }
 
-    fn title(&self) -> String {
+    /// Title of the work-precision diagram.
+    pub fn title(&self) -> String {
         format!(
             "{}: L2 error against wall time (reference: {})",
             self.scene, self.reference
         )
     }
 
-    /// `(label, [(wall time, L2 error)])` per setting.
-    fn lines(&self) -> Vec<(String, Vec<(f64, f64)>)> {
+    /// The lines of the work-precision diagram: `(label, [(wall time, L2 error)])` per setting.
+    pub fn lines(&self) -> Vec<(String, Vec<(f64, f64)>)> {
         settings_of(&self.rows)
             .into_iter()
             .map(|s| {
@@ -586,122 +602,6 @@ impl Study {
             })
             .collect()
     }
-}
-
-/// Line colours, one per setting (exact, then OSQP shades, then penalty shades).
-const COLOURS: [(u8, u8, u8); 7] = [
-    (0, 0, 0),
-    (8, 81, 156),
-    (49, 130, 189),
-    (107, 174, 214),
-    (165, 15, 21),
-    (222, 45, 38),
-    (251, 106, 74),
-];
-/// Size of the work-precision figure (pixels).
-const PLOT_SIZE: (u32, u32) = (900, 640);
-
-/// Draws a log-log diagram and writes it (PNG or SVG, by extension) via a temporary file.
-fn write_plot(
-    path: &Path,
-    title: &str,
-    lines: &[(String, Vec<(f64, f64)>)],
-) -> Result<(), ConvergeError> {
-    use plotters::prelude::*;
-    crate::study::figures::register_font().map_err(|e| ConvergeError::Draw {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })?;
-    let file = path
-        .file_name()
-        .map_or_else(String::new, |f| f.to_string_lossy().into_owned());
-    let tmp = path.with_file_name(format!(".partial-{}-{file}", std::process::id()));
-    let bounds = |f: fn(&(f64, f64)) -> f64| {
-        let vals = lines.iter().flat_map(|l| l.1.iter().map(f));
-        let (lo, hi) = vals.fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
-        (lo / 1.5, hi * 1.5)
-    };
-    let (x0, x1) = bounds(|p| p.0);
-    let (y0, y1) = bounds(|p| p.1);
-    fn draw<DB: DrawingBackend>(
-        root: DrawingArea<DB, plotters::coord::Shift>,
-        title: &str,
-        lines: &[(String, Vec<(f64, f64)>)],
-        (x0, x1, y0, y1): (f64, f64, f64, f64),
-    ) -> Result<(), Box<dyn std::error::Error>>
-    where
-        DB::ErrorType: 'static,
-    {
-        root.fill(&WHITE)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 20))
-            .margin(15)
-            .x_label_area_size(45)
-            .y_label_area_size(75)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
-        chart
-            .configure_mesh()
-            .x_desc("wall time of the steps (s)")
-            .y_desc("L2 error (max over t)")
-            .label_style(("sans-serif", 15))
-            .axis_desc_style(("sans-serif", 17))
-            .x_label_formatter(&|v| format!("{v:.0e}"))
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .draw()?;
-        for (k, (label, pts)) in lines.iter().enumerate() {
-            let (r, g, b) = COLOURS[k % COLOURS.len()];
-            let colour = RGBColor(r, g, b);
-            chart
-                .draw_series(LineSeries::new(pts.iter().copied(), colour.stroke_width(2)))?
-                .label(label.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
-            chart.draw_series(pts.iter().map(|p| Circle::new(*p, 4, colour.filled())))?;
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 15))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()?;
-        root.present()?;
-        Ok(())
-    }
-    let b = (x0, x1, y0, y1);
-    let drawn = if path.extension().is_some_and(|e| e == "svg") {
-        let mut svg = String::new();
-        let r = draw(
-            SVGBackend::with_string(&mut svg, PLOT_SIZE).into_drawing_area(),
-            title,
-            lines,
-            b,
-        );
-        r.and_then(|()| Ok(std::fs::write(&tmp, svg)?))
-    } else {
-        draw(
-            BitMapBackend::new(&tmp, PLOT_SIZE).into_drawing_area(),
-            title,
-            lines,
-            b,
-        )
-    };
-    let result = drawn
-        .map_err(|e| ConvergeError::Draw {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })
-        .and_then(|()| {
-            std::fs::rename(&tmp, path).map_err(|source| ConvergeError::Write {
-                path: path.to_path_buf(),
-                source,
-            })
-        });
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }
 
 /// Viscosities of the `α → 0` sweep: half-decades from 1e-1 down to 1e-6.

@@ -8,6 +8,13 @@
 //! Text is laid out with the embedded DejaVu Sans font through plotters' `ab_glyph` feature, so
 //! no system font library is needed. Every file is written to a temporary name in the output
 //! folder and renamed into place, so it is whole or absent.
+//!
+//! The work-precision diagram of `viscobar converge` is drawn here too
+//! ([`write_work_precision`]).
+//!
+//! Only with the `plots` feature (on by default), which brings plotters and the font.
+
+#![cfg(feature = "plots")]
 
 use crate::scene::{self, Scene};
 use crate::time::RunError;
@@ -395,6 +402,8 @@ type DrawResult = Result<(), Box<dyn std::error::Error>>;
 enum Figure<'a> {
     Scene(&'a SampledRun),
     Pair(&'a str, [&'a SampledRun; 2]),
+    /// A log-log work-precision diagram: its title and one line per solver setting.
+    WorkPrecision(&'a str, &'a [WorkPrecisionLine]),
 }
 
 impl Figure<'_> {
@@ -402,6 +411,7 @@ impl Figure<'_> {
         match self {
             Figure::Scene(_) => SCENE_SIZE,
             Figure::Pair(..) => PAIR_SIZE,
+            Figure::WorkPrecision(..) => WORK_PRECISION_SIZE,
         }
     }
 
@@ -413,6 +423,7 @@ impl Figure<'_> {
         match *self {
             Figure::Scene(run) => draw_scene(root, run)?,
             Figure::Pair(title, runs) => draw_pair(root, title, runs)?,
+            Figure::WorkPrecision(title, lines) => draw_work_precision(root, title, lines)?,
         }
         Ok(root.present()?)
     }
@@ -797,6 +808,85 @@ fn tick(v: f64, decimals: usize) -> String {
 
 /// Colour of the contact set: the dark end of viridis (not a grey, so never text).
 const CONTACT_COLOUR: RGBColor = RGBColor(68, 1, 84);
+
+/// One line of a work-precision diagram: its legend label and its `(wall time, error)` points.
+pub type WorkPrecisionLine = (String, Vec<(f64, f64)>);
+
+/// Line colours of the work-precision diagram, one per setting (exact, then OSQP shades, then
+/// penalty shades).
+const WORK_PRECISION_COLOURS: [(u8, u8, u8); 7] = [
+    (0, 0, 0),
+    (8, 81, 156),
+    (49, 130, 189),
+    (107, 174, 214),
+    (165, 15, 21),
+    (222, 45, 38),
+    (251, 106, 74),
+];
+/// Size of the work-precision figure (pixels).
+const WORK_PRECISION_SIZE: (u32, u32) = (900, 640);
+
+/// Draws the log-log work-precision diagram of `lines` (`viscobar converge`) and writes it as
+/// PNG or SVG (by the extension of `path`), whole or not at all.
+pub fn write_work_precision(
+    path: &Path,
+    title: &str,
+    lines: &[WorkPrecisionLine],
+) -> Result<(), FigureError> {
+    register_font()?;
+    write_figure(path, Figure::WorkPrecision(title, lines))
+}
+
+fn draw_work_precision<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    lines: &[WorkPrecisionLine],
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    let bounds = |f: fn(&(f64, f64)) -> f64| {
+        let vals = lines.iter().flat_map(|l| l.1.iter().map(f));
+        let (lo, hi) = vals.fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        (lo / 1.5, hi * 1.5)
+    };
+    let (x0, x1) = bounds(|p| p.0);
+    let (y0, y1) = bounds(|p| p.1);
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 20))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(75)
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+    chart
+        .configure_mesh()
+        .x_desc("wall time of the steps (s)")
+        .y_desc("L2 error (max over t)")
+        .label_style(("sans-serif", 15))
+        .axis_desc_style(("sans-serif", 17))
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .draw()?;
+    for (k, (label, pts)) in lines.iter().enumerate() {
+        let (r, g, b) = WORK_PRECISION_COLOURS[k % WORK_PRECISION_COLOURS.len()];
+        let colour = RGBColor(r, g, b);
+        chart
+            .draw_series(LineSeries::new(pts.iter().copied(), colour.stroke_width(2)))?
+            .label(label.clone())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+        chart.draw_series(pts.iter().map(|p| Circle::new(*p, 4, colour.filled())))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 15))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()?;
+    Ok(())
+}
 
 #[cfg(test)]
 mod tests {

@@ -245,8 +245,11 @@ pub fn run_in_memory(
 }
 
 /// Runs a scene and writes `summary.json`, `history.csv` and `displacement.csv` into `out`.
-/// The files are written into a temporary folder inside `out` and moved into place only when
-/// the run has succeeded, so a failed run leaves earlier results untouched.
+/// The scene is set up (discretised, its initial data evaluated) before anything is created, so
+/// a refused scene leaves no trace on disk. The files are written into a temporary folder
+/// inside `out` and moved into place only when the run has succeeded, so a failed run leaves
+/// earlier results untouched; folders it created for `out` are removed again when it fails.
+/// `progress` shows a progress bar on stderr for long runs (with the `progress` feature).
 pub fn run_to_dir(
     name: &str,
     scene: &Scene,
@@ -257,23 +260,101 @@ pub fn run_to_dir(
         let path = path.to_path_buf();
         move |source| RunError::Write { path, source }
     };
-    std::fs::create_dir_all(out).map_err(write_err(out))?;
-    remove_stale_partials(out);
-    let tmp = out.join(format!(".viscobar-partial-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&tmp);
-    std::fs::create_dir_all(&tmp).map_err(write_err(&tmp))?;
-    let result = write_run(name, scene, &tmp, progress);
-    let outcome = result.and_then(|summary| {
-        for file in ["history.csv", "displacement.csv", "summary.json"] {
-            std::fs::rename(tmp.join(file), out.join(file)).map_err(write_err(&out.join(file)))?;
+    let start = Instant::now();
+    let sim = Simulation::new(scene)?;
+    let created = missing_folders(out);
+    let outcome = (|| {
+        std::fs::create_dir_all(out).map_err(write_err(out))?;
+        remove_stale_partials(out);
+        let tmp = out.join(format!(".viscobar-partial-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&tmp);
+        std::fs::create_dir_all(&tmp).map_err(write_err(&tmp))?;
+        let result = write_run(name, scene, sim, start, &tmp, progress);
+        let outcome = result.and_then(|summary| {
+            for file in ["history.csv", "displacement.csv", "summary.json"] {
+                std::fs::rename(tmp.join(file), out.join(file))
+                    .map_err(write_err(&out.join(file)))?;
+            }
+            Ok(summary)
+        });
+        let _ = std::fs::remove_dir_all(&tmp);
+        outcome
+    })();
+    if outcome.is_err() {
+        // Deepest first; `remove_dir` leaves a folder that is not empty.
+        for folder in &created {
+            let _ = std::fs::remove_dir(folder);
         }
-        Ok(summary)
-    });
-    let _ = std::fs::remove_dir_all(&tmp);
+    }
     outcome
 }
 
-fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Summary, RunError> {
+/// `out` and those of its parents that do not exist yet, deepest first.
+fn missing_folders(out: &Path) -> Vec<PathBuf> {
+    out.ancestors()
+        .filter(|p| !p.as_os_str().is_empty())
+        .take_while(|p| !p.exists())
+        .map(Path::to_path_buf)
+        .collect()
+}
+
+/// Runs below this many node-steps finish in seconds: no progress bar.
+#[cfg(feature = "progress")]
+const PROGRESS_MIN_NODE_STEPS: f64 = 2e8;
+/// The progress bar is moved every this many steps (cheap next to a step of a large run).
+#[cfg(feature = "progress")]
+const PROGRESS_EVERY_STEPS: usize = 1024;
+
+/// A progress bar on stderr for long runs; nothing without the `progress` feature.
+struct Progress {
+    #[cfg(feature = "progress")]
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl Progress {
+    #[cfg_attr(not(feature = "progress"), expect(unused_variables))]
+    fn new(show: bool, steps: usize, nodes: usize) -> Self {
+        #[cfg(feature = "progress")]
+        let bar = (show && steps as f64 * nodes as f64 > PROGRESS_MIN_NODE_STEPS).then(|| {
+            let bar = indicatif::ProgressBar::new(steps as u64);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} steps, eta {eta}")
+                    .expect("static template"),
+            );
+            bar
+        });
+        Self {
+            #[cfg(feature = "progress")]
+            bar,
+        }
+    }
+
+    #[cfg_attr(not(feature = "progress"), expect(unused_variables))]
+    fn step(&self, step: usize) {
+        #[cfg(feature = "progress")]
+        if let Some(b) = &self.bar
+            && step.is_multiple_of(PROGRESS_EVERY_STEPS)
+        {
+            b.set_position(step as u64);
+        }
+    }
+
+    fn finish(self) {
+        #[cfg(feature = "progress")]
+        if let Some(b) = self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
+
+fn write_run(
+    name: &str,
+    scene: &Scene,
+    mut sim: Simulation,
+    start: Instant,
+    dir: &Path,
+    progress: bool,
+) -> Result<Summary, RunError> {
     let open = |file: &str| -> Result<(PathBuf, std::io::BufWriter<std::fs::File>), RunError> {
         let path = dir.join(file);
         let f = std::fs::File::create(&path).map_err(|source| RunError::Write {
@@ -289,8 +370,6 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
         move |source| RunError::Write { path, source }
     };
 
-    let start = Instant::now();
-    let mut sim = Simulation::new(scene)?;
     let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
     let sides: Vec<&str> = sim
         .discretisation()
@@ -322,14 +401,7 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
     write_profile(&mut disp, 0.0, disc, &u, &v).map_err(io(&disp_path))?;
     let steps = scene.steps();
     let every = scene.output.every as usize;
-    let bar = (progress && steps as f64 * nodes as f64 > 2e8).then(|| {
-        let bar = indicatif::ProgressBar::new(steps as u64);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} steps, eta {eta}")
-                .expect("static template"),
-        );
-        bar
-    });
+    let bar = Progress::new(progress, steps, nodes);
     let keep = |n: usize| n.is_multiple_of(every) || n == steps;
     if keep(1) {
         sim.displacement_into(&mut u);
@@ -347,15 +419,9 @@ fn write_run(name: &str, scene: &Scene, dir: &Path, progress: bool) -> Result<Su
             write_profile(&mut disp, sim.time(), sim.discretisation(), &u, &v)
                 .map_err(io(&disp_path))?;
         }
-        if let Some(b) = &bar
-            && r.step.is_multiple_of(1024)
-        {
-            b.set_position(r.step as u64);
-        }
+        bar.step(r.step);
     }
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
+    bar.finish();
     hist.flush().map_err(io(&hist_path))?;
     disp.flush().map_err(io(&disp_path))?;
     let summary = tracker.finish(name, &sim, start.elapsed().as_secs_f64());
