@@ -93,7 +93,8 @@ fn talk_printed_matrices_are_inconsistent() {
 /// dominant.
 #[test]
 fn factorisation_solves_spd_tridiagonal_systems() {
-    use viscobar::linalg::tridiag::{Ldlt, SymTridiag};
+    use viscobar::linalg::ldlt::Ldlt;
+    use viscobar::linalg::tridiag::SymTridiag;
     // Backward-stable solve with condition number below 1e3 here.
     const SOLVE_TOL: f64 = 1e-12;
     for n in 1..40usize {

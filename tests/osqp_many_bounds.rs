@@ -27,8 +27,9 @@
 mod common;
 
 use proptest::prelude::*;
+use viscobar::linalg::ldlt::Ldlt;
 use viscobar::linalg::norms::{max_abs, max_distance};
-use viscobar::linalg::tridiag::{Ldlt, SymTridiag};
+use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
 use viscobar::step::block_pivot::BlockPivotSolver;

@@ -14,8 +14,9 @@
 //! add one it does not make (stationarity mapped to displacement):
 //! [docs/step-solvers.md](../docs/step-solvers.md#kkt-audit).
 
+use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite};
 use crate::linalg::norms::max_abs;
-use crate::linalg::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
+use crate::linalg::tridiag::SymTridiag;
 use crate::step::report::{AuditReport, StepFailure, Worst};
 
 /// Margin over OSQP's own stopping test: OSQP evaluates its residuals on its scaled copy of the

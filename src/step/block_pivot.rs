@@ -18,8 +18,9 @@
 //! The active set is warm-started from the previous step; when it is empty, the factorisation
 //! of `C` computed once per run is used.
 
+use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite};
 use crate::linalg::norms::max_abs;
-use crate::linalg::tridiag::{Ldlt, NotPositiveDefinite, SymTridiag};
+use crate::linalg::tridiag::SymTridiag;
 use crate::step::{SolveInfo, StepFailure, StepSolver};
 
 /// Block iterations allowed without a decrease of the number of infeasible indices before the

@@ -12,9 +12,9 @@
 //! Warm start on the previous active set and the direct re-solve that guards against
 //! cancellation: [docs/step-solvers.md](../docs/step-solvers.md#exact-solver).
 
-use crate::linalg::tridiag::{
-    Ldlt, NotPositiveDefinite, RowChange, SymTridiag, add_columns_in_place, add_in_place,
-};
+use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite, RowChange};
+use crate::linalg::tridiag::SymTridiag;
+use crate::linalg::update::{add_columns_in_place, add_in_place};
 use crate::step::schur::{
     Column, constraint_rows, factor_each_subset, inverse_columns, least_violating, masked_solve,
     row_product, schur_complement,

@@ -19,7 +19,8 @@
 //! default adapts after a fraction of the set-up *time*), so a run gives the same bits every
 //! time on a given machine and build.
 
-use crate::linalg::tridiag::{NotPositiveDefinite, SymTridiag};
+use crate::linalg::ldlt::NotPositiveDefinite;
+use crate::linalg::tridiag::SymTridiag;
 use crate::step::audit::{INACCURATE_FACTOR, KktAudit, Law};
 use crate::step::{OsqpStatus, SettingsError, SolveInfo, SolverReport, StepFailure, StepSolver};
 use osqp::{CscMatrix, Problem, Settings, Status};

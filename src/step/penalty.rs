@@ -15,7 +15,8 @@
 //! computes the answer by a direct solve on the chosen one; why this is exact and backward
 //! stable: [docs/step-solvers.md](../docs/step-solvers.md#penalty-solver).
 
-use crate::linalg::tridiag::{Ldlt, NotPositiveDefinite, RowChange, SymTridiag};
+use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite, RowChange};
+use crate::linalg::tridiag::SymTridiag;
 use crate::step::audit::{KktAudit, Law};
 use crate::step::schur::{
     Column, constraint_rows, factor_each_subset, inverse_columns, least_violating, masked_solve,

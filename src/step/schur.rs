@@ -3,8 +3,10 @@
 //! the ranking of candidate sets by KKT violation, and the factorisations of `C` with the rows
 //! of each subset of constrained nodes changed (for the direct solves).
 
+use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite, RowChange};
 use crate::linalg::norms::max_abs;
-use crate::linalg::tridiag::{Ldlt, NotPositiveDefinite, RowChange, SymTridiag, max4};
+use crate::linalg::tridiag::SymTridiag;
+use crate::linalg::update::max4;
 
 /// Column `C⁻¹ e_j`, truncated to where it is a normal floating-point number. Shared with the
 /// penalty solver, which uses the same Schur complement.

@@ -46,7 +46,7 @@ pub trait StepSolver {
         reactions: &mut [f64],
     ) -> Result<(SolveInfo, f64), StepFailure> {
         let info = self.solve(rhs, lower, z, reactions)?;
-        Ok((info, crate::linalg::tridiag::add_in_place(u, z)))
+        Ok((info, crate::linalg::update::add_in_place(u, z)))
     }
 
     /// Statistics over all solves so far; `None` for solvers that keep none.

@@ -1,7 +1,8 @@
 //! Error measurement against closed forms, shared by the tests and the CLI studies.
 
 use crate::bar::closed_form::ClosedForm;
-use crate::linalg::tridiag::{Ldlt, SymTridiag};
+use crate::linalg::ldlt::Ldlt;
+use crate::linalg::tridiag::SymTridiag;
 use crate::scene::Scene;
 use crate::time::RunError;
 use crate::time::simulation::{Discretisation, Simulation, StepRecord};

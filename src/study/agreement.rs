@@ -9,8 +9,9 @@
 //!
 //! Everything is deterministic (no timings): the same build prints the same numbers.
 
+use crate::linalg::ldlt::Ldlt;
 use crate::linalg::norms::{max_abs, max_distance};
-use crate::linalg::tridiag::{Ldlt, SymTridiag};
+use crate::linalg::tridiag::SymTridiag;
 use crate::scene::{self, Scene};
 use crate::step::StepSolver;
 use crate::step::audit::dual_tolerance;

@@ -618,7 +618,7 @@ pub fn run_case(case: &Case) -> CaseResult {
 
 /// `(min_j, max_j) (C⁻¹)_jj` over the constrained nodes, one O(n) solve each (at most two).
 fn inverse_diagonal_range(d: &Discretisation) -> Option<(f64, f64)> {
-    let factor = crate::linalg::tridiag::Ldlt::factor(&d.step_matrix).ok()?;
+    let factor = crate::linalg::ldlt::Ldlt::factor(&d.step_matrix).ok()?;
     d.constrained_locals()
         .iter()
         .map(|&j| factor.column_of_inverse(j)[j])

@@ -118,7 +118,7 @@ pub fn solve_study(nodes: &[usize]) -> Vec<SolveCase> {
                 &r,
             );
             let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() + 0.1).collect();
-            let Ok(factor) = crate::linalg::tridiag::Ldlt::factor(&c) else {
+            let Ok(factor) = crate::linalg::ldlt::Ldlt::factor(&c) else {
                 continue;
             };
             let mut x = b.clone();

@@ -23,8 +23,10 @@
 pub use crate::bar::discretisation::Discretisation;
 use crate::bar::discretisation::InitialData;
 use crate::bar::matrices;
+use crate::linalg::ldlt::Ldlt;
 use crate::linalg::norms::max_abs;
-use crate::linalg::tridiag::{Ldlt, SymTridiag, Uniform, add_in_place, dot};
+use crate::linalg::tridiag::{SymTridiag, Uniform, dot};
+use crate::linalg::update::add_in_place;
 use crate::scene::expr::Expression;
 use crate::scene::{Condition, Scene, SceneError, SolverMethod};
 use crate::step::block_pivot::BlockPivotSolver;
