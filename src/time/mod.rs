@@ -3,6 +3,7 @@
 //!
 //! Imports every layer below it: [`crate::linalg`], [`crate::step`], [`crate::scene`], [`crate::bar`].
 
+pub mod clock;
 pub mod energy;
 pub mod error;
 pub mod rhs;

@@ -50,7 +50,7 @@ pub struct Summary {
 }
 
 /// Where the time of the steps goes, as fractions of the timed phases of the sampled steps
-/// (one in [`crate::time::simulation::TIMING_SAMPLE_EVERY`], see [`crate::time::simulation::PhaseTimes`]):
+/// (one in [`crate::time::clock::TIMING_SAMPLE_EVERY`], see [`crate::time::clock::PhaseTimes`]):
 /// `rhs` (load and right-hand side), `solver` (the step solver, including its copy of the
 /// right-hand side, and `u += z`), `diagnostics` (energy balance and contact state).
 /// `stepping` is the sampled phases' share of the wall time (the rest is set-up, start-up and
