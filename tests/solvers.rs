@@ -17,6 +17,7 @@ use viscobar::step::audit::{AUDIT_MARGIN, dual_tolerance};
 use viscobar::step::osqp::OSQP_DEFAULT_EPS;
 use viscobar::step::osqp::{OSQP_INFTY, OsqpSettings, OsqpSolver, raw_problem};
 use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::step::penalty::PenaltySettings;
 use viscobar::step::{StepFailure, StepSolver};
 use viscobar::study::accuracy::observed_order;
 use viscobar::study::agreement::stiff_impact_overrides;
@@ -661,7 +662,10 @@ fn cli_warns_about_accepted_inaccurate_steps() {
 fn penalty_solver_refuses_a_bad_epsilon_without_panicking() {
     let c = SymTridiag::new(vec![2.0, 2.0], vec![-1.0]);
     for eps in [0.0, -1.0, f64::NAN, f64::INFINITY] {
-        assert!(viscobar::step::penalty::PenaltySolver::new(&c, &[0], eps).is_err());
+        assert!(
+            viscobar::step::penalty::PenaltySolver::new(&c, &[0], PenaltySettings { epsilon: eps })
+                .is_err()
+        );
     }
     // A scene built in code, never validated, gets an error naming the field.
     let mut scene = common::builtin("impact", &["solver.method=\"penalty\""]);

@@ -6,6 +6,7 @@
 use crate::scene::SceneError;
 use crate::scene::expr::Expression;
 use crate::step::osqp::OsqpSettings;
+use crate::step::penalty::PenaltySettings;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -208,6 +209,14 @@ pub struct SolverSpec {
 }
 
 impl SolverSpec {
+    /// The penalty settings this spec asks for, the defaults for those not given.
+    pub fn penalty_settings(&self) -> PenaltySettings {
+        let d = PenaltySettings::default();
+        PenaltySettings {
+            epsilon: self.epsilon.unwrap_or(d.epsilon),
+        }
+    }
+
     /// The OSQP settings this spec asks for, OSQP's defaults for those not given.
     pub fn osqp_settings(&self) -> OsqpSettings {
         let d = OsqpSettings::default();
@@ -267,9 +276,7 @@ impl SolverSpec {
         }
         // Given values are checked whatever the method (a foreign one was refused above).
         self.osqp_settings().validate()?;
-        if let Some(e) = self.epsilon {
-            positive("solver.epsilon", e)?;
-        }
+        self.penalty_settings().validate()?;
         Ok(())
     }
 }

@@ -17,6 +17,6 @@ pub mod solver;
 pub use block_pivot::BlockPivotSolver;
 pub use exact::ExactSolver;
 pub use osqp::{OsqpSettings, OsqpSolver};
-pub use penalty::PenaltySolver;
+pub use penalty::{PenaltySettings, PenaltySolver};
 pub use report::{AuditReport, OsqpStatus, SettingsError, SolveInfo, SolverReport, StepFailure};
 pub use solver::StepSolver;

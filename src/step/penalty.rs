@@ -22,19 +22,48 @@ use crate::step::schur::{
     Column, constraint_rows, factor_each_subset, inverse_columns, least_violating, masked_solve,
     row_product, schur_complement,
 };
-use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
+use crate::step::{SettingsError, SolveInfo, SolverReport, StepFailure, StepSolver};
 
 /// ε of the penalised problem unless set: penetration ≈ ε × reaction, so about 1e-6 for the
 /// talk's reactions of order 1.
 pub const PENALTY_DEFAULT_EPSILON: f64 = 1e-6;
+
+/// The penalty solver's settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PenaltySettings {
+    /// ε of (PP) (default [`PENALTY_DEFAULT_EPSILON`]): the compliance, penetration = ε × reaction.
+    pub epsilon: f64,
+}
+
+impl Default for PenaltySettings {
+    fn default() -> Self {
+        Self {
+            epsilon: PENALTY_DEFAULT_EPSILON,
+        }
+    }
+}
+
+impl PenaltySettings {
+    /// Checks every field against its range; the error names the field.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        if !(self.epsilon.is_finite() && self.epsilon > 0.0) {
+            return Err(SettingsError::new(
+                "epsilon",
+                self.epsilon,
+                "must be a finite number > 0",
+            ));
+        }
+        Ok(())
+    }
+}
 
 /// Why the penalty solver could not be set up.
 #[derive(Debug, thiserror::Error)]
 pub enum PenaltySetupError {
     #[error(transparent)]
     Matrix(#[from] NotPositiveDefinite),
-    #[error("epsilon = {0} must be a finite number > 0")]
-    Epsilon(f64),
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
     #[error("the penalty solver handles the two Signorini ends only, not {0} constrained nodes")]
     TooManyBounds(usize),
 }
@@ -64,13 +93,16 @@ pub struct PenaltySolver {
 
 impl PenaltySolver {
     /// Factorises `C`, precomputes `C⁻¹ e_j` for each constrained node (at most two).
-    pub fn new(c: &SymTridiag, nodes: &[usize], epsilon: f64) -> Result<Self, PenaltySetupError> {
+    pub fn new(
+        c: &SymTridiag,
+        nodes: &[usize],
+        settings: PenaltySettings,
+    ) -> Result<Self, PenaltySetupError> {
         if nodes.len() > 2 {
             return Err(PenaltySetupError::TooManyBounds(nodes.len()));
         }
-        if !(epsilon.is_finite() && epsilon > 0.0) {
-            return Err(PenaltySetupError::Epsilon(epsilon));
-        }
+        settings.validate()?;
+        let epsilon = settings.epsilon;
         let factor = Ldlt::factor(c)?;
         let columns = inverse_columns(&factor, nodes);
         let mut matrix = schur_complement(&columns);
@@ -229,7 +261,7 @@ mod tests {
         let ends = [0, n - 1];
         let springs = [(1e4, true), (10.0, true), (0.1, false), (1e-4, false)];
         for (epsilon, from_gap) in springs.map(|(ratio, g)| (ratio / c.diag[0], g)) {
-            let mut solver = PenaltySolver::new(&c, &ends, epsilon).unwrap();
+            let mut solver = PenaltySolver::new(&c, &ends, PenaltySettings { epsilon }).unwrap();
             assert_eq!(solver.from_gap, [from_gap; 2]);
             let (mut z, mut r) = (vec![0.0; n], [0.0; 2]);
             let first = solver.solve(&b, &[0.0, 0.0], &mut z, &mut r).unwrap();

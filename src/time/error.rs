@@ -58,11 +58,7 @@ impl From<PenaltySetupError> for RunError {
     fn from(e: PenaltySetupError) -> Self {
         match e {
             PenaltySetupError::Matrix(m) => RunError::Matrix(m),
-            PenaltySetupError::Epsilon(v) => RunError::Scene(SceneError::Invalid {
-                field: "solver.epsilon".into(),
-                value: v.to_string(),
-                allowed: "must be a finite number > 0".into(),
-            }),
+            PenaltySetupError::Settings(e) => RunError::Scene(e.into()),
             PenaltySetupError::TooManyBounds(k) => RunError::Scene(SceneError::Invalid {
                 field: "solver.method".into(),
                 value: "\"penalty\"".into(),

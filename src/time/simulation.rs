@@ -32,7 +32,6 @@ use crate::scene::{Condition, Scene, SceneError, SolverMethod};
 use crate::step::block_pivot::BlockPivotSolver;
 use crate::step::exact::ExactSolver;
 use crate::step::osqp::OsqpSolver;
-use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
 use crate::step::penalty::PenaltySolver;
 use crate::step::{SolverReport, StepSolver};
 use crate::time::RunError;
@@ -87,7 +86,7 @@ pub fn make_solver(scene: &Scene, disc: &Discretisation) -> Result<Box<dyn StepS
         SolverMethod::Penalty => Ok(Box::new(PenaltySolver::new(
             &disc.step_matrix,
             &nodes,
-            scene.solver.epsilon.unwrap_or(PENALTY_DEFAULT_EPSILON),
+            scene.solver.penalty_settings(),
         )?)),
     }
 }
