@@ -66,7 +66,7 @@ fn with_solver_validates_its_scene() {
 #[test]
 fn osqp_settings_are_validated_by_the_solver() {
     use viscobar::linalg::SymTridiag;
-    use viscobar::step::{OsqpSettings, OsqpSolver, osqp::OsqpSetupError};
+    use viscobar::step::{OsqpSettings, OsqpSolver, SetupError};
     let c = SymTridiag::new(vec![2.0; 4], vec![-1.0; 3]);
     let cases = [
         (
@@ -108,7 +108,7 @@ fn osqp_settings_are_validated_by_the_solver() {
     ];
     for (field, settings) in cases {
         match OsqpSolver::new(&c, &[0], settings) {
-            Err(OsqpSetupError::Settings(e)) => assert_eq!(e.field, field),
+            Err(SetupError::Settings(e)) => assert_eq!(e.field, field),
             Err(other) => panic!("{field}: expected a settings error, got {other}"),
             Ok(_) => panic!("{field}: bad settings accepted"),
         }

@@ -18,5 +18,7 @@ pub use block_pivot::BlockPivotSolver;
 pub use exact::ExactSolver;
 pub use osqp::{OsqpSettings, OsqpSolver};
 pub use penalty::{PenaltySettings, PenaltySolver};
-pub use report::{AuditReport, OsqpStatus, SettingsError, SolveInfo, SolverReport, StepFailure};
+pub use report::{
+    AuditReport, OsqpStatus, SettingsError, SetupError, SolveInfo, SolverReport, StepFailure,
+};
 pub use solver::StepSolver;

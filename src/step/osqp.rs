@@ -19,10 +19,11 @@
 //! default adapts after a fraction of the set-up *time*), so a run gives the same bits every
 //! time on a given machine and build.
 
-use crate::linalg::ldlt::NotPositiveDefinite;
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::audit::{INACCURATE_FACTOR, KktAudit, Law};
-use crate::step::{OsqpStatus, SettingsError, SolveInfo, SolverReport, StepFailure, StepSolver};
+use crate::step::{
+    OsqpStatus, SettingsError, SetupError, SolveInfo, SolverReport, StepFailure, StepSolver,
+};
 use osqp::{CscMatrix, Problem, Settings, Status};
 use std::borrow::Cow;
 
@@ -103,17 +104,6 @@ impl OsqpSettings {
     }
 }
 
-/// Why OSQP could not be set up.
-#[derive(Debug, thiserror::Error)]
-pub enum OsqpSetupError {
-    #[error(transparent)]
-    Matrix(#[from] NotPositiveDefinite),
-    #[error(transparent)]
-    Settings(#[from] SettingsError),
-    #[error("{0}")]
-    Osqp(String),
-}
-
 /// OSQP on the step problem, set up once per run, audited every step.
 pub struct OsqpSolver {
     problem: Problem,
@@ -189,7 +179,7 @@ pub fn raw_problem(
     b: &[f64],
     lower: &[f64],
     settings: OsqpSettings,
-) -> Result<Problem, OsqpSetupError> {
+) -> Result<Problem, SetupError> {
     let q: Vec<f64> = b.iter().map(|v| -v).collect();
     let u = vec![OSQP_INFTY; nodes.len()];
     Problem::new(
@@ -200,7 +190,7 @@ pub fn raw_problem(
         &u,
         &settings.to_osqp(),
     )
-    .map_err(|e| OsqpSetupError::Osqp(e.to_string()))
+    .map_err(|e| SetupError::Osqp(e.to_string()))
 }
 
 /// OSQP's status, as its C library spells it.
@@ -224,12 +214,12 @@ impl OsqpSolver {
         c: &SymTridiag,
         nodes: &[usize],
         settings: OsqpSettings,
-    ) -> Result<Self, OsqpSetupError> {
+    ) -> Result<Self, SetupError> {
         settings.validate()?;
         let n = c.dim();
         let k = nodes.len();
         if let Some(&bad) = nodes.iter().find(|&&j| j >= n) {
-            return Err(OsqpSetupError::Osqp(format!(
+            return Err(SetupError::Osqp(format!(
                 "constrained node {bad} outside 0..{n}"
             )));
         }
@@ -245,7 +235,7 @@ impl OsqpSolver {
             &u,
             &settings.to_osqp(),
         )
-        .map_err(|e| OsqpSetupError::Osqp(e.to_string()))?;
+        .map_err(|e| SetupError::Osqp(e.to_string()))?;
         Ok(Self {
             problem,
             settings,

@@ -15,14 +15,14 @@
 //! computes the answer by a direct solve on the chosen one; why this is exact and backward
 //! stable: [docs/step-solvers.md](../docs/step-solvers.md#penalty-solver).
 
-use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite, RowChange};
+use crate::linalg::ldlt::{Ldlt, RowChange};
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::audit::{KktAudit, Law};
 use crate::step::schur::{
     Column, constraint_rows, factor_each_subset, inverse_columns, least_violating, masked_solve,
     row_product, schur_complement,
 };
-use crate::step::{SettingsError, SolveInfo, SolverReport, StepFailure, StepSolver};
+use crate::step::{SettingsError, SetupError, SolveInfo, SolverReport, StepFailure, StepSolver};
 
 /// ε of the penalised problem unless set: penetration ≈ ε × reaction, so about 1e-6 for the
 /// talk's reactions of order 1.
@@ -57,17 +57,6 @@ impl PenaltySettings {
     }
 }
 
-/// Why the penalty solver could not be set up.
-#[derive(Debug, thiserror::Error)]
-pub enum PenaltySetupError {
-    #[error(transparent)]
-    Matrix(#[from] NotPositiveDefinite),
-    #[error(transparent)]
-    Settings(#[from] SettingsError),
-    #[error("the penalty solver handles the two Signorini ends only, not {0} constrained nodes")]
-    TooManyBounds(usize),
-}
-
 /// Normal compliance with parameter `ε`, solved exactly per step, audited every step.
 #[derive(Clone, Debug)]
 pub struct PenaltySolver {
@@ -97,9 +86,12 @@ impl PenaltySolver {
         c: &SymTridiag,
         nodes: &[usize],
         settings: PenaltySettings,
-    ) -> Result<Self, PenaltySetupError> {
+    ) -> Result<Self, SetupError> {
         if nodes.len() > 2 {
-            return Err(PenaltySetupError::TooManyBounds(nodes.len()));
+            return Err(SetupError::TooManyBounds {
+                solver: "penalty",
+                nodes: nodes.len(),
+            });
         }
         settings.validate()?;
         let epsilon = settings.epsilon;

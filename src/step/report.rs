@@ -2,6 +2,7 @@
 //! no trustworthy answer ([`StepFailure`]), and its run-level statistics ([`SolverReport`],
 //! with the worst residuals of the independent audit, [`AuditReport`]).
 
+use crate::linalg::NotPositiveDefinite;
 use serde::Serialize;
 
 /// OSQP's status when it is not "solved" (OSQP 0.6, `constants.h`); "solved inaccurate" is
@@ -138,6 +139,26 @@ pub struct AuditReport {
     pub stationarity: Worst,
     /// `‖C⁻¹(Cz − b − Σ r_j e_j)‖_∞`, displacement.
     pub stationarity_displacement: Worst,
+}
+
+/// Why a step solver could not be set up: bad input, as opposed to a [`StepFailure`] during a
+/// run.
+#[derive(Debug, thiserror::Error)]
+pub enum SetupError {
+    /// The step matrix is not numerically positive definite.
+    #[error(transparent)]
+    Matrix(#[from] NotPositiveDefinite),
+    /// A setting outside its range.
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
+    /// More constrained nodes than the solver handles (the penalty solver: the two ends).
+    #[error(
+        "the {solver} solver handles the two Signorini ends only, not {nodes} constrained nodes"
+    )]
+    TooManyBounds { solver: &'static str, nodes: usize },
+    /// OSQP refused the problem; its own message.
+    #[error("{0}")]
+    Osqp(String),
 }
 
 /// A solver setting outside its range, named by its key in the scene's `[solver]` table

@@ -3,9 +3,8 @@
 
 use crate::linalg::NotPositiveDefinite;
 use crate::scene::SceneError;
+use crate::step::SetupError;
 use crate::step::StepFailure;
-use crate::step::osqp::OsqpSetupError;
-use crate::step::penalty::PenaltySetupError;
 use std::path::PathBuf;
 
 /// A run that started but could not finish.
@@ -41,30 +40,21 @@ impl RunError {
     }
 }
 
-impl From<OsqpSetupError> for RunError {
-    fn from(e: OsqpSetupError) -> Self {
+impl From<SetupError> for RunError {
+    fn from(e: SetupError) -> Self {
         match e {
-            OsqpSetupError::Matrix(m) => RunError::Matrix(m),
-            OsqpSetupError::Settings(e) => RunError::Scene(e.into()),
-            OsqpSetupError::Osqp(reason) => RunError::SolverSetup {
+            SetupError::Matrix(m) => RunError::Matrix(m),
+            SetupError::Settings(e) => RunError::Scene(e.into()),
+            SetupError::Osqp(reason) => RunError::SolverSetup {
                 solver: "osqp".into(),
                 reason,
             },
-        }
-    }
-}
-
-impl From<PenaltySetupError> for RunError {
-    fn from(e: PenaltySetupError) -> Self {
-        match e {
-            PenaltySetupError::Matrix(m) => RunError::Matrix(m),
-            PenaltySetupError::Settings(e) => RunError::Scene(e.into()),
-            PenaltySetupError::TooManyBounds(k) => RunError::Scene(SceneError::Invalid {
+            SetupError::TooManyBounds { solver, nodes } => RunError::Scene(SceneError::Invalid {
                 field: "solver.method".into(),
-                value: "\"penalty\"".into(),
+                value: format!("\"{solver}\""),
                 allowed: format!(
-                    "the penalty solver handles the two Signorini ends only; this scene constrains \
-                     {k} nodes (use exact or osqp for an obstacle)"
+                    "the {solver} solver handles the two Signorini ends only; this scene constrains \
+                     {nodes} nodes (use exact or osqp for an obstacle)"
                 ),
             }),
         }
