@@ -9,6 +9,74 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+/// Times in the outputs: `t = n·Δt` rounded to [`TIME_DIGITS`] significant digits, so that
+/// `3.0300000000000002` reads `3.03`; the exact value stays `step · dt`.
+pub const TIME_DIGITS: usize = 12;
+
+/// `t` rounded to [`TIME_DIGITS`] significant digits (see there): the double nearest to the
+/// decimal `t` rounds to, as parsing its 12-digit text would give.
+pub fn output_time(t: f64) -> f64 {
+    if t == 0.0 || !t.is_finite() {
+        return t;
+    }
+    // Fast path: `round(t·10^k) / 10^k` with `10^k` exact (k <= 22) and the integer below
+    // 2^53 is one correctly rounded division, the parse of the 12-digit text.
+    let k = TIME_DIGITS as i32 - 1 - t.abs().log10().floor() as i32;
+    if (0..=22).contains(&k) {
+        let scale = 10f64.powi(k);
+        let digits = (t * scale).round();
+        if digits.abs() < 1e15 {
+            return digits / scale;
+        }
+    }
+    format!("{:.*e}", TIME_DIGITS - 1, t)
+        .parse()
+        .expect("a formatted float parses")
+}
+
+fn serialize_time<S: serde::Serializer>(t: &f64, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64(output_time(*t))
+}
+
+fn serialize_intervals<S: serde::Serializer>(
+    m: &std::collections::BTreeMap<String, Vec<[f64; 2]>>,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    let rounded: std::collections::BTreeMap<&String, Vec<[f64; 2]>> = m
+        .iter()
+        .map(|(k, v)| (k, v.iter().map(|i| i.map(output_time)).collect()))
+        .collect();
+    serde::Serialize::serialize(&rounded, s)
+}
+
+/// One contact episode: the steps from the first with the end (or any obstacle node) in
+/// contact to the last, contact meaning a gap at most [`CONTACT_GAP_TOL`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ContactEpisode {
+    /// `t` of the first step in contact.
+    #[serde(serialize_with = "serialize_time")]
+    pub start: f64,
+    /// `t` of the last step in contact (the end of the run when `open_at_end`).
+    #[serde(serialize_with = "serialize_time")]
+    pub end: f64,
+    /// Still in contact at the end of the run.
+    pub open_at_end: bool,
+    /// `max r^{n+1}` over the episode (force; at an end its reaction, for the obstacle the sum
+    /// over its nodes).
+    pub peak_reaction: f64,
+    /// `Σ Δt r^{n+1}` over the episode: the momentum the obstacle gives the bar (exactly, in
+    /// the scheme: `R` has zero row sums when no end is clamped).
+    pub impulse: f64,
+    /// `Σ −½ r^{n+1}·(u^{n+1} − u^{n−1})` over the episode, the contact term of the energy
+    /// identity (energy); `null` when a step of the episode was not measured.
+    pub contact_dissipation: Option<f64>,
+    /// `E^{n−1/2}` before the first step in contact; `null` when contact starts at the
+    /// start-up step or that energy was not measured.
+    pub energy_before: Option<f64>,
+    /// `E^{n+1/2}` after the last step in contact; `null` when not measured.
+    pub energy_after: Option<f64>,
+}
+
 /// Summary statistics of a run, as written to `summary.json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
@@ -18,6 +86,7 @@ pub struct Summary {
     pub elements: usize,
     pub dt: f64,
     pub steps: usize,
+    #[serde(serialize_with = "serialize_time")]
     pub final_time: f64,
     pub wall_time_s: f64,
     pub ns_per_node_step: f64,
@@ -37,8 +106,13 @@ pub struct Summary {
     pub max_violation: f64,
     /// Most negative reaction (0 when none is negative).
     pub min_reaction: f64,
-    /// `[start, end]` time intervals of contact per constrained end.
+    /// `[start, end]` time intervals of contact per constrained end (the episodes' start and
+    /// end).
+    #[serde(serialize_with = "serialize_intervals")]
     pub contact_intervals: std::collections::BTreeMap<String, Vec<[f64; 2]>>,
+    /// The contact episodes per Signorini end, and for a distributed obstacle one list for the
+    /// whole contact set (`obstacle`: an episode lasts while any node is in contact).
+    pub contact_episodes: std::collections::BTreeMap<String, Vec<ContactEpisode>>,
     pub solver_iterations: Iterations,
     /// Worst optimality residuals of the solver's answers, for solvers that audit them
     /// (`osqp`, `penalty`; see `viscobar::step::audit`).
@@ -104,8 +178,11 @@ pub struct Tracker {
     max_comp: f64,
     max_violation: f64,
     min_reaction: f64,
-    intervals: Vec<Vec<[f64; 2]>>,
+    episodes: Vec<Vec<ContactEpisode>>,
     in_contact: Vec<bool>,
+    dt: f64,
+    /// `E` of the last record, when it was measured.
+    last_energy: Option<f64>,
     iterations_sum: u64,
     iterations_max: u32,
     records: usize,
@@ -141,13 +218,16 @@ impl Tracker {
             max_comp: 0.0,
             max_violation: 0.0,
             min_reaction: 0.0,
-            intervals: vec![Vec::new(); k],
+            episodes: vec![Vec::new(); k],
             in_contact: vec![false; k],
+            dt: sim.discretisation().dt,
+            last_energy: None,
             iterations_sum: 0,
             iterations_max: 0,
             records: 0,
         };
         t.observe_contact(&first);
+        t.last_energy = Some(first.energy);
         t
     }
 
@@ -165,6 +245,7 @@ impl Tracker {
         self.iterations_max = self.iterations_max.max(r.iterations);
         self.records += 1;
         self.observe_contact(r);
+        self.last_energy = r.measured.then_some(r.energy);
     }
 
     fn observe_contact(&mut self, r: &StepRecord) {
@@ -177,10 +258,31 @@ impl Tracker {
             } else {
                 r.contact_nodes > 0
             };
-            match (contact, self.in_contact[j]) {
-                (true, false) => self.intervals[j].push([r.time, r.time]),
-                (true, true) => self.intervals[j].last_mut().expect("open interval")[1] = r.time,
-                _ => {}
+            let (reaction, dissipation) = if j < self.ends {
+                (r.reaction[j], r.end_contact_dissipation[j])
+            } else {
+                (r.total_reaction, r.contact_dissipation)
+            };
+            let measured = r.measured.then_some(dissipation);
+            let energy = r.measured.then_some(r.energy);
+            if contact && !self.in_contact[j] {
+                self.episodes[j].push(ContactEpisode {
+                    start: r.time,
+                    end: r.time,
+                    open_at_end: false,
+                    peak_reaction: reaction,
+                    impulse: self.dt * reaction,
+                    contact_dissipation: measured,
+                    energy_before: if r.step > 1 { self.last_energy } else { None },
+                    energy_after: energy,
+                });
+            } else if contact {
+                let e = self.episodes[j].last_mut().expect("an open episode");
+                e.end = r.time;
+                e.peak_reaction = e.peak_reaction.max(reaction);
+                e.impulse += self.dt * reaction;
+                e.contact_dissipation = e.contact_dissipation.zip(measured).map(|(a, b)| a + b);
+                e.energy_after = energy;
             }
             self.in_contact[j] = contact;
         }
@@ -213,7 +315,28 @@ impl Tracker {
                 .sides
                 .iter()
                 .cloned()
-                .zip(self.intervals.iter().cloned())
+                .zip(
+                    self.episodes
+                        .iter()
+                        .map(|e| e.iter().map(|e| [e.start, e.end]).collect()),
+                )
+                .collect(),
+            contact_episodes: self
+                .sides
+                .iter()
+                .cloned()
+                .zip(
+                    self.episodes
+                        .iter()
+                        .zip(&self.in_contact)
+                        .map(|(e, &open)| {
+                            let mut e = e.clone();
+                            if let Some(last) = e.last_mut().filter(|_| open) {
+                                last.open_at_end = true;
+                            }
+                            e
+                        }),
+                )
                 .collect(),
             solver_iterations: Iterations {
                 mean: self.iterations_sum as f64 / self.records.max(1) as f64,
@@ -442,7 +565,7 @@ fn write_history_row(
             w,
             "{},{},{},{},{},{},{}",
             r.step,
-            r.time,
+            output_time(r.time),
             r.energy,
             r.work,
             r.viscous_dissipation,
@@ -451,7 +574,7 @@ fn write_history_row(
         )?;
     } else {
         // Not measured ([output] diagnostics_every): empty cells, not zeros.
-        write!(w, "{},{},,,,,", r.step, r.time)?;
+        write!(w, "{},{},,,,,", r.step, output_time(r.time))?;
     }
     for j in 0..k {
         write!(w, ",{},{}", r.gap[j], r.reaction[j])?;
@@ -478,8 +601,9 @@ fn write_profile(
     u: &[f64],
     v: &[f64],
 ) -> std::io::Result<()> {
+    let t = output_time(t);
     for i in 0..u.len() {
-        writeln!(w, "{t},{},{},{}", disc.x(i), u[i], v[i])?;
+        writeln!(w, "{t},{},{},{}", output_time(disc.x(i)), u[i], v[i])?;
     }
     Ok(())
 }

@@ -115,6 +115,11 @@ pub struct StepRecord {
     pub gap: [f64; 2],
     /// `r^{n+1}_j` at each Signorini end.
     pub reaction: [f64; 2],
+    /// `−½ r^{n+1}_j (u^{n+1}_j − u^{n−1}_j)` at each Signorini end: its share of
+    /// `contact_dissipation` (0 when not measured).
+    pub end_contact_dissipation: [f64; 2],
+    /// `Σ_j r^{n+1}_j` over all constrained nodes: the total contact force.
+    pub total_reaction: f64,
     /// Over all constrained nodes (ends and obstacle): the least gap, the least reaction and
     /// the largest `|gap · reaction|`.
     pub min_gap: f64,
@@ -478,8 +483,15 @@ impl Simulation {
         };
         let work = 0.5 * sums.work;
         let mut contact = 0.0;
+        let mut end = 0;
         for (j, &l) in self.locals.iter().enumerate() {
-            contact -= 0.5 * self.reactions[j] * (self.z[l] + self.w[l]);
+            // `+= −½ r δ` has the bits of `−= ½ r δ` (negation is exact).
+            let share = -0.5 * self.reactions[j] * (self.z[l] + self.w[l]);
+            contact += share;
+            if self.disc.constraints[j].side.is_some() {
+                record.end_contact_dissipation[end] = share;
+                end += 1;
+            }
         }
         let residual = energy - self.energy - work + viscous + contact;
         let scale = [energy, self.energy, work.abs(), viscous, contact.abs()]
@@ -512,6 +524,7 @@ impl Simulation {
         let (mut min_gap, mut min_reaction, mut max_comp) = (f64::INFINITY, f64::INFINITY, 0.0f64);
         let (mut count, mut lo, mut hi) = (0, f64::NAN, f64::NAN);
         let mut end = 0;
+        let mut total = 0.0;
         for (j, c) in self.disc.constraints.iter().enumerate() {
             let gap = self.u[self.locals[j]] + c.gap;
             let reaction = self.reactions[j];
@@ -520,6 +533,7 @@ impl Simulation {
                 record.reaction[end] = reaction;
                 end += 1;
             }
+            total += reaction;
             min_gap = min_gap.min(gap);
             min_reaction = min_reaction.min(reaction);
             max_comp = max_comp.max((gap * reaction).abs());
@@ -540,6 +554,7 @@ impl Simulation {
         record.max_complementarity = max_comp;
         record.contact_nodes = count;
         record.contact_extent = [lo, hi];
+        record.total_reaction = total;
     }
 
     /// `u^n_j + a_j` at every constrained node, in the order of `constraints`.
