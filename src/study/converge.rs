@@ -560,10 +560,10 @@ impl Study {
         let mut files = vec![csv];
         #[cfg(feature = "plots")]
         for ext in ["png", "svg"] {
-            use crate::study::figures::{self, FigureError};
+            use crate::study::figure_writer::FigureError;
             let path = out.join(format!("work-precision.{ext}"));
-            figures::write_work_precision(&path, &self.title(), &self.lines()).map_err(
-                |e| match e {
+            crate::study::work_precision::write_work_precision(&path, &self.title(), &self.lines())
+                .map_err(|e| match e {
                     FigureError::Write { path, source } => ConvergeError::Write { path, source },
                     e => ConvergeError::Draw {
                         path: path.clone(),
@@ -572,8 +572,7 @@ impl Study {
                             e => e.to_string(),
                         },
                     },
-                },
-            )?;
+                })?;
             files.push(path);
         }
         Ok(files)
