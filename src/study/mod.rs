@@ -13,4 +13,5 @@ pub mod figures;
 pub mod sampled_run;
 pub mod stiff;
 pub mod verify;
+pub mod viscosity_sweep;
 pub mod work_precision;

@@ -330,8 +330,12 @@ pub const SWEEP_ELEMENTS: [u64; 2] = [800, 1600];
 
 fn viscosity_section() -> Result<Section, crate::study::converge::ConvergeError> {
     let (_, base) = scene::load("impact", &[])?;
-    let sweep =
-        crate::study::converge::viscosity_sweep("impact", &base, &SWEEP_ALPHAS, &SWEEP_ELEMENTS)?;
+    let sweep = crate::study::viscosity_sweep::viscosity_sweep(
+        "impact",
+        &base,
+        &SWEEP_ALPHAS,
+        &SWEEP_ELEMENTS,
+    )?;
     Ok(Section {
         id: "viscosity",
         markdown: sweep.markdown(),
