@@ -12,6 +12,7 @@ pub mod figure_writer;
 pub mod figures;
 pub mod sampled_run;
 pub mod stiff;
+pub mod stiff_runs;
 pub mod verify;
 pub mod viscosity_sweep;
 pub mod work_precision;

@@ -347,6 +347,6 @@ fn viscosity_section() -> Result<Section, crate::study::converge::ConvergeError>
 pub fn stiff_section(size: crate::study::stiff::Size) -> Section {
     Section {
         id: "stiff",
-        markdown: crate::study::stiff::markdown(&crate::study::stiff::run_all(size)),
+        markdown: crate::study::stiff::markdown(&crate::study::stiff_runs::run_all(size)),
     }
 }
