@@ -260,16 +260,16 @@ fn converge(
     out: Option<PathBuf>,
     viscosity_sweep: bool,
 ) -> Result<(), viscobar::study::converge::ConvergeError> {
-    use viscobar::study::converge;
+    use viscobar::study::{converge, viscosity_sweep as sweep};
     let settings = converge::parse_solvers(solvers)?;
     let (scene_name, scene) = scene::load(name, &[])?;
     let out = out.unwrap_or_else(|| PathBuf::from("out").join(format!("converge-{scene_name}")));
     let files = if viscosity_sweep {
-        let sweep = converge::viscosity_sweep(
+        let sweep = sweep::viscosity_sweep(
             &scene_name,
             &scene,
-            &converge::SWEEP_ALPHAS,
-            &converge::SWEEP_ELEMENTS,
+            &sweep::SWEEP_ALPHAS,
+            &sweep::SWEEP_ELEMENTS,
         )?;
         print!("{}", sweep.markdown());
         sweep.write(&out)?

@@ -9,6 +9,7 @@
 mod common;
 use common::{KINK_ORDER_BAND, MODAL_ORDER, MODAL_ORDER_TOL};
 use viscobar::study::converge::{self, SolverSetting};
+use viscobar::study::viscosity_sweep::viscosity_sweep;
 
 /// OSQP does ~50 ADMM iterations per step where the exact solver does one factorised solve
 /// and an enumeration; measured ~40x, required 3x so that a loaded test machine still passes.
@@ -80,7 +81,7 @@ fn exact_solver_beats_tight_osqp_at_equal_error_on_a_talk_scene() {
 #[test]
 fn viscous_impact_approaches_the_elastic_one_like_sqrt_alpha() {
     let base = common::builtin("impact", &[]);
-    let sweep = converge::viscosity_sweep("impact", &base, &SWEEP_ALPHAS, &SWEEP_ELEMENTS).unwrap();
+    let sweep = viscosity_sweep("impact", &base, &SWEEP_ALPHAS, &SWEEP_ELEMENTS).unwrap();
     let [(_, p_closed, _, p_energy)] = sweep.exponents()[..] else {
         panic!("one mesh")
     };
@@ -103,7 +104,7 @@ fn bad_input_is_an_error_not_a_panic() {
     assert_eq!(e.exit_code(), 2);
     let e = converge::study("modal", &base, &[SolverSetting::Exact], 2, Some(-1.0)).unwrap_err();
     assert_eq!(e.exit_code(), 2);
-    let e = converge::viscosity_sweep("modal", &base, &SWEEP_ALPHAS, &SWEEP_ELEMENTS).unwrap_err();
+    let e = viscosity_sweep("modal", &base, &SWEEP_ALPHAS, &SWEEP_ELEMENTS).unwrap_err();
     assert_eq!(e.exit_code(), 2);
 }
 

@@ -7,7 +7,8 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use viscobar::Simulation;
-use viscobar::study::figures::{self, Sampling, TALK_FIGURES};
+use viscobar::study::figures::{self, TALK_FIGURES};
+use viscobar::study::sampled_run::{self, Sampling};
 
 fn viscobar(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_viscobar"))
@@ -30,7 +31,7 @@ fn sampled_run_holds_the_runs_mesh_values_and_peak_reactions() {
         x_stride: 7,
         t_stride: 30,
     };
-    let run = figures::sample_run("both-ends", &scene, sampling).unwrap();
+    let run = sampled_run::sample_run("both-ends", &scene, sampling).unwrap();
     let nodes: Vec<usize> = (0..=399).step_by(7).chain([400]).collect();
     let steps: Vec<usize> = (0..=390).step_by(30).chain([400]).collect();
     assert_eq!(run.nodes, nodes);
@@ -287,8 +288,8 @@ fn no_system_font_library_is_in_the_dependency_graph() {
     }
 }
 
-/// The work-precision diagram of `viscobar converge` (drawn in `figures`): PNG and SVG, whole,
-/// byte-for-byte reproducible, with the title and one legend entry per line.
+/// The work-precision diagram of `viscobar converge` (drawn in `study::work_precision`): PNG and
+/// SVG, whole, byte-for-byte reproducible, with the title and one legend entry per line.
 #[test]
 fn work_precision_diagram_is_written_whole_and_reproducibly() {
     let lines = vec![
@@ -309,7 +310,7 @@ fn work_precision_diagram_is_written_whole_and_reproducibly() {
         let mut files = Vec::new();
         for ext in ["png", "svg"] {
             let path = dir.join(format!("work-precision.{ext}"));
-            figures::write_work_precision(&path, title, &lines).unwrap();
+            viscobar::study::work_precision::write_work_precision(&path, title, &lines).unwrap();
             files.push(std::fs::read(&path).unwrap());
         }
         let names: Vec<String> = std::fs::read_dir(&dir)

@@ -24,7 +24,8 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use viscobar::linalg::norms::max_abs;
-use viscobar::study::figures::{self, Sampling};
+use viscobar::study::figures;
+use viscobar::study::sampled_run::{self, Sampling};
 
 mod common;
 
@@ -96,7 +97,7 @@ fn snapshot_of(name: &str) -> Snapshot {
             scene.steps()
         )
     });
-    let run = figures::sample_run(name, &scene, sampling).expect("talk scene runs");
+    let run = sampled_run::sample_run(name, &scene, sampling).expect("talk scene runs");
     let u_scale = max_abs(&run.u);
     let e_scale = max_abs(run.energy.iter().flatten());
     let t_scale = run.final_time();

@@ -1,26 +1,19 @@
-//! The talk's figures: each talk scene is run once, `u` and the contact history are sampled on
-//! a bounded grid while stepping, and the samples are drawn with plotters as PNG and SVG.
+//! The talk's figures: each talk scene is run once and sampled while stepping
+//! (`study::sampled_run`), and the samples are drawn with plotters as PNG and SVG
+//! (`study::figure_writer` writes each file whole or not at all).
 //!
 //! Per scene (`<scene>.png`, `<scene>.svg`): the displacement `u(x, t)` as a colour map with a
 //! colour bar, beside the contact history. Per talk figure (`figure-<k>.png/.svg`): the `l = 0`
 //! scene beside the forced one, as the talk lays them out.
 //!
-//! Text is laid out with the embedded DejaVu Sans font through plotters' `ab_glyph` feature, so
-//! no system font library is needed. Every file is written to a temporary name in the output
-//! folder and renamed into place, so it is whole or absent.
-//!
-//! The work-precision diagram of `viscobar converge` is drawn here too
-//! ([`write_work_precision`]).
-//!
 //! Only with the `plots` feature (on by default), which brings plotters and the font.
 
 #![cfg(feature = "plots")]
 
-use crate::scene::{self, Scene};
+use crate::scene;
+use crate::study::figure_writer::{DrawResult, Drawing, FigureError, register_font, write_figure};
+use crate::study::sampled_run::{ContactHistory, SampledRun, Sampling, sample_run};
 use crate::time::RunError;
-use crate::time::run::{Summary, Tracker};
-use crate::time::simulation::CONTACT_GAP_TOL;
-use crate::time::simulation::{Simulation, StepRecord};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::element::Polygon;
@@ -58,11 +51,6 @@ pub fn talk_scenes() -> impl Iterator<Item = &'static str> {
 /// Default output folder of `viscobar figures`.
 pub const DEFAULT_OUT: &str = "out/figures";
 
-/// At most this many x-intervals of `u` are kept (a 400-element mesh is kept node for node;
-/// more nodes than plot pixels would add memory, not detail).
-pub const MAX_X_INTERVALS: usize = 400;
-/// At most this many t-intervals are kept: about one per pixel row of the colour map.
-pub const MAX_T_INTERVALS: usize = 600;
 /// One line per constraint is legible up to this many constraints (the two ends); beyond it the
 /// contact panel draws the contact set over `(x, t)` instead.
 pub const MAX_REACTION_LINES: usize = 2;
@@ -71,99 +59,6 @@ pub const MAX_REACTION_LINES: usize = 2;
 pub const SCENE_SIZE: (u32, u32) = (1200, 500);
 /// Size of a two-panel talk figure.
 pub const PAIR_SIZE: (u32, u32) = (1200, 900);
-
-/// Which mesh points are kept: every `x_stride`-th node and every `t_stride`-th step, plus the
-/// last node and the last step.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Sampling {
-    pub x_stride: usize,
-    pub t_stride: usize,
-}
-
-impl Sampling {
-    /// The figures' sampling: the finest with at most [`MAX_X_INTERVALS`] by
-    /// [`MAX_T_INTERVALS`] intervals.
-    pub fn for_figure(scene: &Scene) -> Self {
-        Self {
-            x_stride: scene.elements().div_ceil(MAX_X_INTERVALS).max(1),
-            t_stride: scene.steps().div_ceil(MAX_T_INTERVALS).max(1),
-        }
-    }
-
-    /// Exactly `x_points` nodes by `t_points` steps, all of them mesh points (so no
-    /// interpolation), or `None` when the mesh does not contain such a grid.
-    pub fn exact(scene: &Scene, x_points: usize, t_points: usize) -> Option<Self> {
-        let (elements, steps) = (scene.elements(), scene.steps());
-        let (xi, ti) = (x_points.checked_sub(1)?, t_points.checked_sub(1)?);
-        (xi > 0 && ti > 0 && elements % xi == 0 && steps % ti == 0).then(|| Self {
-            x_stride: elements / xi,
-            t_stride: steps / ti,
-        })
-    }
-}
-
-/// Indices `0, stride, 2·stride, …` up to `last`, with `last` always included.
-fn strided(last: usize, stride: usize) -> Vec<usize> {
-    let mut v: Vec<usize> = (0..=last).step_by(stride.max(1)).collect();
-    if v.last() != Some(&last) {
-        v.push(last);
-    }
-    v
-}
-
-/// The contact history of a run, per time bin and per constraint, in a form that does not
-/// depend on how many constraints there are (two ends, or one per node for a distributed
-/// obstacle). Bin `k` covers the steps after the previous sampled step up to its own.
-#[derive(Clone, Debug, Default)]
-pub struct ContactHistory {
-    /// One per constraint: a name (`left`, `right`, ...) and the node's `x`.
-    pub names: Vec<String>,
-    pub xs: Vec<f64>,
-    /// The time of the last step of each bin.
-    pub times: Vec<f64>,
-    /// Largest reaction in each bin, `reaction[bin * constraints + j]` (peaks of short impacts
-    /// are kept, not sampled away).
-    pub reaction: Vec<f64>,
-    /// Smallest gap `u + a` in each bin, same layout.
-    pub gap: Vec<f64>,
-}
-
-impl ContactHistory {
-    pub fn new(names: Vec<String>, xs: Vec<f64>) -> Self {
-        Self {
-            names,
-            xs,
-            ..Default::default()
-        }
-    }
-
-    pub fn constraints(&self) -> usize {
-        self.names.len()
-    }
-
-    /// Takes one step's contact data (`gaps[j]`, `reactions[j]` per constraint); `new_bin`
-    /// starts the next bin.
-    pub fn observe(&mut self, t: f64, gaps: &[f64], reactions: &[f64], new_bin: bool) {
-        let k = self.constraints();
-        if new_bin || self.times.is_empty() {
-            self.times.push(t);
-            self.reaction.extend_from_slice(&reactions[..k]);
-            self.gap.extend_from_slice(&gaps[..k]);
-            return;
-        }
-        *self.times.last_mut().expect("a bin is open") = t;
-        let start = self.reaction.len() - k;
-        for j in 0..k {
-            self.reaction[start + j] = self.reaction[start + j].max(reactions[j]);
-            self.gap[start + j] = self.gap[start + j].min(gaps[j]);
-        }
-    }
-
-    /// Whether constraint `j` touched its obstacle during bin `bin`.
-    pub fn in_contact(&self, bin: usize, j: usize) -> bool {
-        self.gap[bin * self.constraints() + j] <= CONTACT_GAP_TOL
-    }
-}
 
 /// What the second panel shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -182,172 +77,6 @@ impl ContactPanel {
             Self::ContactSet
         }
     }
-}
-
-/// A run reduced to what the figures and the snapshots need.
-#[derive(Clone, Debug)]
-pub struct SampledRun {
-    pub name: String,
-    pub solver: String,
-    pub alpha: f64,
-    pub length: f64,
-    pub elements: usize,
-    pub dt: f64,
-    pub steps: usize,
-    /// The load density as written in the scene, `None` for `l = 0`.
-    pub load: Option<String>,
-    /// Sampled nodes and their `x`.
-    pub nodes: Vec<usize>,
-    pub xs: Vec<f64>,
-    /// Sampled steps and their `t`.
-    pub steps_sampled: Vec<usize>,
-    pub ts: Vec<f64>,
-    /// `u[k * xs.len() + i]` = `u` at node `nodes[i]` after step `steps_sampled[k]`.
-    pub u: Vec<f64>,
-    /// `E^{n−1/2}` recorded by sampled step `n` (`None` for `n = 0`, which has no record).
-    pub energy: Vec<Option<f64>>,
-    /// Binned like `steps_sampled` (bin `k` ends at sampled step `k + 1`).
-    pub contact: ContactHistory,
-    pub summary: Summary,
-}
-
-impl SampledRun {
-    /// Row `k` of the sampled displacement.
-    pub fn u_row(&self, k: usize) -> &[f64] {
-        &self.u[k * self.xs.len()..(k + 1) * self.xs.len()]
-    }
-
-    /// `l = 0` or `l = <expression>`.
-    pub fn load_label(&self) -> String {
-        format!("l = {}", self.load.as_deref().unwrap_or("0"))
-    }
-
-    /// The line naming the discretisation and the solver.
-    pub fn parameters_label(&self) -> String {
-        format!(
-            "α = {}, J = {} ({} elements), Δt = {}, solver: {}",
-            self.alpha,
-            self.elements.saturating_sub(1),
-            self.elements,
-            self.dt,
-            self.solver
-        )
-    }
-
-    pub fn final_time(&self) -> f64 {
-        self.ts.last().copied().unwrap_or(0.0)
-    }
-}
-
-/// Runs `scene`, keeping `u` at the sampled mesh points, the energy at the sampled steps and
-/// the contact history binned between them. Memory is that of the samples, not of the run.
-pub fn sample_run(name: &str, scene: &Scene, sampling: Sampling) -> Result<SampledRun, RunError> {
-    let mut sim = Simulation::new(scene)?;
-    let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
-    let disc = sim.discretisation();
-    let nodes = strided(disc.nodes - 1, sampling.x_stride);
-    let xs: Vec<f64> = nodes.iter().map(|&i| disc.x(i)).collect();
-    let steps = scene.steps();
-    let steps_sampled = strided(steps, sampling.t_stride);
-    let ts: Vec<f64> = steps_sampled.iter().map(|&n| n as f64 * disc.dt).collect();
-    let mut contact = ContactHistory::new(
-        disc.constraints
-            .iter()
-            .map(|c| {
-                c.side.map_or_else(
-                    || format!("x = {:.3}", disc.x(c.node)),
-                    |s| s.name().to_string(),
-                )
-            })
-            .collect(),
-        disc.constraints.iter().map(|c| disc.x(c.node)).collect(),
-    );
-    let mut full = vec![0.0; disc.nodes];
-    let mut gaps = vec![0.0; disc.constraints.len()];
-    let mut u = Vec::with_capacity(nodes.len() * steps_sampled.len());
-    let mut energy = Vec::with_capacity(steps_sampled.len());
-    let keep = |full: &[f64], u: &mut Vec<f64>| u.extend(nodes.iter().map(|&i| full[i]));
-    keep(&sim.initial_state().0, &mut u);
-    energy.push(None);
-    let mut next = 1; // index into steps_sampled of the next step to keep
-    let mut observe = |sim: &Simulation, r: &StepRecord, u: &mut Vec<f64>, energy: &mut Vec<_>| {
-        let k = contact.constraints();
-        let new_bin = r.step == steps_sampled[next - 1] + 1; // the previous bin closed
-        // Per-constraint contact data come from the simulation (a step record keeps only the
-        // ends and aggregates).
-        sim.constraint_gaps_into(&mut gaps[..k]);
-        contact.observe(r.time, &gaps[..k], &sim.reactions()[..k], new_bin);
-        if steps_sampled.get(next) == Some(&r.step) {
-            sim.displacement_into(&mut full);
-            keep(&full, u);
-            energy.push(Some(r.energy));
-            next += 1;
-        }
-    };
-    let first = sim.first_record();
-    observe(&sim, &first, &mut u, &mut energy);
-    let start = std::time::Instant::now();
-    for _ in 1..steps {
-        let r = sim.step()?;
-        tracker.observe(&r);
-        observe(&sim, &r, &mut u, &mut energy);
-    }
-    let summary = tracker.finish(name, &sim, start.elapsed().as_secs_f64());
-    Ok(SampledRun {
-        name: name.to_string(),
-        solver: sim.solver_name().to_string(),
-        alpha: scene.bar.viscosity,
-        length: scene.bar.length,
-        elements: scene.elements(),
-        dt: scene.time.step,
-        steps,
-        load: scene.load.density.clone(),
-        nodes,
-        xs,
-        steps_sampled,
-        ts,
-        u,
-        energy,
-        contact,
-        summary,
-    })
-}
-
-/// Why `viscobar figures` failed.
-#[derive(Debug, thiserror::Error)]
-pub enum FigureError {
-    #[error("scene `{scene}`: {source}")]
-    Run { scene: String, source: RunError },
-    #[error("cannot draw {path}: {message}")]
-    Draw { path: PathBuf, message: String },
-    #[error("cannot write {path}: {source}")]
-    Write {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-    #[error("cannot load the embedded font")]
-    Font,
-}
-
-impl FigureError {
-    /// Process exit code, as for `run`: 2 for bad input, 1 for a failure during the run.
-    pub fn exit_code(&self) -> i32 {
-        match self {
-            FigureError::Run { source, .. } => source.exit_code(),
-            _ => 1,
-        }
-    }
-}
-
-/// Registers DejaVu Sans as plotters' "sans-serif"; without it every text fails with
-/// `FontUnavailable`.
-pub fn register_font() -> Result<(), FigureError> {
-    static REGISTERED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    let ok = *REGISTERED.get_or_init(|| {
-        plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
-            .is_ok()
-    });
-    ok.then_some(()).ok_or(FigureError::Font)
 }
 
 /// Runs the talk scenes (with `overrides`, e.g. the solver) and writes every figure into `out`.
@@ -379,7 +108,7 @@ pub fn write_talk_figures(out: &Path, overrides: &[String]) -> Result<Vec<PathBu
     for run in &runs {
         for ext in ["png", "svg"] {
             let path = out.join(format!("{}.{ext}", run.name));
-            write_figure(&path, Figure::Scene(run))?;
+            write_figure(&path, &TalkFigure::Scene(run))?;
             written.push(path);
         }
     }
@@ -388,83 +117,37 @@ pub fn write_talk_figures(out: &Path, overrides: &[String]) -> Result<Vec<PathBu
         let title = format!("Figure {}: {caption}", k + 1);
         for ext in ["png", "svg"] {
             let path = out.join(format!("{stem}.{ext}"));
-            write_figure(&path, Figure::Pair(&title, pair))?;
+            write_figure(&path, &TalkFigure::Pair(&title, pair))?;
             written.push(path);
         }
     }
     Ok(written)
 }
 
-type DrawResult = Result<(), Box<dyn std::error::Error>>;
-
 /// A figure to draw: one scene, or a talk figure (its title and its two scenes).
 #[derive(Clone, Copy)]
-enum Figure<'a> {
+enum TalkFigure<'a> {
     Scene(&'a SampledRun),
     Pair(&'a str, [&'a SampledRun; 2]),
-    /// A log-log work-precision diagram: its title and one line per solver setting.
-    WorkPrecision(&'a str, &'a [WorkPrecisionLine]),
 }
 
-impl Figure<'_> {
+impl Drawing for TalkFigure<'_> {
     fn size(&self) -> (u32, u32) {
         match self {
-            Figure::Scene(_) => SCENE_SIZE,
-            Figure::Pair(..) => PAIR_SIZE,
-            Figure::WorkPrecision(..) => WORK_PRECISION_SIZE,
+            TalkFigure::Scene(_) => SCENE_SIZE,
+            TalkFigure::Pair(..) => PAIR_SIZE,
         }
     }
 
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
     where
         DB::ErrorType: 'static,
     {
-        root.fill(&WHITE)?;
         match *self {
-            Figure::Scene(run) => draw_scene(root, run)?,
-            Figure::Pair(title, runs) => draw_pair(root, title, runs)?,
-            Figure::WorkPrecision(title, lines) => draw_work_precision(root, title, lines)?,
+            TalkFigure::Scene(run) => draw_scene(root, run),
+            TalkFigure::Pair(title, runs) => draw_pair(root, title, runs),
         }
-        Ok(root.present()?)
     }
-}
-
-/// Draws `fig` as PNG or SVG (by the extension of `path`) and writes it via a temporary file in
-/// the same folder, renamed into place only when complete.
-fn write_figure(path: &Path, fig: Figure) -> Result<(), FigureError> {
-    let file = path
-        .file_name()
-        .map_or_else(String::new, |f| f.to_string_lossy().into_owned());
-    // The bitmap backend picks the encoder from the extension, so the temporary name keeps it.
-    let tmp = path.with_file_name(format!(".partial-{}-{file}", std::process::id()));
-    let draw_err = |e: Box<dyn std::error::Error>| FigureError::Draw {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    };
-    let write_err = |source| FigureError::Write {
-        path: path.to_path_buf(),
-        source,
-    };
-    let result = if path.extension().is_some_and(|e| e == "svg") {
-        let mut svg = String::new();
-        let drawn = {
-            let root = SVGBackend::with_string(&mut svg, fig.size()).into_drawing_area();
-            fig.draw(&root)
-        };
-        // plotters-svg 0.3.7 writes the invalid MIME type `data:png` for embedded bitmaps.
-        drawn.map_err(draw_err).and_then(|()| {
-            let svg = svg.replace("\"data:png;base64,", "\"data:image/png;base64,");
-            std::fs::write(&tmp, svg).map_err(write_err)
-        })
-    } else {
-        let root = BitMapBackend::new(&tmp, fig.size()).into_drawing_area();
-        fig.draw(&root).map_err(draw_err)
-    };
-    let result = result.and_then(|()| std::fs::rename(&tmp, path).map_err(write_err));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }
 
 /// Font sizes (pixels): figure title, panel title, axis names, tick labels, legend.
@@ -808,85 +491,6 @@ fn tick(v: f64, decimals: usize) -> String {
 
 /// Colour of the contact set: the dark end of viridis (not a grey, so never text).
 const CONTACT_COLOUR: RGBColor = RGBColor(68, 1, 84);
-
-/// One line of a work-precision diagram: its legend label and its `(wall time, error)` points.
-pub type WorkPrecisionLine = (String, Vec<(f64, f64)>);
-
-/// Line colours of the work-precision diagram, one per setting (exact, then OSQP shades, then
-/// penalty shades).
-const WORK_PRECISION_COLOURS: [(u8, u8, u8); 7] = [
-    (0, 0, 0),
-    (8, 81, 156),
-    (49, 130, 189),
-    (107, 174, 214),
-    (165, 15, 21),
-    (222, 45, 38),
-    (251, 106, 74),
-];
-/// Size of the work-precision figure (pixels).
-const WORK_PRECISION_SIZE: (u32, u32) = (900, 640);
-
-/// Draws the log-log work-precision diagram of `lines` (`viscobar converge`) and writes it as
-/// PNG or SVG (by the extension of `path`), whole or not at all.
-pub fn write_work_precision(
-    path: &Path,
-    title: &str,
-    lines: &[WorkPrecisionLine],
-) -> Result<(), FigureError> {
-    register_font()?;
-    write_figure(path, Figure::WorkPrecision(title, lines))
-}
-
-fn draw_work_precision<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    title: &str,
-    lines: &[WorkPrecisionLine],
-) -> DrawResult
-where
-    DB::ErrorType: 'static,
-{
-    let bounds = |f: fn(&(f64, f64)) -> f64| {
-        let vals = lines.iter().flat_map(|l| l.1.iter().map(f));
-        let (lo, hi) = vals.fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
-        (lo / 1.5, hi * 1.5)
-    };
-    let (x0, x1) = bounds(|p| p.0);
-    let (y0, y1) = bounds(|p| p.1);
-    let mut chart = ChartBuilder::on(root)
-        .caption(title, ("sans-serif", 20))
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(75)
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
-    chart
-        .configure_mesh()
-        .x_desc("wall time of the steps (s)")
-        .y_desc("L2 error (max over t)")
-        .label_style(("sans-serif", 15))
-        .axis_desc_style(("sans-serif", 17))
-        .x_label_formatter(&|v| format!("{v:.0e}"))
-        .y_label_formatter(&|v| format!("{v:.0e}"))
-        .draw()?;
-    for (k, (label, pts)) in lines.iter().enumerate() {
-        let (r, g, b) = WORK_PRECISION_COLOURS[k % WORK_PRECISION_COLOURS.len()];
-        let colour = RGBColor(r, g, b);
-        chart
-            .draw_series(LineSeries::new(pts.iter().copied(), colour.stroke_width(2)))?
-            .label(label.clone())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-            });
-        chart.draw_series(pts.iter().map(|p| Circle::new(*p, 4, colour.filled())))?;
-    }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 15))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()?;
-    Ok(())
-}
 
 #[cfg(test)]
 mod tests {

@@ -330,8 +330,12 @@ pub const SWEEP_ELEMENTS: [u64; 2] = [800, 1600];
 
 fn viscosity_section() -> Result<Section, crate::study::converge::ConvergeError> {
     let (_, base) = scene::load("impact", &[])?;
-    let sweep =
-        crate::study::converge::viscosity_sweep("impact", &base, &SWEEP_ALPHAS, &SWEEP_ELEMENTS)?;
+    let sweep = crate::study::viscosity_sweep::viscosity_sweep(
+        "impact",
+        &base,
+        &SWEEP_ALPHAS,
+        &SWEEP_ELEMENTS,
+    )?;
     Ok(Section {
         id: "viscosity",
         markdown: sweep.markdown(),
@@ -343,6 +347,6 @@ fn viscosity_section() -> Result<Section, crate::study::converge::ConvergeError>
 pub fn stiff_section(size: crate::study::stiff::Size) -> Section {
     Section {
         id: "stiff",
-        markdown: crate::study::stiff::markdown(&crate::study::stiff::run_all(size)),
+        markdown: crate::study::stiff::markdown(&crate::study::stiff_runs::run_all(size)),
     }
 }

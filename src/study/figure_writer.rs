@@ -1,0 +1,111 @@
+//! Writing a figure as PNG or SVG, whole or absent: every file is drawn to a temporary name in
+//! the output folder and renamed into place, and the SVG backend's embedded-bitmap MIME type is
+//! corrected. Text is laid out with the embedded DejaVu Sans font through plotters' `ab_glyph`
+//! feature, so no system font library is needed.
+//!
+//! Shared by the talk's figures (`study::figures`) and the work-precision diagram
+//! (`study::work_precision`). Only with the `plots` feature.
+
+#![cfg(feature = "plots")]
+
+use crate::time::RunError;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Why a figure could not be made: a scene of `viscobar figures` failed, or drawing, writing or
+/// the font did.
+#[derive(Debug, thiserror::Error)]
+pub enum FigureError {
+    #[error("scene `{scene}`: {source}")]
+    Run { scene: String, source: RunError },
+    #[error("cannot draw {path}: {message}")]
+    Draw { path: PathBuf, message: String },
+    #[error("cannot write {path}: {source}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("cannot load the embedded font")]
+    Font,
+}
+
+impl FigureError {
+    /// Process exit code, as for `run`: 2 for bad input, 1 for a failure during the run.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            FigureError::Run { source, .. } => source.exit_code(),
+            _ => 1,
+        }
+    }
+}
+
+/// Registers DejaVu Sans as plotters' "sans-serif"; without it every text fails with
+/// `FontUnavailable`.
+pub fn register_font() -> Result<(), FigureError> {
+    static REGISTERED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let ok = *REGISTERED.get_or_init(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
+            .is_ok()
+    });
+    ok.then_some(()).ok_or(FigureError::Font)
+}
+
+pub(crate) type DrawResult = Result<(), Box<dyn std::error::Error>>;
+
+/// A figure to draw: its size in pixels and its drawing on a white page.
+pub(crate) trait Drawing {
+    fn size(&self) -> (u32, u32);
+
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
+    where
+        DB::ErrorType: 'static;
+}
+
+/// Fills `root` white, draws `fig` on it and presents it.
+fn render<DB: DrawingBackend>(fig: &impl Drawing, root: &DrawingArea<DB, Shift>) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    fig.draw_on(root)?;
+    Ok(root.present()?)
+}
+
+/// Draws `fig` as PNG or SVG (by the extension of `path`) and writes it via a temporary file in
+/// the same folder, renamed into place only when complete.
+pub(crate) fn write_figure(path: &Path, fig: &impl Drawing) -> Result<(), FigureError> {
+    let file = path
+        .file_name()
+        .map_or_else(String::new, |f| f.to_string_lossy().into_owned());
+    // The bitmap backend picks the encoder from the extension, so the temporary name keeps it.
+    let tmp = path.with_file_name(format!(".partial-{}-{file}", std::process::id()));
+    let draw_err = |e: Box<dyn std::error::Error>| FigureError::Draw {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let write_err = |source| FigureError::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    let result = if path.extension().is_some_and(|e| e == "svg") {
+        let mut svg = String::new();
+        let drawn = {
+            let root = SVGBackend::with_string(&mut svg, fig.size()).into_drawing_area();
+            render(fig, &root)
+        };
+        // plotters-svg 0.3.7 writes the invalid MIME type `data:png` for embedded bitmaps.
+        drawn.map_err(draw_err).and_then(|()| {
+            let svg = svg.replace("\"data:png;base64,", "\"data:image/png;base64,");
+            std::fs::write(&tmp, svg).map_err(write_err)
+        })
+    } else {
+        let root = BitMapBackend::new(&tmp, fig.size()).into_drawing_area();
+        render(fig, &root).map_err(draw_err)
+    };
+    let result = result.and_then(|()| std::fs::rename(&tmp, path).map_err(write_err));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
