@@ -7,7 +7,7 @@ mod common;
 use common::{IDENTITY_TOL, KINK_ORDER_BAND, builtin};
 use viscobar::bar::matrices::{MatrixVariant, mass};
 use viscobar::study::accuracy::observed_order;
-use viscobar::time::run::{ContactEpisode, TIME_DIGITS, output_time};
+use viscobar::time::summary::{ContactEpisode, TIME_DIGITS, output_time};
 use viscobar::{Summary, run_in_memory};
 
 /// The release time's error on the coarsest mesh here (Δx = 0.01) is 0.02; a margin of a

@@ -298,7 +298,7 @@ fn step_failure(
     result: Result<
         (
             Vec<viscobar::time::simulation::StepRecord>,
-            viscobar::time::run::Summary,
+            viscobar::time::summary::Summary,
             Simulation,
         ),
         RunError,

@@ -48,7 +48,7 @@ fn with_method(m: &str, extra: &[String]) -> Vec<String> {
 /// The audit report of an OSQP or penalty run (both always audit).
 fn audit_of<'a>(
     name: &str,
-    s: &'a crate::time::run::Summary,
+    s: &'a crate::time::summary::Summary,
 ) -> Result<&'a crate::step::AuditReport, RunError> {
     s.audit.as_ref().ok_or_else(|| RunError::SolverSetup {
         solver: s.solver.clone(),

@@ -6,8 +6,8 @@ use crate::scene::Scene;
 use crate::scene::SceneError;
 use crate::study::accuracy::lockstep;
 use crate::time::RunError;
-use crate::time::run::{Summary, Tracker};
 use crate::time::simulation::{Simulation, StepRecord};
+use crate::time::summary::{Summary, Tracker};
 
 /// How far run `b` is from run `a`, over every step `u^1 … u^N` and every node.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

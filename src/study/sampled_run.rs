@@ -9,9 +9,9 @@
 
 use crate::scene::Scene;
 use crate::time::RunError;
-use crate::time::run::{Summary, Tracker};
 use crate::time::simulation::CONTACT_GAP_TOL;
 use crate::time::simulation::{Simulation, StepRecord};
+use crate::time::summary::{Summary, Tracker};
 
 /// At most this many x-intervals of `u` are kept (a 400-element mesh is kept node for node;
 /// more nodes than plot pixels would add memory, not detail).

@@ -13,8 +13,8 @@ use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
 use crate::study::accuracy::rigid_drift;
 use crate::study::stiff::{Case, CaseResult, Family, Size, SolverRun, cases};
 use crate::time::RunError;
-use crate::time::run::Tracker;
 use crate::time::simulation::{Discretisation, Simulation, make_solver};
+use crate::time::summary::Tracker;
 use rayon::prelude::*;
 
 /// The exact solver with the KKT audit at round-off floors recorded after every step (not

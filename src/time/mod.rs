@@ -9,7 +9,9 @@ pub mod error;
 pub mod rhs;
 pub mod run;
 pub mod simulation;
+pub mod summary;
 
 pub use error::RunError;
-pub use run::{Summary, run_in_memory, run_to_dir};
+pub use run::{run_in_memory, run_to_dir};
 pub use simulation::{Simulation, StepRecord};
+pub use summary::{ContactEpisode, Summary, Tracker};
