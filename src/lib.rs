@@ -70,4 +70,6 @@ pub mod time;
 
 pub use scene::{Scene, SceneError, SolverMethod};
 pub use step::{StepFailure, StepSolver};
-pub use time::{RunError, Simulation, StepRecord, Summary, run_in_memory, run_to_dir};
+pub use time::{
+    ContactEpisode, RunError, Simulation, StepRecord, Summary, run_in_memory, run_to_dir,
+};

@@ -243,6 +243,9 @@ fn run(name: &str, out: Option<PathBuf>, set: &[String]) -> Result<(), viscobar:
         summary.max_identity_residual,
         out.display()
     );
+    for (side, episodes) in &summary.contact_episodes {
+        println!("  {side}: {}", episode_line(episodes));
+    }
     if let Some(n) = summary.inaccurate_steps.filter(|n| *n > 0) {
         eprintln!(
             "warning: {n} steps accepted although OSQP reported `solved inaccurate` \
@@ -332,4 +335,38 @@ mod tests {
         assert_eq!(first_sentence("Ends here."), "Ends here.");
         assert_eq!(first_sentence("  no full stop "), "no full stop");
     }
+}
+
+/// The contact episodes of one end (or of the obstacle) in one line: when, impulse and the
+/// energy the contact term took (the same episodes as `summary.json` and the figures).
+fn episode_line(episodes: &[viscobar::ContactEpisode]) -> String {
+    use viscobar::time::summary::output_time;
+    if episodes.is_empty() {
+        return "no contact".into();
+    }
+    let each: Vec<String> = episodes
+        .iter()
+        .map(|e| {
+            let end = if e.open_at_end {
+                format!("{} (open at the end)", output_time(e.end))
+            } else {
+                output_time(e.end).to_string()
+            };
+            let lost = e
+                .contact_dissipation
+                .map_or_else(|| "not measured".into(), |d| format!("{d:.3e}"));
+            format!(
+                "[{}, {end}] impulse {:.4} peak reaction {:.4} contact dissipation {lost}",
+                output_time(e.start),
+                e.impulse,
+                e.peak_reaction
+            )
+        })
+        .collect();
+    let n = episodes.len();
+    format!(
+        "{n} contact episode{}: {}",
+        if n == 1 { "" } else { "s" },
+        each.join("; ")
+    )
 }

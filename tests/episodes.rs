@@ -146,3 +146,34 @@ fn output_times_are_the_twelve_digit_decimals() {
     }
     assert_eq!(output_time(3.0300000000000002), 3.03);
 }
+
+/// The command line's closing lines name the same episodes as `summary.json`.
+#[test]
+fn run_prints_the_episodes_of_the_summary() {
+    let out = std::env::temp_dir().join(format!("viscobar-episodes-{}", std::process::id()));
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_viscobar"))
+        .args(["run", "falling-bar", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let episodes = summary["contact_episodes"]["left"].as_array().unwrap();
+    let line = stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("left:"))
+        .unwrap_or_else(|| panic!("no episode line in {stdout}"));
+    assert!(
+        line.contains(&format!("{} contact episodes", episodes.len())),
+        "{line}"
+    );
+    for e in episodes {
+        let time = |k: &str| e[k].as_f64().unwrap();
+        let when = format!("[{}, {}]", time("start"), time("end"));
+        assert!(line.contains(&when), "{when} not in {line}");
+        assert!(line.contains(&format!("impulse {:.4}", e["impulse"].as_f64().unwrap())));
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}

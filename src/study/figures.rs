@@ -165,6 +165,9 @@ const COLOUR_BAR_WIDTH: u32 = 115;
 const MAP_COLUMN_WIDTH: u32 = 680;
 /// Share of a talk figure's column height given to the colour map (the rest: contact panel).
 const MAP_HEIGHT_PERCENT: u32 = 62;
+/// Opacity of the contact episodes' shading behind the reactions: light enough that the
+/// reaction fills and lines stay readable over it.
+const EPISODE_OPACITY: f64 = 0.12;
 /// Line colours of the contact panel, one per constraint.
 const LINE_COLOURS: [RGBColor; 2] = [RGBColor(31, 119, 180), RGBColor(214, 39, 40)];
 
@@ -362,22 +365,24 @@ where
     DB::ErrorType: 'static,
 {
     match ContactPanel::for_history(&run.contact) {
-        ContactPanel::Reactions => draw_reactions(area, &run.contact, run.final_time()),
+        ContactPanel::Reactions => draw_reactions(area, run, run.final_time()),
         ContactPanel::ContactSet => {
             draw_contact_set(area, &run.contact, run.length, run.final_time())
         }
     }
 }
 
-/// One line per constraint: its largest reaction in each time bin, against `t`.
+/// One line per constraint: its largest reaction in each time bin, against `t`, over the
+/// contact episodes of `summary.json` shaded in the end's colour (the same episodes).
 fn draw_reactions<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    h: &ContactHistory,
+    run: &SampledRun,
     t_end: f64,
 ) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
+    let h = &run.contact;
     let k = h.constraints();
     let title = if k == 1 {
         "contact reaction r at the Signorini end"
@@ -410,6 +415,16 @@ where
             sans(AXIS_FONT),
         )))?;
         return Ok(());
+    }
+    for j in 0..k {
+        let colour = LINE_COLOURS[j % LINE_COLOURS.len()];
+        let episodes = run.summary.contact_episodes.get(&h.names[j]);
+        chart.draw_series(episodes.into_iter().flatten().map(|e| {
+            Rectangle::new(
+                [(e.start, 0.0), (e.end, top)],
+                colour.mix(EPISODE_OPACITY).filled(),
+            )
+        }))?;
     }
     // Filled under a 1-pixel line: thicker plotters lines are polygonised with mitre joins,
     // which break up at the sharp reaction peaks; the translucent fill keeps overlapping ends
