@@ -322,21 +322,6 @@ fn verify(update: Option<PathBuf>, stiff: bool) -> i32 {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::first_sentence;
-
-    #[test]
-    fn first_sentence_stops_at_a_full_stop_outside_brackets_before_a_space() {
-        assert_eq!(
-            first_sentence("Gap a0 = 0.1\nbelow (see f. 2) the end. Then more."),
-            "Gap a0 = 0.1 below (see f. 2) the end."
-        );
-        assert_eq!(first_sentence("Ends here."), "Ends here.");
-        assert_eq!(first_sentence("  no full stop "), "no full stop");
-    }
-}
-
 /// The contact episodes of one end (or of the obstacle) in one line: when, impulse and the
 /// energy the contact term took (the same episodes as `summary.json` and the figures).
 fn episode_line(episodes: &[viscobar::ContactEpisode]) -> String {
@@ -369,4 +354,19 @@ fn episode_line(episodes: &[viscobar::ContactEpisode]) -> String {
         if n == 1 { "" } else { "s" },
         each.join("; ")
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::first_sentence;
+
+    #[test]
+    fn first_sentence_stops_at_a_full_stop_outside_brackets_before_a_space() {
+        assert_eq!(
+            first_sentence("Gap a0 = 0.1\nbelow (see f. 2) the end. Then more."),
+            "Gap a0 = 0.1 below (see f. 2) the end."
+        );
+        assert_eq!(first_sentence("Ends here."), "Ends here.");
+        assert_eq!(first_sentence("  no full stop "), "no full stop");
+    }
 }
