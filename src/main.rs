@@ -4,6 +4,7 @@ use clap::{Parser, Subcommand};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use viscobar::scene;
+use viscobar::{SceneError, SolverMethod};
 
 #[derive(Parser)]
 #[command(
@@ -65,6 +66,19 @@ enum Command {
         #[arg(long)]
         viscosity_sweep: bool,
     },
+    /// Run a scene with several step solvers side by side and print, as a Markdown table, how
+    /// far each is from the first one listed over every step (displacements and reactions).
+    Compare {
+        /// A built-in scene (a name from `viscobar scenes`) or the path of a TOML scene file.
+        scene: String,
+        /// Comma-separated step solvers (exact, osqp, penalty); the first is the reference.
+        /// Each uses the scene's [solver] settings that belong to it.
+        #[arg(long, default_value = "exact,osqp,penalty")]
+        solvers: String,
+        /// Override a scene key, e.g. --set time.step=0.001 (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
     /// List the built-in scenes.
     Scenes,
     /// Print a built-in scene as TOML.
@@ -112,6 +126,17 @@ fn main() {
             out,
             viscosity_sweep,
         } => match converge(&scene, &solvers, levels, ratio, out, viscosity_sweep) {
+            Ok(()) => 0,
+            Err(e) => {
+                eprintln!("error: {e}");
+                e.exit_code()
+            }
+        },
+        Command::Compare {
+            scene,
+            solvers,
+            set,
+        } => match compare(&scene, &solvers, &set) {
             Ok(()) => 0,
             Err(e) => {
                 eprintln!("error: {e}");
@@ -283,6 +308,110 @@ fn converge(
     };
     for f in &files {
         println!("wrote {}", f.display());
+    }
+    Ok(())
+}
+
+/// The step solvers `compare` knows, by name.
+const METHODS: [SolverMethod; 3] = [
+    SolverMethod::Exact,
+    SolverMethod::Osqp,
+    SolverMethod::Penalty,
+];
+
+/// The `--solvers` list of `compare`: known names, no repeats, at least two.
+fn parse_methods(list: &str) -> Result<Vec<SolverMethod>, SceneError> {
+    let bad = |allowed: String| SceneError::Invalid {
+        field: "--solvers".into(),
+        value: list.to_string(),
+        allowed,
+    };
+    let known = || METHODS.map(SolverMethod::name).join(", ");
+    let mut methods = Vec::new();
+    for name in list.split(',').map(str::trim) {
+        let method = METHODS
+            .into_iter()
+            .find(|m| m.name() == name)
+            .ok_or_else(|| bad(format!("unknown solver `{name}` (known: {})", known())))?;
+        if methods.contains(&method) {
+            return Err(bad(format!("`{name}` is listed twice")));
+        }
+        methods.push(method);
+    }
+    if methods.len() < 2 {
+        return Err(bad(format!(
+            "list at least two solvers, the reference first (known: {})",
+            known()
+        )));
+    }
+    Ok(methods)
+}
+
+/// `viscobar compare`: each solver after the first run side by side with the first, one row
+/// of the Markdown table per pair, printed as soon as it is measured. A solver that cannot
+/// handle the scene (penalty on an obstacle) gets a row saying why.
+fn compare(name: &str, solvers: &str, set: &[String]) -> Result<(), viscobar::RunError> {
+    use viscobar::study::compare::{compare, with_solver};
+    let methods = parse_methods(solvers)?;
+    let (scene_name, scene) = scene::load(name, set)?;
+    let reference = with_solver(&scene, methods[0]);
+    // Refused here (exit 2) if the reference itself cannot handle the scene.
+    viscobar::Simulation::new(&reference)?;
+    let ends = !scene.signorini_ends().is_empty();
+    let dash = || "–".to_string();
+    println!(
+        "{scene_name}: {} steps of dt = {}, {} elements; each solver against `{}`\n",
+        scene.steps(),
+        scene.time.step,
+        scene.mesh.elements,
+        methods[0].name()
+    );
+    println!(
+        "| solvers | steps | max \\|Δu\\| | at step | max \\|Δu\\| / max \\|u\\| \
+         | max \\|Δreaction\\| (ends) | max \\|Δreaction\\| / max \\|reaction\\| \
+         | max violation | iterations mean / max | wall time (s) |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for &method in &methods[1..] {
+        let pair = format!("{} vs {}", method.name(), methods[0].name());
+        let other = with_solver(&scene, method);
+        let c = match compare(method.name(), &reference, &other) {
+            Ok(c) => c,
+            Err(viscobar::RunError::Scene(SceneError::Invalid { field, allowed, .. }))
+                if field == "solver.method" =>
+            {
+                println!("| {pair} | does not apply: {allowed} |{}", " |".repeat(8));
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
+        let (a, s) = (c.agreement, &c.summary);
+        let ratio = |d: f64, scale: f64| {
+            if scale > 0.0 {
+                format!("{:.2e}", d / scale)
+            } else {
+                dash()
+            }
+        };
+        let (dr, dr_rel) = if ends {
+            (
+                format!("{:.3e}", a.max_reaction_difference),
+                ratio(a.max_reaction_difference, a.max_reaction),
+            )
+        } else {
+            (dash(), dash())
+        };
+        println!(
+            "| {pair} | {} | {:.3e} | {} | {} | {dr} | {dr_rel} | {:.1e} | {:.1} / {} | {:.3} |",
+            a.steps,
+            a.max_difference,
+            a.worst_step,
+            ratio(a.max_difference, a.max_displacement),
+            s.max_violation,
+            s.solver_iterations.mean,
+            s.solver_iterations.max,
+            s.wall_time_s
+        );
     }
     Ok(())
 }

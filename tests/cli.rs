@@ -124,6 +124,7 @@ fn help_describes_the_scene_arguments() {
     for (command, argument) in [
         ("run", "<SCENE>"),
         ("converge", "<SCENE>"),
+        ("compare", "<SCENE>"),
         ("show", "<NAME>"),
     ] {
         let o = viscobar(&[command, "--help"]);
@@ -232,4 +233,247 @@ fn without_default_features_the_library_needs_no_cli_or_plotting_crate() {
         assert!(!bare.iter().any(|n| n == name), "{name} is not optional");
     }
     assert!(bare.iter().any(|n| n == "nalgebra"), "{bare:?}");
+}
+
+/// Exit code, stdout and stderr of `viscobar args`.
+fn outcome(args: &[&str]) -> (i32, String, String) {
+    let o = viscobar(args);
+    (
+        o.status.code().expect("exited"),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// A step that does not divide `time.end` is refused (it used to run on to the nearest multiple
+/// of the step, e.g. to t = 10 for an end of 6), with the valid ends and steps nearest to it.
+#[test]
+fn a_step_that_does_not_divide_the_end_is_refused_with_the_nearest_valid_values() {
+    let out = tmpdir("grid");
+    let dir = out.to_str().unwrap();
+    let run = |set: &[&str]| {
+        let mut args = vec!["run", "impact", "--out", dir];
+        for s in set {
+            args.extend(["--set", s]);
+        }
+        outcome(&args)
+    };
+    // Longer than the whole run: one valid end above, one valid step below.
+    let (code, _, err) = run(&["time.step=10", "time.end=6"]);
+    assert_eq!(code, 2, "{err}");
+    for part in [
+        "`time.step` = 10",
+        "`time.end` = 6",
+        "time.end = 10 (1 step)",
+        "time.step = 6 (1 step)",
+    ] {
+        assert!(err.contains(part), "lacks {part:?}: {err}");
+    }
+    assert!(!out.exists(), "a refused run creates nothing");
+    // 299.6 steps: the ends of 299 and 300 steps, the steps giving 300 and 299 of them.
+    let (code, _, err) = run(&["time.end=2.996"]);
+    assert_eq!(code, 2, "{err}");
+    for part in [
+        "time.end = 2.99 (299 steps) or time.end = 3 (300 steps)",
+        "time.step = 0.00998666666667 (300 steps) or time.step = 0.0100200668896 (299 steps)",
+    ] {
+        assert!(err.contains(part), "lacks {part:?}: {err}");
+    }
+    // Each suggestion is accepted.
+    for set in [
+        ["time.end=2.99", "time.step=0.01"],
+        ["time.end=2.996", "time.step=0.00998666666667"],
+    ] {
+        let (code, _, err) = run(&set);
+        assert_eq!(code, 0, "{set:?}: {err}");
+    }
+    // Round-off is not a mismatch: 0.3 / 0.1 = 2.9999999999999996 in binary, three steps.
+    let (code, _, err) = run(&["time.step=0.1", "time.end=0.3"]);
+    assert_eq!(code, 0, "{err}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["steps"], 3);
+}
+
+/// The suggested expression of a message `... field = "TEXT"` (the last quoted text).
+fn suggested(err: &str, field: &str) -> String {
+    let start = err
+        .rfind(&format!("{field} = \""))
+        .unwrap_or_else(|| panic!("no suggestion for {field}: {err}"))
+        + field.len()
+        + 4;
+    let end = start + err[start..].find('"').expect("closing quote");
+    err[start..end].to_string()
+}
+
+/// Initial data that do not vanish at a clamped end are refused with the field, its value there
+/// and an expression that does vanish (the data times a ramp written with the scene's length),
+/// which runs.
+#[test]
+fn initial_data_not_vanishing_at_a_clamped_end_get_a_ramp_that_does() {
+    let out = tmpdir("ramp");
+    std::fs::create_dir_all(&out).unwrap();
+    let file = out.join("clamped.toml");
+    let scene = |left: &str, right: &str| {
+        format!(
+            "[bar]\nlength = 2.0\n[left]\ncondition = \"{left}\"\n[right]\ncondition = \"{right}\"\n\
+             [initial]\nvelocity = \"-0.3\"\n[mesh]\nelements = 40\n[time]\nstep = 0.05\nend = 0.5\n"
+        )
+    };
+    for (left, right, side, ramp) in [
+        ("free", "clamped", "right", "(-0.3)*(2 - x)/2"),
+        ("clamped", "free", "left", "(-0.3)*x/2"),
+        ("clamped", "clamped", "left", "(-0.3)*4*x*(2 - x)/(2*2)"),
+    ] {
+        std::fs::write(&file, scene(left, right)).unwrap();
+        let path = file.to_str().unwrap();
+        let run_out = out.join("run");
+        let run = |set: &[&str]| {
+            let mut args = vec!["run", path, "--out", run_out.to_str().unwrap()];
+            for s in set {
+                args.extend(["--set", s]);
+            }
+            outcome(&args)
+        };
+        let (code, _, err) = run(&[]);
+        assert_eq!(code, 2, "{err}");
+        for part in [
+            "`initial.velocity` = -0.3",
+            &format!("must vanish at the clamped {side} end"),
+        ] {
+            assert!(err.contains(part), "lacks {part:?}: {err}");
+        }
+        let fix = suggested(&err, "initial.velocity");
+        assert_eq!(fix, ramp, "{err}");
+        let (code, _, err) = run(&[&format!("initial.velocity=\"{fix}\"")]);
+        assert_eq!(code, 0, "the suggestion {fix} is refused: {err}");
+    }
+    // The built-in clamped scene, at its own length 1.
+    let (code, _, err) = outcome(&[
+        "run",
+        "clamped-impact",
+        "--set",
+        "initial.velocity=\"-0.3\"",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(
+        suggested(&err, "initial.velocity"),
+        "(-0.3)*(1 - x)/1",
+        "{err}"
+    );
+}
+
+/// The cells of the Markdown table row that starts with `| pair |`.
+fn row<'a>(table: &'a str, pair: &str) -> Vec<&'a str> {
+    table
+        .lines()
+        .find(|l| l.starts_with(&format!("| {pair} |")))
+        .unwrap_or_else(|| panic!("no row {pair}: {table}"))
+        .trim_matches('|')
+        .split(" | ")
+        .map(str::trim)
+        .collect()
+}
+
+/// How close OSQP (tolerance 1e-10, polished) comes to the exact solver on the impact scene's
+/// first half second, in displacement and reaction: measured 1e-11 and 1e-9; bounds with room.
+const OSQP_AGREEMENT_TOL: f64 = 1e-6;
+
+#[test]
+fn compare_prints_the_agreement_of_each_solver_with_the_first() {
+    let (code, table, err) = outcome(&[
+        "compare",
+        "impact",
+        "--solvers",
+        "exact,osqp,penalty",
+        "--set",
+        "time.end=0.5",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let header = table
+        .lines()
+        .find(|l| l.starts_with("| solvers |"))
+        .unwrap_or_else(|| panic!("no table: {table}"));
+    for column in ["steps", "max \\|Δu\\|", "max \\|Δreaction\\| (ends)"] {
+        assert!(header.contains(column), "lacks {column}: {header}");
+    }
+    let osqp = row(&table, "osqp vs exact");
+    let penalty = row(&table, "penalty vs exact");
+    assert_eq!(osqp.len(), header.matches(" | ").count() + 1, "{table}");
+    for cells in [&osqp, &penalty] {
+        assert_eq!(cells[1], "50", "{table}");
+    }
+    let number = |cells: &[&str], i: usize| -> f64 {
+        cells[i]
+            .parse()
+            .unwrap_or_else(|_| panic!("cell {i} not a number: {cells:?}"))
+    };
+    // Displacement and reaction differences: OSQP agrees closely, the penalty only to O(ε).
+    for i in [2, 5] {
+        assert!(number(&osqp, i) < OSQP_AGREEMENT_TOL, "{table}");
+        assert!(number(&penalty, i) > number(&osqp, i), "{table}");
+    }
+    // A scene file and --set, with the penalty on a distributed obstacle: a row, not a crash.
+    let (code, table, err) = outcome(&[
+        "compare",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/distributed.toml"),
+        "--solvers",
+        "exact,penalty,osqp",
+        "--set",
+        "time.end=0.1",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        row(&table, "penalty vs exact")[1].starts_with("does not apply"),
+        "{table}"
+    );
+    row(&table, "osqp vs exact");
+}
+
+#[test]
+fn compare_refuses_bad_input_with_2_and_a_failing_run_with_1() {
+    for (args, names) in [
+        (
+            &["compare", "impact", "--solvers", "exact,cplex"][..],
+            "cplex",
+        ),
+        (
+            &["compare", "impact", "--solvers", "exact"][..],
+            "--solvers",
+        ),
+        (&["compare", "no-such-scene"][..], "no-such-scene"),
+        (
+            &[
+                "compare",
+                "impact",
+                "--set",
+                "time.step=10",
+                "--set",
+                "time.end=6",
+            ][..],
+            "time.step",
+        ),
+        // The reference itself cannot handle an obstacle.
+        (
+            &["compare", "distributed", "--solvers", "penalty,exact"][..],
+            "penalty",
+        ),
+    ] {
+        let (code, _, err) = outcome(args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(names), "{args:?}: {err}");
+    }
+    // OSQP allowed one iteration per step fails during the run.
+    let (code, _, err) = outcome(&[
+        "compare",
+        "impact",
+        "--solvers",
+        "exact,osqp",
+        "--set",
+        "solver.method=\"osqp\"",
+        "--set",
+        "solver.max_iter=1",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("osqp") && err.contains("step"), "{err}");
 }

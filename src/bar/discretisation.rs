@@ -154,7 +154,27 @@ pub struct InitialData {
     pub(crate) clamped: [bool; 2],
 }
 
+/// Significant digits of the bar length written into a suggested expression (`L = J·Δx`
+/// rounded, so that `1/640 · 640` prints as `1`, not `0.9999999999999999`).
+const LENGTH_DIGITS: usize = 12;
+
 impl InitialData {
+    /// `expression` multiplied by a ramp that vanishes at every clamped end: `(L − x)/L` for the
+    /// right end, `x/L` for the left, `4x(L − x)/L²` for both (1 at mid-bar).
+    fn ramped(&self, expression: &Expression, disc: &Discretisation) -> String {
+        let length = disc.x(disc.nodes - 1);
+        let l = format!("{length:.prec$e}", prec = LENGTH_DIGITS - 1)
+            .parse::<f64>()
+            .unwrap_or(length)
+            .to_string();
+        let text = expression.text().trim();
+        match self.clamped {
+            [true, true] => format!("({text})*4*x*({l} - x)/({l}*{l})"),
+            [true, false] => format!("({text})*x/{l}"),
+            _ => format!("({text})*({l} - x)/{l}"),
+        }
+    }
+
     /// `u_0`, `u_1` at all nodes; at a clamped node they must vanish (up to
     /// [`CLAMPED_START_TOL`]) and are set to 0.
     pub fn eval_into(
@@ -175,18 +195,21 @@ impl InitialData {
             if !clamped {
                 continue;
             }
-            for (field, value) in [
-                ("initial.displacement", u[node]),
-                ("initial.velocity", v[node]),
+            for (field, value, expression) in [
+                ("initial.displacement", u[node], &self.displacement),
+                ("initial.velocity", v[node], &self.velocity),
             ] {
                 if value.abs() > CLAMPED_START_TOL {
                     return Err(SceneError::Invalid {
                         field: field.into(),
                         value: value.to_string(),
                         allowed: format!(
-                            "must vanish at the clamped {} end (x = {})",
+                            "must vanish at the clamped {} end (x = {}); to make the data \
+                             consistent, multiply it by a ramp that vanishes there, e.g. \
+                             {field} = \"{}\"",
                             side.name(),
-                            disc.x(node)
+                            disc.x(node),
+                            self.ramped(expression, disc)
                         ),
                     });
                 }

@@ -478,13 +478,14 @@ impl Scene {
         positive("time.step", self.time.step)?;
         positive("time.end", self.time.end)?;
         let steps = self.time.end / self.time.step;
-        if steps.round() < 1.0 || steps > MAX_STEPS as f64 {
+        if steps > MAX_STEPS as f64 {
             return Err(SceneError::Invalid {
                 field: "time.end".into(),
                 value: self.time.end.to_string(),
                 allowed: format!("time.end / time.step must lie between 1 and {MAX_STEPS}"),
             });
         }
+        check_time_grid(self.time.step, self.time.end)?;
         self.solver.validate()?;
         if self.output.every < 1 {
             return Err(invalid(
@@ -568,6 +569,57 @@ impl Side {
             Side::Right => "right",
         }
     }
+}
+
+/// How far `time.end / time.step` may miss a whole number of steps, relative to it: decimal
+/// inputs such as `0.005` carry binary round-off (a few ulps, ~1e-15 relative, in the ratio), and
+/// steps typed to 10 digits (`0.3333333333` for 1/3) stay within 1e-10; below `1/MAX_STEPS` a
+/// tenth of a step is still caught at the largest step count.
+pub const TIME_GRID_TOL: f64 = 1e-10;
+
+/// Significant digits of the suggested `time.end` and `time.step` values (enough to divide to
+/// within [`TIME_GRID_TOL`], few enough to read).
+const SUGGESTION_DIGITS: usize = 12;
+
+/// `time.step` must divide `time.end` (up to [`TIME_GRID_TOL`]): the run then ends at
+/// `time.end` exactly instead of at the nearest multiple of the step. Refused otherwise, with
+/// the nearest valid ends for this step and the nearest valid steps for this end.
+fn check_time_grid(step: f64, end: f64) -> Result<(), SceneError> {
+    let ratio = end / step;
+    let n = ratio.round();
+    if n >= 1.0 && (ratio - n).abs() <= TIME_GRID_TOL * n {
+        return Ok(());
+    }
+    // Rounded to SUGGESTION_DIGITS significant digits and printed in the shortest form.
+    let short = |x: f64| {
+        format!("{x:.prec$e}", prec = SUGGESTION_DIGITS - 1)
+            .parse::<f64>()
+            .map_or_else(|_| x.to_string(), |r| r.to_string())
+    };
+    let plural = |n: f64| if n == 1.0 { "step" } else { "steps" };
+    let (below, above) = (ratio.floor(), ratio.ceil());
+    let candidates: Vec<f64> = [below, above].into_iter().filter(|k| *k >= 1.0).collect();
+    let ends: Vec<String> = candidates
+        .iter()
+        .map(|k| format!("time.end = {} ({k} {})", short(k * step), plural(*k)))
+        .collect();
+    let steps: Vec<String> = candidates
+        .iter()
+        .rev()
+        .map(|k| format!("time.step = {} ({k} {})", short(end / k), plural(*k)))
+        .collect();
+    Err(SceneError::Invalid {
+        field: "time.step".into(),
+        value: step.to_string(),
+        allowed: format!(
+            "does not divide `time.end` = {end} (time.end / time.step = {}, not a whole number \
+             of steps; the run would end at a multiple of the step, not at time.end); \
+             nearest valid ends for this step: {}; nearest valid steps for this end: {}",
+            short(ratio),
+            ends.join(" or "),
+            steps.join(" or ")
+        ),
+    })
 }
 
 fn invalid(field: &str, value: f64, allowed: &str) -> SceneError {

@@ -4,12 +4,14 @@
 use crate::linalg::norms::{max_abs, max_distance};
 use crate::scene::Scene;
 use crate::scene::SceneError;
+use crate::scene::SolverMethod;
 use crate::study::accuracy::lockstep;
 use crate::time::RunError;
 use crate::time::simulation::{Simulation, StepRecord};
 use crate::time::summary::{Summary, Tracker};
 
-/// How far run `b` is from run `a`, over every step `u^1 … u^N` and every node.
+/// How far run `b` is from run `a`, over every step `u^1 … u^N` and every node (and the
+/// reactions at the Signorini ends).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Agreement {
     /// Number of states compared (`N`).
@@ -20,6 +22,23 @@ pub struct Agreement {
     pub worst_step: usize,
     /// `max_{n,i} |u_a|`, the scale of the displacements.
     pub max_displacement: f64,
+    /// `max_{n,j} |r_b − r_a|` over the Signorini ends `j` (0 when there is none; the
+    /// reactions of obstacle nodes are not recorded).
+    pub max_reaction_difference: f64,
+    /// `max_{n,j} |r_a|` over the Signorini ends, the scale of the reactions.
+    pub max_reaction: f64,
+}
+
+impl Agreement {
+    /// Takes the reactions of one step of `a` and `b` into account.
+    fn observe_reactions(&mut self, a: &StepRecord, b: &StepRecord) {
+        for j in 0..a.reaction.len() {
+            self.max_reaction_difference = self
+                .max_reaction_difference
+                .max((b.reaction[j] - a.reaction[j]).abs());
+            self.max_reaction = self.max_reaction.max(a.reaction[j].abs());
+        }
+    }
 }
 
 /// The comparison, and run `b`'s step records (start-up step first) and summary.
@@ -53,10 +72,12 @@ pub fn compare(name: &str, a: &Scene, b: &Scene) -> Result<Comparison, RunError>
     let nodes = sims[0].discretisation().nodes;
     let (mut ua, mut ub) = (vec![0.0; nodes], vec![0.0; nodes]);
     let mut out = Agreement::default();
+    out.observe_reactions(&sims[0].first_record(), &sims[1].first_record());
     lockstep(&mut sims, a.steps(), |sims, step| {
-        if let Some(&r) = step.get(1) {
-            tracker.observe(&r);
-            records.push(r);
+        if let [ra, rb] = step[..] {
+            out.observe_reactions(&ra, &rb);
+            tracker.observe(&rb);
+            records.push(rb);
         }
         let [sa, sb] = sims else {
             unreachable!("two runs")
@@ -77,6 +98,27 @@ pub fn compare(name: &str, a: &Scene, b: &Scene) -> Result<Comparison, RunError>
         records,
         summary,
     })
+}
+
+/// `scene` with step solver `method`: the `[solver]` settings that belong to `method` are kept,
+/// those of other methods dropped (so one scene with e.g. `epsilon` set serves every solver of a
+/// comparison, the penalty one using it).
+pub fn with_solver(scene: &Scene, method: SolverMethod) -> Scene {
+    let mut s = scene.clone();
+    let spec = &mut s.solver;
+    spec.method = method;
+    if method != SolverMethod::Osqp {
+        spec.eps_abs = None;
+        spec.eps_rel = None;
+        spec.polish = None;
+        spec.max_iter = None;
+        spec.adaptive_rho_interval = None;
+        spec.accept_inaccurate = None;
+    }
+    if method != SolverMethod::Penalty {
+        spec.epsilon = None;
+    }
+    s
 }
 
 /// One step problem `min ½zᵀCz − bᵀz, z_j >= lo_j` with the exact solver's answer `(z, r)`.
