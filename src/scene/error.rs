@@ -22,7 +22,7 @@ pub enum SceneError {
         value: String,
         allowed: String,
     },
-    #[error("`{field}` = \"{text}\" cannot be used: {reason}")]
+    #[error("`{field}` = \"{text}\": {reason}")]
     Expression {
         field: String,
         text: String,

@@ -81,11 +81,11 @@ pub struct EndSpec {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Initial {
-    /// `u(x, 0)`, an expression in `x`.
-    #[serde(default = "zero")]
+    /// `u(x, 0)`, an expression in `x` (a number is kept as its text, see [`number_text`]).
+    #[serde(default = "zero", deserialize_with = "number_or_expression")]
     pub displacement: String,
-    /// `u_t(x, 0)`, an expression in `x`.
-    #[serde(default = "zero")]
+    /// `u_t(x, 0)`, an expression in `x` (a number is kept as its text).
+    #[serde(default = "zero", deserialize_with = "number_or_expression")]
     pub velocity: String,
 }
 
@@ -105,8 +105,12 @@ fn zero() -> String {
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Load {
-    /// `l(x, t)`, force per unit length; absent means no load.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    /// `l(x, t)`, force per unit length; absent means no load (a number is kept as its text).
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "optional_number_or_expression"
+    )]
     pub density: Option<String>,
 }
 
@@ -132,10 +136,52 @@ impl GapValue {
     pub fn expression(&self, field: &str) -> Result<Expression, SceneError> {
         match self {
             GapValue::Number(v) if !v.is_finite() => Err(invalid(field, *v, "must be finite")),
-            GapValue::Number(v) => Expression::parse(field, &format!("{v:?}"), false),
+            GapValue::Number(v) => Expression::parse(field, &number_text(*v), false),
             GapValue::Expression(text) => Expression::parse(field, text, false),
         }
     }
+}
+
+/// The text of a number given where an expression may be: `{:?}` of the `f64`, which reads back
+/// to the same bits (`0.1` stays `0.1`, `1e-7` stays `1e-7`); shared by every expression field
+/// so that `displacement = 0.1`, `--set initial.displacement=0.1` and `gap = 0.1` agree.
+pub fn number_text(v: f64) -> String {
+    format!("{v:?}")
+}
+
+/// Serde: an expression field given as a string (the expression) or as a number (TOML integer
+/// or float, kept as [`number_text`]). A non-finite float is kept as `inf`/`NaN`, which the
+/// expression parser then refuses with the field's name.
+fn number_or_expression<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+    struct Visitor;
+    impl serde::de::Visitor<'_> for Visitor {
+        type Value = String;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a number or an expression in quotes, e.g. 0.1 or \"0.3*cos(2*x)\"")
+        }
+        fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<String, E> {
+            Ok(v.to_string())
+        }
+        fn visit_string<E: serde::de::Error>(self, v: String) -> Result<String, E> {
+            Ok(v)
+        }
+        fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<String, E> {
+            Ok(number_text(v as f64))
+        }
+        fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<String, E> {
+            Ok(number_text(v as f64))
+        }
+        fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<String, E> {
+            Ok(number_text(v))
+        }
+    }
+    d.deserialize_any(Visitor)
+}
+
+fn optional_number_or_expression<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<String>, D::Error> {
+    number_or_expression(d).map(Some)
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
