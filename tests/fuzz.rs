@@ -90,9 +90,16 @@ fn scene_text() -> impl Strategy<Value = String> {
         (number(), number(), prop_oneof![6 => Just("consistent"), 2 => Just("talk-printed"), 1 => Just("x")]),
         (condition(), condition()),
         (expression(), expression(), prop::option::of(expression())),
-        (count(), number(), prop_oneof![8 => (0.5f64..3.0).prop_map(|v| format!("{v:?}")), 1 => number()], count()),
+        // The end: usually a whole number of steps (scenes whose step does not divide the end
+        // are refused), sometimes any number.
+        (count(), number(), prop_oneof![8 => (1u32..400).prop_map(Ok), 1 => number().prop_map(Err)], count()),
     )
         .prop_map(|((len, visc, mat), (l, r), (u0, v0, load), (el, dt, end, every))| {
+            let end = match (end, dt.parse::<f64>()) {
+                (Ok(steps), Ok(step)) => format!("{:?}", f64::from(steps) * step),
+                (Ok(steps), Err(_)) => steps.to_string(),
+                (Err(text), _) => text,
+            };
             let end_block = |name: &str, (c, g): &(String, Option<String>)| {
                 let gap = g.as_ref().map(|g| format!("gap = {g}\n")).unwrap_or_default();
                 format!("[{name}]\ncondition = \"{c}\"\n{gap}")
