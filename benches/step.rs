@@ -151,9 +151,51 @@ fn bench_other_solvers(c: &mut Criterion) {
 
 // No HTML plots: criterion's plotters backend would need a registered font (the project's
 // plotters is built with `ab_glyph` only); the numbers are in target/criterion/*/new/.
+/// A built-in scene refined to `elements` with `Δt/Δx` kept, long enough for any bench.
+fn refined_builtin(name: &str, elements: u64, extra: &[&str]) -> Scene {
+    let (_, base) = viscobar::scene::load(name, &[]).unwrap();
+    let step = base.time.step * base.mesh.elements as f64 / elements as f64;
+    let mut o = vec![
+        format!("mesh.elements={elements}"),
+        format!("time.step={step}"),
+        format!("time.end={}", 1_000_000.0 * step),
+    ];
+    o.extend(extra.iter().map(|s| s.to_string()));
+    viscobar::scene::load(name, &o).unwrap().1
+}
+
+/// Issue 17's load path: each forced talk scene against its unforced twin (the same bar,
+/// obstacles and data without the load), and the twin with a load that does not separate
+/// (two transcendental calls per node).
+fn bench_loads(c: &mut Criterion) {
+    let mut group = c.benchmark_group("load");
+    for elements in [100u64, 1_000, 10_000, 100_000] {
+        group.throughput(Throughput::Elements(elements + 1));
+        for (label, name, extra) in [
+            ("both-ends", "both-ends", &[][..]),
+            ("both-ends-forced", "both-ends-forced", &[][..]),
+            (
+                "both-ends-mixed-load",
+                "both-ends",
+                &["load.density=\"0.1*sin(x*t)*exp(-(x-t)^2)\""][..],
+            ),
+            ("distributed", "distributed", &[][..]),
+            ("distributed-forced", "distributed-forced", &[][..]),
+        ] {
+            settle_and_bench(
+                &mut group,
+                label,
+                elements,
+                &refined_builtin(name, elements, extra),
+            );
+        }
+    }
+    group.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().without_plots();
-    targets = bench_step, bench_other_solvers
+    targets = bench_step, bench_other_solvers, bench_loads
 }
 criterion_main!(benches);

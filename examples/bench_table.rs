@@ -17,6 +17,10 @@ use std::path::Path;
 const BARE_NS_PER_NODE_TARGET: f64 = 2.0;
 const DIAGNOSTICS_OVERHEAD_TARGET: f64 = 0.5;
 const EXACT_RATIO_TARGET: f64 = 1.15;
+/// Issue 17's targets: a forced talk scene against its unforced twin, per step; a load that
+/// does not separate (two transcendental calls), per node-step.
+const FORCED_RATIO_TARGET: f64 = 1.3;
+const MIXED_LOAD_NS_TARGET: f64 = 30.0;
 
 /// Rows measured this long before the newest row of their group are stale.
 const STALE_AFTER_S: u64 = 3600;
@@ -77,7 +81,7 @@ fn verdict(ok: bool) -> &'static str {
 fn main() {
     let target = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/criterion");
     let (rows, stale) = fresh(step_rows(&target.join("step")));
-    if rows.is_empty() {
+    if rows.is_empty() && !target.join("load").exists() {
         eprintln!("no measurements in target/criterion/step: run `cargo bench --bench step` first");
         std::process::exit(1);
     }
@@ -116,6 +120,48 @@ fn main() {
         }
         for name in &stale_scenes {
             println!("| {name} (stale) | | |");
+        }
+    }
+    let (loads, stale_loads) = fresh(step_rows(&target.join("load")));
+    if !loads.is_empty() {
+        println!();
+        println!("| elements | scene | median per step | ns per node-step | / unforced twin |");
+        println!("|---|---|---|---|---|");
+        for ((j, name), t) in &loads {
+            let twin = name
+                .strip_suffix("-forced")
+                .or(name.strip_suffix("-mixed-load"));
+            let ratio = twin
+                .and_then(|tw| loads.get(&(*j, tw.to_string())))
+                .map(|b| format!("{:.3}", t / b))
+                .unwrap_or_default();
+            println!(
+                "| {j} | {name} | {:.1} µs | {:.2} | {ratio} |",
+                t / 1e3,
+                t / (*j + 1) as f64
+            );
+        }
+        for (j, name) in &stale_loads {
+            println!("| {j} | {name} (stale) | | | |");
+        }
+        println!();
+        println!("Targets (issue 17, loads):");
+        for ((j, name), t) in &loads {
+            if let Some(twin) = name.strip_suffix("-forced") {
+                if let Some(b) = loads.get(&(*j, twin.to_string())) {
+                    println!(
+                        "- {name} at J = {j}: {:.3}x its unforced twin (target <= {FORCED_RATIO_TARGET}): {}",
+                        t / b,
+                        verdict(t / b <= FORCED_RATIO_TARGET)
+                    );
+                }
+            } else if name.ends_with("-mixed-load") {
+                let per = t / (*j + 1) as f64;
+                println!(
+                    "- {name} at J = {j}: {per:.2} ns per node-step (target <= {MIXED_LOAD_NS_TARGET}): {}",
+                    verdict(per <= MIXED_LOAD_NS_TARGET)
+                );
+            }
         }
     }
     println!();

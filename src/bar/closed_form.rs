@@ -315,7 +315,8 @@ impl ForcedMode {
     /// The load density `l(x, t)` that makes `u` a solution.
     pub fn load(&self, x: f64, t: f64) -> f64 {
         let k = self.k();
-        ((k * k - 4.0) * (2.0 * t).cos() - 2.0 * self.alpha * k * k * (2.0 * t).sin()) * (k * x).cos()
+        ((k * k - 4.0) * (2.0 * t).cos() - 2.0 * self.alpha * k * k * (2.0 * t).sin())
+            * (k * x).cos()
     }
     /// The load written in the scene grammar (README, "Expressions"), for scenes built in code.
     pub fn load_expression(&self) -> String {

@@ -46,7 +46,7 @@ pub struct Expression {
 }
 
 #[derive(Clone, Debug)]
-enum Node {
+pub(super) enum Node {
     Num(f64),
     X,
     T,
@@ -59,7 +59,7 @@ enum Node {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum BinOp {
+pub(super) enum BinOp {
     Add,
     Sub,
     Mul,
@@ -68,7 +68,7 @@ enum BinOp {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum CmpOp {
+pub(super) enum CmpOp {
     Lt,
     Le,
     Gt,
@@ -78,7 +78,7 @@ enum CmpOp {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Func1 {
+pub(super) enum Func1 {
     Sin,
     Cos,
     Tan,
@@ -109,7 +109,7 @@ enum Func1 {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Func2 {
+pub(super) enum Func2 {
     Min,
     Max,
     Atan2,
@@ -158,7 +158,7 @@ const CONSTANTS: &[(&str, f64)] = &[
 ];
 
 impl Func1 {
-    fn apply(self, a: f64) -> f64 {
+    pub(super) fn apply(self, a: f64) -> f64 {
         match self {
             Func1::Sin => a.sin(),
             Func1::Cos => a.cos(),
@@ -209,12 +209,18 @@ impl Func1 {
     }
 }
 
-fn truth(b: bool) -> f64 {
+/// `a^b`, with the square as one correctly rounded product (the commonest power in loads and
+/// data, and several times cheaper than `powf`).
+pub(super) fn pow(a: f64, b: f64) -> f64 {
+    if b == 2.0 { a * a } else { a.powf(b) }
+}
+
+pub(super) fn truth(b: bool) -> f64 {
     if b { 1.0 } else { 0.0 }
 }
 
 impl Node {
-    fn eval(&self, x: f64, t: f64) -> f64 {
+    pub(super) fn eval(&self, x: f64, t: f64) -> f64 {
         match self {
             Node::Num(v) => *v,
             Node::X => x,
@@ -227,7 +233,7 @@ impl Node {
                     BinOp::Sub => a - b,
                     BinOp::Mul => a * b,
                     BinOp::Div => a / b,
-                    BinOp::Pow => a.powf(b),
+                    BinOp::Pow => pow(a, b),
                 }
             }
             Node::Cmp(op, a, b) => {
@@ -773,6 +779,27 @@ impl Expression {
             uses_x: parser.uses_x,
             uses_t: parser.uses_t,
         })
+    }
+
+    /// An expression for `field` with the tree `root` (a part of a parsed expression, whose
+    /// `text` it keeps for messages).
+    pub(super) fn from_root(field: &str, text: &str, root: Node) -> Self {
+        let (uses_x, uses_t) = root.uses();
+        Self {
+            text: text.to_string(),
+            field: field.to_string(),
+            root,
+            uses_x,
+            uses_t,
+        }
+    }
+
+    pub(super) fn root(&self) -> &Node {
+        &self.root
+    }
+
+    pub(super) fn field(&self) -> &str {
+        &self.field
     }
 
     pub fn text(&self) -> &str {

@@ -5,7 +5,9 @@
 
 pub mod error;
 pub mod expr;
+pub mod nodal;
 pub mod schema;
+pub mod separation;
 
 pub use error::SceneError;
 pub use expr::Expression;

@@ -378,10 +378,7 @@ pub const MAX_STEPS: u64 = 1_000_000_000;
 /// Built-in scenes, embedded from `scenes/*.toml`.
 pub const BUILTIN: &[(&str, &str)] = &[
     ("modal", include_str!("../../scenes/modal.toml")),
-    (
-        "forced-mode",
-        include_str!("../../scenes/forced-mode.toml"),
-    ),
+    ("forced-mode", include_str!("../../scenes/forced-mode.toml")),
     ("impact", include_str!("../../scenes/impact.toml")),
     ("falling-bar", include_str!("../../scenes/falling-bar.toml")),
     (

@@ -206,7 +206,13 @@ fn convergence_section() -> Result<Section, RunError> {
     let mut md = String::from(
         "| scene | elements | dt | L2 error (max over t) | max-norm error | observed order (L2, all levels) |\n|---|---|---|---|---|---|\n",
     );
-    for name in ["modal", "forced-mode", "impact", "clamped-impact", "falling-bar"] {
+    for name in [
+        "modal",
+        "forced-mode",
+        "impact",
+        "clamped-impact",
+        "falling-bar",
+    ] {
         let (_, base) = scene::load(name, &[])?;
         let exact = closed_form::for_scene(name, &base).expect("built-in closed form");
         let mut rows = Vec::new();

@@ -28,6 +28,7 @@ use crate::linalg::norms::max_abs;
 use crate::linalg::tridiag::{SymTridiag, Uniform, dot};
 use crate::linalg::update::add_in_place;
 use crate::scene::expr::Expression;
+use crate::scene::nodal::NodalEvaluator;
 use crate::scene::{Condition, Scene, SceneError, SolverMethod};
 use crate::step::block_pivot::BlockPivotSolver;
 use crate::step::exact::ExactSolver;
@@ -143,13 +144,33 @@ enum LoadTerm {
         expr: Expression,
         m_one: Vec<f64>,
     },
-    /// General `l(x, t)`: nodal values every step, times the full-mesh mass matrix.
-    General {
+    /// `l = Σ_k f_k(t) g_k(x)` ([`Expression::separate`]): `F^n = Σ_k f_k(t_n) (M g_k)`, the
+    /// products `M g_k` computed once. A step where a factor is not finite evaluates `expr`
+    /// itself node by node, so that its error names the node.
+    Separable {
         expr: Expression,
-        mass_full: SymTridiag,
-        nodal: Vec<f64>,
-        full: Vec<f64>,
+        terms: Vec<(Expression, Vec<f64>)>,
     },
+    /// General `l(x, t)`: nodal values every step, times the full-mesh mass matrix.
+    General(GeneralLoad),
+}
+
+/// `F^n = M (l(x_i, t_n))_i` with the nodal values evaluated over the node array.
+#[derive(Clone, Debug)]
+struct GeneralLoad {
+    eval: NodalEvaluator,
+    mass_full: SymTridiag,
+    nodal: Vec<f64>,
+    full: Vec<f64>,
+}
+
+impl GeneralLoad {
+    fn force_into(&mut self, t: f64, first: usize, force: &mut [f64]) -> Result<(), SceneError> {
+        self.eval.eval_into(t, &mut self.nodal)?;
+        self.mass_full.mul_into(&self.nodal, &mut self.full);
+        force.copy_from_slice(&self.full[first..first + force.len()]);
+        Ok(())
+    }
 }
 
 /// A running simulation. Holds `u^n`, `u^n − u^{n−1}` and the matrix products the next step
@@ -258,11 +279,28 @@ impl Simulation {
                     load_rows_into(&disc, |_| 1.0, &mut m_one);
                     LoadTerm::TimeOnly { expr, m_one }
                 } else {
-                    LoadTerm::General {
-                        expr,
-                        mass_full: matrices::mass(disc.variant, nodes, disc.dx),
-                        nodal: vec![0.0; nodes],
-                        full: vec![0.0; nodes],
+                    match expr.separate() {
+                        None => LoadTerm::General(GeneralLoad {
+                            eval: NodalEvaluator::new(
+                                expr,
+                                (0..nodes).map(|i| disc.x(i)).collect(),
+                            ),
+                            mass_full: matrices::mass(disc.variant, nodes, disc.dx),
+                            nodal: vec![0.0; nodes],
+                            full: vec![0.0; nodes],
+                        }),
+                        Some(parts) => {
+                            let mut terms = Vec::with_capacity(parts.len());
+                            for p in parts {
+                                let g = (0..nodes)
+                                    .map(|i| p.space.eval(disc.x(i), 0.0))
+                                    .collect::<Result<Vec<_>, _>>()?;
+                                let mut mg = vec![0.0; n];
+                                load_rows_into(&disc, |i| g[i], &mut mg);
+                                terms.push((p.time, mg));
+                            }
+                            LoadTerm::Separable { expr, terms }
+                        }
                     }
                 }
             }
@@ -369,6 +407,13 @@ impl Simulation {
         }
     }
 
+    /// The load vector `F^n` on the unknowns, as the step from `t_n` uses it (for checks of
+    /// the load path; the next step recomputes its own).
+    pub fn load_vector(&mut self, n: usize) -> Result<&[f64], SceneError> {
+        self.update_force(n)?;
+        Ok(&self.force)
+    }
+
     /// `F^n` into `self.force`.
     fn update_force(&mut self, n: usize) -> Result<(), SceneError> {
         let t = n as f64 * self.disc.dt;
@@ -381,19 +426,37 @@ impl Simulation {
                     *fi = f * mi;
                 }
             }
-            LoadTerm::General {
-                expr,
-                mass_full,
-                nodal,
-                full,
-            } => {
-                for (i, v) in nodal.iter_mut().enumerate() {
-                    *v = expr.eval(i as f64 * self.disc.dx, t)?;
+            LoadTerm::Separable { expr, terms } => {
+                let mut finite = true;
+                for (k, (f, mg)) in terms.iter().enumerate() {
+                    let Ok(fk) = f.eval(0.0, t) else {
+                        finite = false;
+                        break;
+                    };
+                    if k == 0 {
+                        self.force.iter_mut().zip(mg).for_each(|(o, g)| *o = fk * g);
+                    } else {
+                        self.force
+                            .iter_mut()
+                            .zip(mg)
+                            .for_each(|(o, g)| *o += fk * g);
+                    }
                 }
-                mass_full.mul_into(nodal, full);
-                let n = self.force.len();
-                self.force.copy_from_slice(&full[first..first + n]);
+                if !finite {
+                    // Off the hot path: name the node where `l` itself is not finite, or (a
+                    // factor overflowing while the product does not) take `M l` directly.
+                    let x = |i: usize| i as f64 * self.disc.dx;
+                    for i in 0..self.disc.nodes {
+                        expr.eval(x(i), t)?;
+                    }
+                    load_rows_into(
+                        &self.disc,
+                        |i| expr.eval(x(i), t).unwrap_or(f64::NAN),
+                        &mut self.force,
+                    );
+                }
             }
+            LoadTerm::General(general) => general.force_into(t, first, &mut self.force)?,
         }
         Ok(())
     }

@@ -1,0 +1,142 @@
+//! The load vector `F^n = M (l(x_i, t_n))_i` through the fast paths against the plain
+//! evaluation: random sums of products of a function of `t` and a function of `x` (split once
+//! into `Σ_k f_k(t) M g_k`) to round-off, and random non-separable loads (evaluated over the
+//! node array) bit for bit.
+
+mod common;
+use proptest::prelude::*;
+use viscobar::Simulation;
+use viscobar::bar::matrices::{MatrixVariant, mass};
+use viscobar::scene::Expression;
+
+/// The split regroups at most `MAX_TERMS` = 8 terms, each combined by at most a few roundings
+/// along the sums and products of the tree: 64 ε relative to `Σ_k |f_k| M|g_k| + M|l|` (the
+/// regrouped sum may cancel where the tree did not).
+const SEPARATION_TOL: f64 = 64.0 * f64::EPSILON;
+
+/// Nodes of the free-free bar the loads are put on (small: the check is per node).
+const ELEMENTS: u64 = 40;
+
+/// `(F^n from the simulation, M l plain, a scale for round-off)` at step `n` of the `modal`
+/// scene (free-free, every node an unknown) with the load `text`.
+fn load_vectors(text: &str, n: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let scene = common::builtin(
+        "modal",
+        &[
+            &format!("load.density=\"{text}\""),
+            &format!("mesh.elements={ELEMENTS}"),
+            &format!("time.step={}", 1.0 / ELEMENTS as f64),
+        ],
+    );
+    let mut sim = Simulation::new(&scene).unwrap();
+    let disc = sim.discretisation().clone();
+    let t = n as f64 * disc.dt;
+    let fast = sim.load_vector(n).unwrap().to_vec();
+    let expr = Expression::parse("load.density", text, true).unwrap();
+    let m = mass(MatrixVariant::Consistent, disc.nodes, disc.dx);
+    let xs: Vec<f64> = (0..disc.nodes).map(|i| disc.x(i)).collect();
+    let l: Vec<f64> = xs.iter().map(|&x| expr.eval(x, t).unwrap()).collect();
+    let plain = m.mul(&l);
+    let mut scale = m.mul(&l.iter().map(|v| v.abs()).collect::<Vec<_>>());
+    for term in expr.separate().unwrap_or_default() {
+        let f = term.time.eval(0.0, t).unwrap().abs();
+        let g: Vec<f64> = xs
+            .iter()
+            .map(|&x| term.space.eval(x, 0.0).unwrap().abs())
+            .collect();
+        for (s, mg) in scale.iter_mut().zip(m.mul(&g)) {
+            *s += f * mg;
+        }
+    }
+    (fast, plain, scale)
+}
+
+/// Factors of one variable (bounded, finite on the bar and the times used).
+fn factor(var: &'static str) -> impl Strategy<Value = String> {
+    prop_oneof![
+        (0.5f64..3.0).prop_map(|c| format!("{c}")),
+        Just(var.to_string()),
+        (0.5f64..3.0).prop_map(move |c| format!("sin({c}*{var})")),
+        (0.5f64..3.0).prop_map(move |c| format!("cos({c}*{var})")),
+        (0.5f64..3.0).prop_map(move |c| format!("exp(-{c}*{var})")),
+        (0.5f64..3.0).prop_map(move |c| format!("(1 + {var}^2)/({c} + {var})")),
+    ]
+}
+
+/// Random trees of sums, differences, products and quotients (by a factor of one variable)
+/// over factors of `x` and of `t`: they always separate, though not always within the term limit.
+fn separable() -> impl Strategy<Value = String> {
+    let leaf = prop_oneof![factor("x"), factor("t")];
+    leaf.prop_recursive(4, 16, 2, |inner| {
+        prop_oneof![
+            (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("({a} + {b})")),
+            (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("({a} - {b})")),
+            (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("({a})*({b})")),
+            (inner.clone(), factor("t")).prop_map(|(a, b)| format!("({a})/(2 + {b})")),
+            (inner.clone(), factor("x")).prop_map(|(a, b)| format!("({a})/(2 + {b})")),
+            inner.prop_map(|a| format!("-({a})")),
+        ]
+    })
+}
+
+/// A separable tree with a non-separable part mixed in.
+fn non_separable() -> impl Strategy<Value = String> {
+    let mixed = prop_oneof![
+        (0.5f64..3.0).prop_map(|c| format!("sin({c}*x*t)")),
+        Just("exp(-(x - t)^2)".to_string()),
+        Just("min(x, t)".to_string()),
+        Just("if(x < t, 1, -1)".to_string()),
+    ];
+    (separable(), mixed).prop_map(|(a, m)| format!("{a} + ({a})*{m}"))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn separated_loads_match_the_plain_evaluation(text in separable(), n in 0usize..80) {
+        let (fast, plain, scale) = load_vectors(&text, n);
+        for i in 0..fast.len() {
+            prop_assert!(
+                (fast[i] - plain[i]).abs() <= SEPARATION_TOL * scale[i],
+                "{text} at node {i}, step {n}: {} against {}", fast[i], plain[i]
+            );
+        }
+    }
+
+    #[test]
+    fn non_separable_loads_match_the_plain_evaluation_bitwise(text in non_separable(), n in 0usize..80) {
+        let (fast, plain, _) = load_vectors(&text, n);
+        let expr = Expression::parse("load.density", &text, true).unwrap();
+        prop_assert!(expr.separate().is_none(), "{text} separated");
+        for i in 0..fast.len() {
+            prop_assert_eq!(fast[i].to_bits(), plain[i].to_bits(), "{} at node {}", text, i);
+        }
+    }
+}
+
+#[test]
+fn the_talk_loads_take_the_separated_path() {
+    for text in ["sin(t*sqrt(2))*cos(2*x)", "-0.5 + 0.8*sin(3*t)*cos(pi*x/2)"] {
+        let e = Expression::parse("load.density", text, true).unwrap();
+        assert!(e.separate().is_some(), "{text}");
+        let (fast, plain, scale) = load_vectors(text, 17);
+        for i in 0..fast.len() {
+            assert!((fast[i] - plain[i]).abs() <= SEPARATION_TOL * scale[i]);
+        }
+    }
+}
+
+#[test]
+fn a_load_that_is_not_finite_is_named_with_its_node() {
+    // Separable, infinite at x = 0.5 from t = 0 on: the error names the field and the point.
+    let scene = common::builtin(
+        "modal",
+        &["load.density=\"cos(t)/(x - 0.5)\"", "mesh.elements=4"],
+    );
+    let err = match Simulation::new(&scene) {
+        Err(e) => e.to_string(),
+        Ok(mut sim) => sim.load_vector(0).unwrap_err().to_string(),
+    };
+    assert!(err.contains("load.density") && err.contains("0.5"), "{err}");
+}
