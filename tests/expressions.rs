@@ -171,9 +171,20 @@ impl Tree {
             Sin(a) => a.value(x, t).sin(),
             Min(a, b) => a.value(x, t).min(b.value(x, t)),
             Max(a, b) => a.value(x, t).max(b.value(x, t)),
-            Less(a, b) => f64::from(u8::from(a.value(x, t) < b.value(x, t))),
+            // A comparison or condition on NaN is NaN (README, "Expressions"), not false.
+            Less(a, b) => {
+                let (a, b) = (a.value(x, t), b.value(x, t));
+                if a.is_nan() || b.is_nan() {
+                    f64::NAN
+                } else {
+                    f64::from(u8::from(a < b))
+                }
+            }
             If(c, a, b) => {
-                if c.value(x, t) != 0.0 {
+                let c = c.value(x, t);
+                if c.is_nan() {
+                    f64::NAN
+                } else if c != 0.0 {
                     a.value(x, t)
                 } else {
                     b.value(x, t)

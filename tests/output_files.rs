@@ -46,3 +46,79 @@ fn displacement_csv_reads_back_to_the_simulation_bits() {
     assert!(kept > 2);
     assert!(rows.next().is_none(), "no rows beyond the kept steps");
 }
+
+/// Runs `scene` into a fresh folder; returns the `x` of each row of `displacement.csv`, grouped
+/// by kept step, and summary.json.
+fn written(scene: &viscobar::Scene, tag: &str) -> (Vec<Vec<f64>>, serde_json::Value) {
+    let dir = std::env::temp_dir().join(format!("viscobar-output-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    run_to_dir("impact", scene, &dir, false).unwrap();
+    let text = std::fs::read_to_string(dir.join("displacement.csv")).unwrap();
+    let summary =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    let mut steps: Vec<(String, Vec<f64>)> = Vec::new();
+    for row in text.lines().skip(1) {
+        let mut cells = row.split(',');
+        let t = cells.next().unwrap().to_string();
+        let x: f64 = cells.next().unwrap().parse().unwrap();
+        match steps.last_mut() {
+            Some((last, xs)) if *last == t => xs.push(x),
+            _ => steps.push((t, vec![x])),
+        }
+    }
+    (steps.into_iter().map(|s| s.1).collect(), summary)
+}
+
+/// `x` is written rounded to 12 significant digits (README, "Output files").
+const X_ROUNDING_TOL: f64 = 1e-12;
+
+#[test]
+fn every_node_is_written_while_the_rows_stay_within_max_rows() {
+    let scene = common::builtin("impact", &["output.every=50"]);
+    let sampling = scene.output_sampling();
+    let (steps, summary) = written(&scene, "all");
+    assert_eq!(sampling.node_stride, 1);
+    assert!(steps.iter().all(|xs| xs.len() == scene.elements() + 1));
+    assert_eq!(steps.len() as u64, sampling.kept_steps);
+    assert_eq!(summary["output"]["rows"], sampling.rows);
+}
+
+#[test]
+fn a_run_past_max_rows_is_thinned_to_strided_nodes_with_both_ends() {
+    for (overrides, tag) in [
+        (&["output.every=50", "output.max_rows=300"][..], "bounded"),
+        (&["output.every=50", "output.nodes=7"][..], "nodes"),
+    ] {
+        let scene = common::builtin("impact", overrides);
+        let s = scene.output_sampling();
+        let (steps, summary) = written(&scene, tag);
+        let length = scene.bar.length;
+        for xs in &steps {
+            assert_eq!(xs.len() as u64, s.nodes_written, "{tag}");
+            assert_eq!(xs[0], 0.0);
+            assert!(
+                (xs[xs.len() - 1] - length).abs() <= X_ROUNDING_TOL * length,
+                "{tag}: last x"
+            );
+        }
+        let rows = (steps.len() * steps[0].len()) as u64;
+        assert_eq!(rows, s.rows);
+        assert_eq!(summary["output"]["node_stride"], s.node_stride);
+        if tag == "bounded" {
+            assert!(rows <= 300, "{rows} rows");
+            // The fewest nodes dropped: one stride less would pass the bound.
+            let n = scene.elements() as u64;
+            let at = |k: u64| n / k + 1 + u64::from(!n.is_multiple_of(k));
+            assert!(s.node_stride > 1 && s.kept_steps * at(s.node_stride - 1) > 300);
+        } else {
+            assert!(s.nodes_written <= 7 && s.nodes_written >= 6, "{s:?}");
+        }
+    }
+}
+
+#[test]
+fn output_nodes_below_two_is_refused_naming_the_key() {
+    let err = viscobar::scene::load("impact", &["output.nodes=1".into()]).unwrap_err();
+    assert!(err.to_string().contains("output.nodes"), "{err}");
+}

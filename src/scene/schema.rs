@@ -337,6 +337,14 @@ pub struct OutputSpec {
     /// step and at the last; the contact state is recorded at every step regardless.
     #[serde(default = "one")]
     pub diagnostics_every: u64,
+    /// Nodes written at each kept step of `displacement.csv`, evenly strided, both ends always
+    /// included. Unset: every node, unless that would write more than `max_rows` rows.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nodes: Option<u64>,
+    /// The bound on the rows of `displacement.csv` when `nodes` is unset (about 40 MB of text
+    /// at the default); raise it, or set `nodes`, to write more.
+    #[serde(default = "default_max_rows")]
+    pub max_rows: u64,
 }
 
 impl Default for OutputSpec {
@@ -344,7 +352,36 @@ impl Default for OutputSpec {
         Self {
             every: 1,
             diagnostics_every: 1,
+            nodes: None,
+            max_rows: DEFAULT_MAX_ROWS,
         }
+    }
+}
+
+/// Default bound on the rows of `displacement.csv` (`[output] max_rows`).
+pub const DEFAULT_MAX_ROWS: u64 = 1_000_000;
+
+fn default_max_rows() -> u64 {
+    DEFAULT_MAX_ROWS
+}
+
+/// What `displacement.csv` holds: the kept steps and the written nodes (reported in
+/// summary.json as `output`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct OutputSampling {
+    /// Every `every`-th step is kept, and `t = 0` and the last step.
+    pub every: u64,
+    /// Every `node_stride`-th node is written, and the last node.
+    pub node_stride: u64,
+    pub kept_steps: u64,
+    pub nodes_written: u64,
+    pub rows: u64,
+}
+
+impl OutputSampling {
+    /// Whether node `i` of `nodes` is written.
+    pub fn writes_node(&self, i: usize, nodes: usize) -> bool {
+        (i as u64).is_multiple_of(self.node_stride) || i + 1 == nodes
     }
 }
 
@@ -548,6 +585,22 @@ impl Scene {
                 "must be >= 1",
             ));
         }
+        if let Some(n) = self.output.nodes
+            && n < 2
+        {
+            return Err(invalid(
+                "output.nodes",
+                n as f64,
+                "must be >= 2 (both ends are always written)",
+            ));
+        }
+        if self.output.max_rows < 2 {
+            return Err(invalid(
+                "output.max_rows",
+                self.output.max_rows as f64,
+                "must be >= 2",
+            ));
+        }
         Expression::parse("initial.displacement", &self.initial.displacement, false)?;
         Expression::parse("initial.velocity", &self.initial.velocity, false)?;
         if let Some(d) = &self.load.density {
@@ -587,6 +640,36 @@ impl Scene {
     /// `steps · dt`, which differs from `T` by at most `dt / 2`.
     pub fn steps(&self) -> usize {
         (self.time.end / self.time.step).round() as usize
+    }
+
+    /// The sampling of `displacement.csv`: the kept steps (`[output] every`), and the nodes
+    /// (`[output] nodes`, or all of them unless the rows would pass `[output] max_rows`, then
+    /// the fewest strided away that keep within it, both ends always written).
+    pub fn output_sampling(&self) -> OutputSampling {
+        let steps = self.steps() as u64;
+        let every = self.output.every;
+        let kept_steps = 1 + steps / every + u64::from(!steps.is_multiple_of(every));
+        let nodes = self.elements() as u64 + 1;
+        let wanted = match self.output.nodes {
+            Some(n) => n.min(nodes),
+            None if kept_steps.saturating_mul(nodes) <= self.output.max_rows => nodes,
+            None => (self.output.max_rows / kept_steps).clamp(2, nodes),
+        };
+        // The smallest stride writing at most `wanted` nodes (the last node comes on top of
+        // the multiples of the stride unless it is one of them).
+        let mut stride = (nodes - 1).div_ceil(wanted - 1).max(1);
+        let written = |s: u64| (nodes - 1) / s + 1 + u64::from(!(nodes - 1).is_multiple_of(s));
+        while written(stride) > wanted {
+            stride += 1;
+        }
+        let nodes_written = written(stride);
+        OutputSampling {
+            every,
+            node_stride: stride,
+            kept_steps,
+            nodes_written,
+            rows: kept_steps * nodes_written,
+        }
     }
 
     /// The Signorini ends as `(side, gap)`, left first.

@@ -183,10 +183,15 @@ fn write_run(
     let mut v = vec![0.0; nodes];
     sim.initial_state_into(&mut u, &mut v);
     // The written x, rounded once for the run rather than at every kept step.
-    let xs: Vec<String> = (0..nodes)
-        .map(|i| output_time(disc.x(i)).to_string())
+    let sampling = scene.output_sampling();
+    let written: Vec<usize> = (0..nodes)
+        .filter(|&i| sampling.writes_node(i, nodes))
         .collect();
-    write_profile(&mut disp, 0.0, &xs, &u, &v).map_err(io(&disp_path))?;
+    let xs: Vec<String> = written
+        .iter()
+        .map(|&i| output_time(disc.x(i)).to_string())
+        .collect();
+    write_profile(&mut disp, 0.0, &xs, &written, &u, &v).map_err(io(&disp_path))?;
     let steps = scene.steps();
     let every = scene.output.every as usize;
     let bar = Progress::new(progress, steps, nodes);
@@ -194,7 +199,7 @@ fn write_run(
     if keep(1) {
         sim.displacement_into(&mut u);
         sim.velocity_into(&mut v);
-        write_profile(&mut disp, sim.time(), &xs, &u, &v).map_err(io(&disp_path))?;
+        write_profile(&mut disp, sim.time(), &xs, &written, &u, &v).map_err(io(&disp_path))?;
     }
     for _ in 1..steps {
         let r = sim.step()?;
@@ -203,14 +208,15 @@ fn write_run(
         if keep(r.step) {
             sim.displacement_into(&mut u);
             sim.velocity_into(&mut v);
-            write_profile(&mut disp, sim.time(), &xs, &u, &v).map_err(io(&disp_path))?;
+            write_profile(&mut disp, sim.time(), &xs, &written, &u, &v).map_err(io(&disp_path))?;
         }
         bar.step(r.step);
     }
     bar.finish();
     hist.flush().map_err(io(&hist_path))?;
     disp.flush().map_err(io(&disp_path))?;
-    let summary = tracker.finish(name, &sim, start.elapsed().as_secs_f64());
+    let mut summary = tracker.finish(name, &sim, start.elapsed().as_secs_f64());
+    summary.output = Some(sampling);
     let json_path = dir.join("summary.json");
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
     std::fs::write(&json_path, json + "\n").map_err(io(&json_path))?;
@@ -256,19 +262,21 @@ fn write_history_row(
     writeln!(w, ",{}", r.iterations)
 }
 
-/// One row a node, `t,x,u,v`: `t` and `x` rounded (see [`output_time`]), `x` from the run's
+/// One row a written node (`nodes`, with their `xs`), `t,x,u,v`: `t` and `x` rounded (see [`output_time`]), `x` from the run's
 /// `xs` (formatted once per run), `u` and `v` in the shortest form that reads back to the same
 /// `f64` (Żmij; `1.5e-7` rather than `0.00000015`), several times faster than `core::fmt`.
 fn write_profile(
     w: &mut impl Write,
     t: f64,
     xs: &[String],
+    nodes: &[usize],
     u: &[f64],
     v: &[f64],
 ) -> std::io::Result<()> {
     let t = output_time(t).to_string();
     let (mut bu, mut bv) = (zmij::Buffer::new(), zmij::Buffer::new());
-    for ((x, &u), &v) in xs.iter().zip(u).zip(v) {
+    for (x, &i) in xs.iter().zip(nodes) {
+        let (u, v) = (u[i], v[i]);
         w.write_all(t.as_bytes())?;
         w.write_all(b",")?;
         w.write_all(x.as_bytes())?;

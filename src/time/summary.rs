@@ -110,6 +110,9 @@ pub struct Summary {
     /// whole contact set (`obstacle`: an episode lasts while any node is in contact).
     pub contact_episodes: std::collections::BTreeMap<String, Vec<ContactEpisode>>,
     pub solver_iterations: Iterations,
+    /// What `displacement.csv` holds (written runs only): kept steps, node stride, rows.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub output: Option<crate::scene::OutputSampling>,
     /// Worst optimality residuals of the solver's answers, for solvers that audit them
     /// (`osqp`, `penalty`; see `viscobar::step::audit`).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -338,6 +341,7 @@ impl Tracker {
                 mean: self.iterations_sum as f64 / self.records.max(1) as f64,
                 max: self.iterations_max,
             },
+            output: None,
             inaccurate_steps: report.as_ref().and_then(|r| r.inaccurate_steps),
             audit: report.map(|r| r.audit),
         }
