@@ -10,6 +10,7 @@ pub mod compare;
 pub mod converge;
 pub mod figure_writer;
 pub mod figures;
+pub mod mass_figure;
 pub mod mass_variants;
 pub mod sampled_run;
 pub mod stiff;
