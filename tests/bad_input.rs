@@ -115,11 +115,7 @@ const CASES: &[(&str, Edit, &str)] = &[
         Edit::Set(&["bar.matrices=\"lumped\""]),
         "lumped",
     ),
-    (
-        "unknown mass",
-        Edit::Set(&["bar.mass=\"heavy\""]),
-        "heavy",
-    ),
+    ("unknown mass", Edit::Set(&["bar.mass=\"heavy\""]), "heavy"),
     (
         "mass variant with the talk's printed matrices",
         Edit::Set(&["bar.mass=\"lumped\"", "bar.matrices=\"talk-printed\""]),

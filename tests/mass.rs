@@ -48,14 +48,20 @@ fn refused_combinations_name_both_keys_and_exit_2() {
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{scene} {sets:?}: {err}");
         for key in keys {
-            assert!(err.contains(key), "{scene} {sets:?}: `{key}` not named: {err}");
+            assert!(
+                err.contains(key),
+                "{scene} {sets:?}: `{key}` not named: {err}"
+            );
         }
         assert!(!err.contains("panicked"), "{err}");
         assert!(!out.exists(), "{scene} {sets:?}: output written");
     }
     // Lumped goes with an obstacle; consistent with the talk's matrices.
     common::builtin("distributed", &["bar.mass=lumped"]);
-    common::builtin("impact", &["bar.matrices=talk-printed", "bar.mass=consistent"]);
+    common::builtin(
+        "impact",
+        &["bar.matrices=talk-printed", "bar.mass=consistent"],
+    );
 }
 
 /// `viscobar run SCENE --set bar.mass=V` is the library's `run_with_mass(…, V)`: the same final
@@ -68,7 +74,14 @@ fn set_bar_mass_on_the_command_line_is_run_with_mass() {
     for mass in MassVariant::ALL {
         let out = base.join(mass.name());
         let set = format!("bar.mass={}", mass.name());
-        let o = viscobar(&["run", "impact", "--out", out.to_str().unwrap(), "--set", &set]);
+        let o = viscobar(&[
+            "run",
+            "impact",
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            &set,
+        ]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let json: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
@@ -164,12 +177,17 @@ fn the_mass_study_shows_the_claimed_bands() {
         if g[0].scene == "impact" && g[0].alpha == 0.0 {
             for r in g {
                 let d = (r.energy_drop - r.contact_dissipation).abs();
-                assert!(d <= DROP_TOL, "{at} {}: drop − dissipation {d:e}", r.elements);
+                assert!(
+                    d <= DROP_TOL,
+                    "{at} {}: drop − dissipation {d:e}",
+                    r.elements
+                );
             }
         }
     }
     let ratio = |scene, alpha, mass, f: fn(&MassRow) -> f64| {
-        f(finest(&rows, scene, alpha, mass)) / f(finest(&rows, scene, alpha, MassVariant::Consistent))
+        f(finest(&rows, scene, alpha, mass))
+            / f(finest(&rows, scene, alpha, MassVariant::Consistent))
     };
     for scene in ["impact", "falling-bar"] {
         let loss = |m| ratio(scene, 0.0, m, |r: &MassRow| r.contact_dissipation);
@@ -182,7 +200,9 @@ fn the_mass_study_shows_the_claimed_bands() {
             (LUMPED_LOSS_RATIO_BAND.0..=LUMPED_LOSS_RATIO_BAND.1).contains(&lump),
             "{scene}: lumped/consistent loss {lump}"
         );
-        let tv = ratio(scene, 0.0, MassVariant::Redistributed, |r| r.reaction_variation);
+        let tv = ratio(scene, 0.0, MassVariant::Redistributed, |r| {
+            r.reaction_variation
+        });
         assert!(tv >= REDISTRIBUTED_TV_RATIO_MIN, "{scene}: TV ratio {tv}");
         let l2 = ratio(scene, 0.0, MassVariant::Redistributed, |r| r.l2_error);
         assert!(
@@ -191,7 +211,10 @@ fn the_mass_study_shows_the_claimed_bands() {
         );
         for alpha in [0.0, 0.1] {
             let l2 = ratio(scene, alpha, MassVariant::Lumped, |r| r.l2_error);
-            assert!(l2 >= LUMPED_L2_RATIO_MIN, "{scene} α = {alpha}: lumped/consistent L2 {l2}");
+            assert!(
+                l2 >= LUMPED_L2_RATIO_MIN,
+                "{scene} α = {alpha}: lumped/consistent L2 {l2}"
+            );
         }
     }
 }
@@ -200,16 +223,32 @@ fn the_mass_study_shows_the_claimed_bands() {
 #[test]
 fn the_mass_command_writes_the_figure() {
     let out = std::env::temp_dir().join(format!("viscobar-mass-figure-{}", std::process::id()));
-    let o = viscobar(&["mass", "--out", out.to_str().unwrap(), "--set", "time.end=1"]);
+    let o = viscobar(&[
+        "mass",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "time.end=1",
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let png = std::fs::read(out.join("mass-variants-impact.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"), "not a PNG");
     let svg = std::fs::read_to_string(out.join("mass-variants-impact.svg")).unwrap();
     for variant in MassVariant::ALL {
-        assert!(svg.contains(variant.name()), "{} not in the SVG", variant.name());
+        assert!(
+            svg.contains(variant.name()),
+            "{} not in the SVG",
+            variant.name()
+        );
     }
     let _ = std::fs::remove_dir_all(&out);
-    let o = viscobar(&["mass", "--out", out.to_str().unwrap(), "--set", "bar.mass=heavy"]);
+    let o = viscobar(&[
+        "mass",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "bar.mass=heavy",
+    ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(!out.exists());
 }

@@ -167,7 +167,9 @@ mod mass_variants {
     use viscobar::bar::matrices::{MassVariant, MatrixVariant, mass_matrix, stiffness};
     use viscobar::linalg::ldlt::Ldlt;
     use viscobar::linalg::tridiag::SymTridiag;
-    use viscobar::scene::{REDISTRIBUTED_MIN_ELEMENTS_ONE_END, REDISTRIBUTED_MIN_ELEMENTS_TWO_ENDS};
+    use viscobar::scene::{
+        REDISTRIBUTED_MIN_ELEMENTS_ONE_END, REDISTRIBUTED_MIN_ELEMENTS_TWO_ENDS,
+    };
 
     /// `1ᵀM1` and `xᵀM1` sum `J + 2` rounded entries of size Δx (times x <= L): a few ulps of
     /// `L` and `L²` per entry, far below the `Δx²/6` a lost moment correction would leave.
@@ -342,12 +344,18 @@ mod mass_variants {
     /// Δx/6, off-diagonals 1 inside), whose third pivot is `1 − 11/10 < 0`.
     #[test]
     fn too_short_bars_are_refused() {
-        let pivots = [11.0, 1.0, 1.0, 11.0].into_iter().scan(None, |p: &mut Option<f64>, d| {
-            let next = p.map_or(d, |q| d - 1.0 / q);
-            *p = Some(next);
-            Some(next)
-        });
-        assert!(pivots.clone().any(|p| p < 0.0), "{:?}", pivots.collect::<Vec<_>>());
+        let pivots = [11.0, 1.0, 1.0, 11.0]
+            .into_iter()
+            .scan(None, |p: &mut Option<f64>, d| {
+                let next = p.map_or(d, |q| d - 1.0 / q);
+                *p = Some(next);
+                Some(next)
+            });
+        assert!(
+            pivots.clone().any(|p| p < 0.0),
+            "{:?}",
+            pivots.collect::<Vec<_>>()
+        );
         for ends in [[true, false], [false, true], [true, true]] {
             let least = least(ends);
             for elements in 1..least {

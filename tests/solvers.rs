@@ -106,7 +106,10 @@ fn check_solver(method: Method) {
             // Redistribution with an obstacle is refused, naming both keys.
             assert_eq!(mass, MassVariant::Redistributed, "{scene_name}: {err}");
             let err = err.to_string();
-            assert!(err.contains("bar.mass") && err.contains("obstacle.gap"), "{err}");
+            assert!(
+                err.contains("bar.mass") && err.contains("obstacle.gap"),
+                "{err}"
+            );
             continue;
         }
         let label = format!("{scene_name} [mass {}]", mass.name());

@@ -137,8 +137,18 @@ impl Drawing for MassFigure {
             let colour = COLOURS[k % COLOURS.len()];
             let name = s.mass.name();
             let panels = [
-                (&rows[2 * k], format!("{name}: energy E^(n+1/2)"), e_range, &s.energy),
-                (&rows[2 * k + 1], format!("{name}: reaction at x = 0"), r_range, &s.reaction),
+                (
+                    &rows[2 * k],
+                    format!("{name}: energy E^(n+1/2)"),
+                    e_range,
+                    &s.energy,
+                ),
+                (
+                    &rows[2 * k + 1],
+                    format!("{name}: reaction at x = 0"),
+                    r_range,
+                    &s.reaction,
+                ),
             ];
             for (p, (area, caption, (lo, hi), values)) in panels.into_iter().enumerate() {
                 let mut chart = ChartBuilder::on(area)
@@ -164,7 +174,14 @@ impl Drawing for MassFigure {
                     && let Some(([a, b], v0)) = self.exact
                 {
                     chart.draw_series(LineSeries::new(
-                        [(0.0, 0.0), (a, 0.0), (a, v0), (b, v0), (b, 0.0), (t_end, 0.0)],
+                        [
+                            (0.0, 0.0),
+                            (a, 0.0),
+                            (a, v0),
+                            (b, v0),
+                            (b, 0.0),
+                            (t_end, 0.0),
+                        ],
                         EXACT_GREY.stroke_width(2),
                     ))?;
                 }

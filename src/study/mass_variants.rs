@@ -141,7 +141,9 @@ fn first_episode(summary: &Summary) -> Option<(Vec<[f64; 2]>, f64, f64, f64)> {
 pub enum MassStudyError {
     #[error(transparent)]
     Run(#[from] RunError),
-    #[error("{scene} (mass {mass}, α = {alpha}, {elements} elements): no complete contact episode at the left end")]
+    #[error(
+        "{scene} (mass {mass}, α = {alpha}, {elements} elements): no complete contact episode at the left end"
+    )]
     NoEpisode {
         scene: &'static str,
         mass: &'static str,
@@ -260,9 +262,7 @@ fn study_one(
 pub fn group_order(group: &[MassRow], f: impl Fn(&MassRow) -> f64) -> Option<f64> {
     let h: Vec<f64> = group.iter().map(|r| r.dx).collect();
     let e: Vec<f64> = group.iter().map(f).collect();
-    e.iter()
-        .all(|v| *v > 0.0)
-        .then(|| observed_order(&h, &e))
+    e.iter().all(|v| *v > 0.0).then(|| observed_order(&h, &e))
 }
 
 /// The rows grouped by (scene, α, variant), each group the levels in order.
