@@ -334,3 +334,67 @@ pub fn markdown(rows: &[MassRow]) -> String {
     }
     md
 }
+
+/// The scenes of the certificate table (those of the generic checker's mass variants in
+/// `tests/solvers.rs`): one and two Signorini ends, a clamped far end, a load, an obstacle.
+pub const CERTIFICATE_SCENES: [&str; 5] = [
+    "impact",
+    "falling-bar",
+    "clamped-impact",
+    "both-ends",
+    "distributed",
+];
+
+/// The certificate of every (scene, variant, solver) for the redistributed and lumped mass
+/// (consistent: VERIFICATION.md's "Scenes" and "Step solvers" sections): each solver run side
+/// by side with the exact solver on the same variant, as Markdown: the largest identity
+/// residual, `|gap·r|`, penetration and distance to exact, or why the combination is refused.
+pub fn certificate_markdown() -> Result<String, RunError> {
+    use crate::scene::SolverMethod;
+    let mut md = String::from(
+        "| scene | mass | solver | max identity residual | max abs(gap·reaction) | max penetration | max abs(u − u_exact) |\n\
+         |---|---|---|---|---|---|---|\n",
+    );
+    for name in CERTIFICATE_SCENES {
+        let (_, base) = scene::load(name, &[])?;
+        for mass in [MassVariant::Redistributed, MassVariant::Lumped] {
+            let exact = match with_mass(&base, mass) {
+                Ok(s) => s,
+                Err(e) => {
+                    let _ = writeln!(
+                        md,
+                        "| {name} | {} | all | refused: {e} | | | |",
+                        mass.name()
+                    );
+                    continue;
+                }
+            };
+            for method in [
+                SolverMethod::Exact,
+                SolverMethod::Osqp,
+                SolverMethod::Penalty,
+            ] {
+                let mut s = exact.clone();
+                s.solver.method = method;
+                let row = match crate::study::compare::compare(name, &exact, &s) {
+                    Ok(c) => format!(
+                        "{:.1e} | {:.1e} | {:.1e} | {:.1e}",
+                        c.summary.max_identity_residual,
+                        c.summary.max_complementarity,
+                        c.summary.max_violation,
+                        c.agreement.max_difference
+                    ),
+                    Err(RunError::Scene(e)) => format!("refused: {e} | | |"),
+                    Err(e) => return Err(e),
+                };
+                let _ = writeln!(
+                    md,
+                    "| {name} | {} | {} | {row} |",
+                    mass.name(),
+                    method.name()
+                );
+            }
+        }
+    }
+    Ok(md)
+}

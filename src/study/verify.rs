@@ -360,8 +360,11 @@ fn mass_variants_section() -> Result<Section, crate::study::converge::ConvergeEr
         MassStudyError::Run(r) => ConvergeError::Run(r),
         other => ConvergeError::BadInput(other.to_string()),
     })?;
+    let mut markdown = crate::study::mass_variants::certificate_markdown()?;
+    markdown.push('\n');
+    markdown.push_str(&crate::study::mass_variants::markdown(&rows));
     Ok(Section {
         id: "mass-variants",
-        markdown: crate::study::mass_variants::markdown(&rows),
+        markdown,
     })
 }
