@@ -252,3 +252,16 @@ fn the_mass_command_writes_the_figure() {
     assert_eq!(o.status.code(), Some(2));
     assert!(!out.exists());
 }
+
+/// The README shows `docs/figures/mass-variants-impact.png`, which `viscobar mass --out
+/// docs/figures` writes (the name; the pixels are not pinned, as for the talk's figures).
+#[test]
+fn the_committed_mass_figure_is_the_one_the_command_writes() {
+    let name = format!("{}.png", viscobar::study::mass_figure::STEM);
+    let docs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/figures");
+    assert!(docs.join(&name).is_file(), "docs/figures/{name} missing");
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    assert!(readme.contains(&format!("(docs/figures/{name})")));
+    assert!(readme.contains("cargo run --release -- mass --out docs/figures"));
+}
