@@ -265,3 +265,37 @@ fn the_committed_mass_figure_is_the_one_the_command_writes() {
     assert!(readme.contains(&format!("(docs/figures/{name})")));
     assert!(readme.contains("cargo run --release -- mass --out docs/figures"));
 }
+
+/// Start-up with a massless node: its Taylor term is 0, so away from contact `u^1 = u^0 + Δt u_1`
+/// there (the projection of an inactive start-up is `z = C⁻¹C w = w` up to the solve's
+/// round-off), while the massive nodes accelerate. `one-end` starts at rest in the shape
+/// `0.3 cos 2x`, its left end 0.4 above the obstacle.
+#[test]
+fn the_start_up_leaves_the_massless_node_without_acceleration() {
+    /// Round-off of `C⁻¹(C w)` relative to `‖w‖∞` (condition number of C about 10 here).
+    const START_TOL: f64 = 1e-14;
+    use viscobar::Simulation;
+    for mass in MassVariant::ALL {
+        let scene = common::builtin("one-end", &[&format!("bar.mass={}", mass.name())]);
+        let sim = Simulation::new(&scene).unwrap();
+        let (u0, _) = sim.initial_state();
+        let u1 = sim.displacement();
+        let moved = (u1[0] - u0[0]).abs();
+        let scale = u1
+            .iter()
+            .zip(&u0)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(scale > 0.0, "{mass:?}: the bar does not move at the start");
+        if mass == MassVariant::Redistributed {
+            assert!(
+                moved <= START_TOL * scale,
+                "{mass:?}: massless node moved {moved:e}"
+            );
+        } else {
+            assert!(
+                moved > START_TOL * scale * 1e6,
+                "{mass:?}: end node at rest ({moved:e})"
+            );
+        }
+    }
+}
