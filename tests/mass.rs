@@ -299,3 +299,25 @@ fn the_start_up_leaves_the_massless_node_without_acceleration() {
         }
     }
 }
+
+/// The list a `converge --mass` option will take (not wired yet): every variant by name, errors
+/// naming the option and the bad item.
+#[test]
+fn mass_lists_parse_and_bad_items_are_named() {
+    use viscobar::study::mass_variants::parse_mass_list;
+    assert_eq!(
+        parse_mass_list("consistent, redistributed,lumped").unwrap(),
+        MassVariant::ALL.to_vec()
+    );
+    assert_eq!(
+        parse_mass_list("lumped").unwrap(),
+        vec![MassVariant::Lumped]
+    );
+    for bad in ["heavy", "lumped,", "", "Lumped"] {
+        let err = parse_mass_list(bad).unwrap_err().to_string();
+        assert!(
+            err.contains("--mass") && err.contains("redistributed"),
+            "{bad}: {err}"
+        );
+    }
+}

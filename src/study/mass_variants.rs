@@ -24,6 +24,23 @@ pub fn with_mass(scene: &Scene, mass: MassVariant) -> Result<Scene, SceneError> 
     Ok(s)
 }
 
+/// Parses a comma-separated list of mass variants (`consistent,redistributed,lumped`), for a
+/// `--mass` option; the error names the option, the bad item and the allowed values.
+pub fn parse_mass_list(list: &str) -> Result<Vec<MassVariant>, SceneError> {
+    list.split(',')
+        .map(|item| {
+            MassVariant::parse(item).ok_or_else(|| SceneError::Invalid {
+                field: "--mass".into(),
+                value: format!("\"{}\"", item.trim()),
+                allowed: format!(
+                    "a comma-separated list of {}",
+                    MassVariant::ALL.map(MassVariant::name).join(", ")
+                ),
+            })
+        })
+        .collect()
+}
+
 /// Runs `scene` with mass variant `mass` (its solver, in memory): the records, the summary and
 /// the finished simulation, as [`crate::time::run::run_in_memory`].
 pub fn run_with_mass(
