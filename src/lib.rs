@@ -31,7 +31,7 @@
 //!
 //! let scene = Scene {
 //!     description: None,
-//!     bar: Bar { length: 1.0, viscosity: 0.0, matrices: Default::default() },
+//!     bar: Bar { length: 1.0, viscosity: 0.0, matrices: Default::default(), mass: Default::default() },
 //!     left: EndSpec { condition: Condition::Signorini, gap: Some(0.1) },
 //!     right: EndSpec { condition: Condition::Free, gap: None },
 //!     initial: Initial { displacement: "0".into(), velocity: "-1".into() },

@@ -44,6 +44,16 @@ enum Command {
         #[arg(long)]
         solver: Option<String>,
     },
+    /// Run `impact` with each mass variant (consistent, redistributed, lumped) and draw
+    /// mass-variants-impact.png/.svg: energy and contact reaction, one variant per row.
+    Mass {
+        /// Output folder.
+        #[arg(long, default_value = viscobar::study::mass_figure::DEFAULT_OUT)]
+        out: PathBuf,
+        /// Override a key of the impact scene, e.g. --set bar.viscosity=0.1 (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
     /// Refinement study of the step solvers (convergence.csv, work-precision.png/.svg), or
     /// with --viscosity-sweep the alpha -> 0 study of the impact scene.
     Converge {
@@ -154,6 +164,20 @@ fn main() {
             }
             match run(&name, out, &set) {
                 Ok(()) => 0,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    e.exit_code()
+                }
+            }
+        }
+        Command::Mass { out, set } => {
+            match viscobar::study::mass_figure::write_mass_figure(&out, &set) {
+                Ok(files) => {
+                    for f in &files {
+                        println!("wrote {}", f.display());
+                    }
+                    0
+                }
                 Err(e) => {
                     eprintln!("error: {e}");
                     e.exit_code()

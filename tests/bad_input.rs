@@ -115,6 +115,22 @@ const CASES: &[(&str, Edit, &str)] = &[
         Edit::Set(&["bar.matrices=\"lumped\""]),
         "lumped",
     ),
+    ("unknown mass", Edit::Set(&["bar.mass=\"heavy\""]), "heavy"),
+    (
+        "mass variant with the talk's printed matrices",
+        Edit::Set(&["bar.mass=\"lumped\"", "bar.matrices=\"talk-printed\""]),
+        "`bar.matrices` = \"talk-printed\"",
+    ),
+    (
+        "redistributed mass with an obstacle",
+        Edit::Set(&["bar.mass=\"redistributed\"", "obstacle.gap=0.2"]),
+        "`obstacle.gap`",
+    ),
+    (
+        "redistributed mass on too short a bar",
+        Edit::Set(&["bar.mass=\"redistributed\"", "mesh.elements=2"]),
+        "must be at least 3 with `bar.mass`",
+    ),
     (
         "unknown solver",
         Edit::Set(&["solver.method=\"magic\""]),

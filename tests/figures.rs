@@ -245,9 +245,11 @@ fn figures_command_refuses_bad_input_with_2_and_write_failures_with_1() {
 #[test]
 fn docs_figures_are_the_pngs_the_command_writes() {
     let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/figures");
+    // The mass variants' figure is `viscobar mass`'s (tests/mass.rs), not `figures`'.
+    let mass_figure = format!("{}.png", viscobar::study::mass_figure::STEM);
     let committed: Vec<String> = listing(&docs)
         .into_iter()
-        .filter(|n| n.ends_with(".png"))
+        .filter(|n| n.ends_with(".png") && *n != mass_figure)
         .collect();
     let mut written: Vec<String> = expected_files()
         .into_iter()

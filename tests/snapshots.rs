@@ -70,6 +70,9 @@ struct Iterations {
 #[derive(Serialize)]
 struct Snapshot {
     scene: String,
+    /// `bar.mass` when not the consistent default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mass: Option<String>,
     solver: String,
     alpha: f64,
     elements: usize,
@@ -88,8 +91,14 @@ struct Snapshot {
     solver_iterations: Iterations,
 }
 
-fn snapshot_of(name: &str) -> Snapshot {
-    let scene = common::builtin(name, &[]);
+/// Snapshots of a talk scene with another mass matrix (issue #19): snapshot name, scene, the
+/// `bar.mass` value.
+const MASS_SNAPSHOTS: [(&str, &str, &str); 1] =
+    [("one-end-mass-redistributed", "one-end", "redistributed")];
+
+fn snapshot_of(name: &str, mass: Option<&str>) -> Snapshot {
+    let set = mass.map(|m| format!("bar.mass={m}"));
+    let scene = common::builtin(name, &set.iter().map(String::as_str).collect::<Vec<_>>());
     let sampling = Sampling::exact(&scene, X_POINTS, T_POINTS).unwrap_or_else(|| {
         panic!(
             "{name}: {} elements and {} steps hold no {X_POINTS} x {T_POINTS} grid of mesh points",
@@ -141,6 +150,7 @@ fn snapshot_of(name: &str) -> Snapshot {
     let it = run.summary.solver_iterations;
     Snapshot {
         scene: name.to_string(),
+        mass: mass.map(str::to_string),
         solver: run.solver.clone(),
         alpha: run.alpha,
         elements: run.elements,
@@ -175,8 +185,11 @@ fn under_ci() -> bool {
 #[test]
 fn talk_scenes_match_their_reviewed_snapshots() {
     let mut failed = Vec::new();
-    for name in figures::talk_scenes() {
-        let data = snapshot_of(name);
+    let cases = figures::talk_scenes()
+        .map(|n| (n, n, None))
+        .chain(MASS_SNAPSHOTS.iter().map(|(s, n, m)| (*s, *n, Some(*m))));
+    for (name, scene, mass) in cases {
+        let data = snapshot_of(scene, mass);
         let missing = !snapshot_dir().join(format!("{name}.snap")).exists();
         let outcome = std::panic::catch_unwind(|| {
             with_settings!({snapshot_path => "../snapshots", prepend_module_to_snapshot => false}, {
@@ -196,10 +209,13 @@ fn talk_scenes_match_their_reviewed_snapshots() {
     );
 }
 
-/// No snapshot outlives its scene: every `snapshots/*.snap` is a talk scene's.
+/// No snapshot outlives its scene: every `snapshots/*.snap` is a talk scene's (or one of
+/// [`MASS_SNAPSHOTS`]).
 #[test]
 fn every_snapshot_belongs_to_a_talk_scene() {
-    let scenes: Vec<&str> = figures::talk_scenes().collect();
+    let scenes: Vec<&str> = figures::talk_scenes()
+        .chain(MASS_SNAPSHOTS.iter().map(|(s, ..)| *s))
+        .collect();
     for entry in std::fs::read_dir(snapshot_dir()).expect("snapshots/ exists") {
         let name = entry.unwrap().file_name().to_string_lossy().into_owned();
         if let Some(stem) = name.strip_suffix(".snap") {

@@ -32,6 +32,13 @@ pub struct Discretisation {
     /// Which matrices (the full-mesh mass matrix of a load is rebuilt from it when needed,
     /// rather than kept: J doubles ×3 that most runs never read).
     pub variant: matrices::MatrixVariant,
+    /// Which mass matrix `mass` is (`[bar] mass`). The load vector does not follow it: it is
+    /// always `M_consistent · (l(x_i))_i`, the P1 load vector of the interpolated force per
+    /// unit length, whatever the inertia.
+    pub mass_variant: matrices::MassVariant,
+    /// Local indices of the unknowns that carry no mass (the Signorini end nodes of a
+    /// redistributed mass; empty otherwise), in increasing order.
+    pub massless: Vec<usize>,
     /// Mass and stiffness on the unknowns.
     pub mass: SymTridiag,
     pub stiffness: SymTridiag,
@@ -50,8 +57,29 @@ impl Discretisation {
         let variant = scene.bar.matrices;
         let first = usize::from(scene.left.condition == Condition::Clamped);
         let last = nodes - 1 - usize::from(scene.right.condition == Condition::Clamped);
+        let mass_variant = scene.bar.mass;
+        let signorini = [&scene.left, &scene.right].map(|e| e.condition == Condition::Signorini);
         // In place: no second copy of the full-mesh matrices at set-up.
-        let mass = matrices::mass(variant, nodes, dx).into_sub(first, last);
+        let mass = match mass_variant {
+            matrices::MassVariant::Consistent => matrices::mass(variant, nodes, dx),
+            _ => matrices::mass_matrix(mass_variant, signorini, nodes, dx).map_err(|e| {
+                SceneError::Invalid {
+                    field: "mesh.elements".into(),
+                    value: e.elements.to_string(),
+                    allowed: format!("with `bar.mass` = \"{}\": {e}", mass_variant.name()),
+                }
+            })?,
+        }
+        .into_sub(first, last);
+        let massless = if mass_variant == matrices::MassVariant::Redistributed {
+            [0, nodes - 1]
+                .into_iter()
+                .zip(signorini)
+                .filter_map(|(node, s)| s.then_some(node - first))
+                .collect()
+        } else {
+            Vec::new()
+        };
         let stiffness = matrices::stiffness(variant, nodes, dx).into_sub(first, last);
         let step_matrix =
             SymTridiag::combine(1.0 / (dt * dt), &mass, 0.5 + alpha / (2.0 * dt), &stiffness);
@@ -99,6 +127,8 @@ impl Discretisation {
             alpha,
             first,
             variant,
+            mass_variant,
+            massless,
             mass,
             stiffness,
             step_matrix,

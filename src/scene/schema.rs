@@ -10,7 +10,6 @@ use crate::step::penalty::PenaltySettings;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// A scene as read from TOML, before validation (see [`Scene::validate`]).
 /// Which pair of matrices a scene uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
@@ -23,6 +22,53 @@ pub enum MatrixVariant {
     TalkPrinted,
 }
 
+/// The mass matrix of a scene (`[bar] mass`), beside the stiffness it shares with every
+/// variant; see [`crate::bar::matrices::mass_matrix`] for the entries and
+/// `docs/mass-variants.md` for the derivation.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MassVariant {
+    /// The P1 (consistent) mass matrix, the talk's scheme.
+    #[default]
+    Consistent,
+    /// No mass at the Signorini end nodes, their mass moved to the two nearest nodes so that
+    /// the total mass and the first moment are kept (Khenous, Laborde & Renard 2008).
+    Redistributed,
+    /// The row sums of the consistent matrix on the diagonal.
+    Lumped,
+}
+
+impl MassVariant {
+    /// All variants, in the order of the documentation.
+    pub const ALL: [MassVariant; 3] = [
+        MassVariant::Consistent,
+        MassVariant::Redistributed,
+        MassVariant::Lumped,
+    ];
+
+    /// The scene key's value: `consistent`, `redistributed`, `lumped`.
+    pub fn name(self) -> &'static str {
+        match self {
+            MassVariant::Consistent => "consistent",
+            MassVariant::Redistributed => "redistributed",
+            MassVariant::Lumped => "lumped",
+        }
+    }
+
+    /// Parses a scene key's value (the names of [`MassVariant::name`]).
+    pub fn parse(text: &str) -> Option<MassVariant> {
+        Self::ALL.into_iter().find(|v| v.name() == text.trim())
+    }
+}
+
+/// Fewest elements a bar with one redistributed Signorini end may have: the two nodes that take
+/// the end's mass must be inner nodes (see [`crate::bar::matrices::mass_matrix`]).
+pub const REDISTRIBUTED_MIN_ELEMENTS_ONE_END: u64 = 3;
+/// Fewest elements with two redistributed Signorini ends: the two modifications may not touch
+/// (with 5 elements the two reduced diagonals `Δx/6` are neighbours and `M` is indefinite).
+pub const REDISTRIBUTED_MIN_ELEMENTS_TWO_ENDS: u64 = 6;
+
+/// A scene as read from TOML, before validation (see [`Scene::validate`]).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
@@ -55,6 +101,14 @@ pub struct Bar {
     pub viscosity: f64,
     #[serde(default)]
     pub matrices: MatrixVariant,
+    /// The mass matrix (default consistent); not written when consistent, so that the TOML of
+    /// a talk scene reads as before.
+    #[serde(default, skip_serializing_if = "is_consistent")]
+    pub mass: MassVariant,
+}
+
+fn is_consistent(m: &MassVariant) -> bool {
+    *m == MassVariant::Consistent
 }
 
 /// Boundary condition at one end of the bar.
@@ -569,6 +623,7 @@ impl Scene {
                 allowed: format!("time.end / time.step must lie between 1 and {MAX_STEPS}"),
             });
         }
+        self.validate_mass()?;
         check_time_grid(self.time.step, self.time.end)?;
         self.solver.validate()?;
         if self.output.every < 1 {
@@ -608,6 +663,55 @@ impl Scene {
         }
         if let Some(o) = &self.obstacle {
             o.gap.expression("obstacle.gap")?;
+        }
+        Ok(())
+    }
+
+    /// `bar.mass` against the other keys: the talk's printed matrices are a diagnostic of their
+    /// own; redistribution needs a node-free obstacle and enough elements.
+    fn validate_mass(&self) -> Result<(), SceneError> {
+        let mass = self.bar.mass;
+        if mass == MassVariant::Consistent {
+            return Ok(());
+        }
+        if self.bar.matrices == MatrixVariant::TalkPrinted {
+            return Err(SceneError::Invalid {
+                field: "bar.mass".into(),
+                value: format!("\"{}\"", mass.name()),
+                allowed: "only \"consistent\" goes with `bar.matrices` = \"talk-printed\" \
+                          (the talk's printed entries are a diagnostic of their own)"
+                    .into(),
+            });
+        }
+        if mass != MassVariant::Redistributed {
+            return Ok(());
+        }
+        if self.obstacle.is_some() {
+            return Err(SceneError::Invalid {
+                field: "bar.mass".into(),
+                value: "\"redistributed\"".into(),
+                allowed: "cannot go with an obstacle (`obstacle.gap`): every node would be a \
+                          contact node and none would keep mass; use \"consistent\" or \
+                          \"lumped\""
+                    .into(),
+            });
+        }
+        let ends = self.signorini_ends().len() as u64;
+        let least = match ends {
+            0 => 0,
+            1 => REDISTRIBUTED_MIN_ELEMENTS_ONE_END,
+            _ => REDISTRIBUTED_MIN_ELEMENTS_TWO_ENDS,
+        };
+        if self.mesh.elements < least {
+            return Err(SceneError::Invalid {
+                field: "mesh.elements".into(),
+                value: self.mesh.elements.to_string(),
+                allowed: format!(
+                    "must be at least {least} with `bar.mass` = \"redistributed\" and {ends} \
+                     signorini end(s) (the end's mass goes to its two nearest inner nodes, \
+                     and two ends' changes may not touch)"
+                ),
+            });
         }
         Ok(())
     }

@@ -1,6 +1,6 @@
 //! The studies that verify the core: errors against closed forms, refinement and
-//! work-precision, solver agreement, the stiff and extreme case matrix, the talk's figures and
-//! the generated tables of VERIFICATION.md.
+//! work-precision, solver agreement, the stiff and extreme case matrix, the mass variants, the
+//! talk's figures and the generated tables of VERIFICATION.md.
 //!
 //! Top layer: may import every other layer; nothing imports it.
 
@@ -10,6 +10,8 @@ pub mod compare;
 pub mod converge;
 pub mod figure_writer;
 pub mod figures;
+pub mod mass_figure;
+pub mod mass_variants;
 pub mod sampled_run;
 pub mod stiff;
 pub mod stiff_runs;

@@ -41,6 +41,7 @@ pub fn sections() -> Result<Vec<Section>, crate::study::converge::ConvergeError>
         roundoff_section()?,
         viscosity_section()?,
         stiff_section(crate::study::stiff::Size::Full),
+        mass_variants_section()?,
     ])
 }
 
@@ -355,4 +356,21 @@ pub fn stiff_section(size: crate::study::stiff::Size) -> Section {
         id: "stiff",
         markdown: crate::study::stiff::markdown(&crate::study::stiff_runs::run_all(size)),
     }
+}
+
+/// The mass variants on `impact` and `falling-bar` (`study::mass_variants`; a few seconds).
+fn mass_variants_section() -> Result<Section, crate::study::converge::ConvergeError> {
+    use crate::study::converge::ConvergeError;
+    use crate::study::mass_variants::{MassStudyError, mass_study};
+    let rows = mass_study().map_err(|e| match e {
+        MassStudyError::Run(r) => ConvergeError::Run(r),
+        other => ConvergeError::BadInput(other.to_string()),
+    })?;
+    let mut markdown = crate::study::mass_variants::certificate_markdown()?;
+    markdown.push('\n');
+    markdown.push_str(&crate::study::mass_variants::markdown(&rows));
+    Ok(Section {
+        id: "mass-variants",
+        markdown,
+    })
 }

@@ -92,6 +92,29 @@ pub fn make_solver(scene: &Scene, disc: &Discretisation) -> Result<Box<dyn StepS
     }
 }
 
+/// `acc ← M⁻¹ acc` on the unknowns that carry mass (a contiguous block: the massless ones are
+/// end nodes), `acc ← 0` on the massless ones ([`Discretisation::massless`]).
+fn solve_on_massive_nodes(
+    disc: &Discretisation,
+    acc: &mut [f64],
+) -> Result<(), crate::linalg::ldlt::NotPositiveDefinite> {
+    let n = acc.len();
+    let lo = usize::from(disc.massless.contains(&0));
+    let hi = n - usize::from(n > 0 && disc.massless.contains(&(n - 1)));
+    for &j in &disc.massless {
+        acc[j] = 0.0;
+    }
+    if lo >= hi {
+        return Ok(());
+    }
+    if lo == 0 && hi == n {
+        Ldlt::factor(&disc.mass)?.solve_in_place(acc);
+    } else {
+        Ldlt::factor(&disc.mass.sub(lo, hi - 1))?.solve_in_place(&mut acc[lo..hi]);
+    }
+    Ok(())
+}
+
 /// The diagnostics of one step, `u^n → u^{n+1}`.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepRecord {
@@ -223,7 +246,10 @@ impl Simulation {
     ///
     /// Start-up: the Taylor step `u^1_T = u^0 + Δt u_1 + Δt²/2 M⁻¹(F^0 − R u^0 − α R u_1)`,
     /// second order for smooth data, followed by the step's own projection onto `K_h` in the
-    /// `C`-norm (the step QP with `b = C (u^1_T − u^0)`), so `u^1` is admissible.
+    /// `C`-norm (the step QP with `b = C (u^1_T − u^0)`), so `u^1` is admissible. With a
+    /// redistributed mass `M` is singular: the acceleration is solved on the nodes that carry
+    /// mass only and the massless nodes' Taylor term is 0 (their `u^1_T = u^0 + Δt u_1`); the
+    /// projection then sets them like any step does.
     pub fn with_solver(
         scene: &Scene,
         disc: Discretisation,
@@ -355,7 +381,7 @@ impl Simulation {
         for i in 0..acc.len() {
             acc[i] = self.force[i] - acc[i] - self.disc.alpha * rv[i];
         }
-        Ldlt::factor(&self.disc.mass)?.solve_in_place(acc);
+        solve_on_massive_nodes(&self.disc, acc)?;
         // The Taylor increment, in w (w becomes the increment z after the step).
         for i in 0..acc.len() {
             self.w[i] = dt * v0[i] + 0.5 * dt * dt * acc[i];
