@@ -15,4 +15,5 @@ pub mod stiff;
 pub mod stiff_runs;
 pub mod verify;
 pub mod viscosity_sweep;
+pub mod viscous_contact;
 pub mod work_precision;

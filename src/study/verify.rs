@@ -38,6 +38,7 @@ pub fn sections() -> Result<Vec<Section>, crate::study::converge::ConvergeError>
         },
         convergence_section()?,
         falling_bar_section()?,
+        crate::study::viscous_contact::section()?,
         roundoff_section()?,
         viscosity_section()?,
         stiff_section(crate::study::stiff::Size::Full),
