@@ -121,8 +121,137 @@ pub fn condition_number(a: &SymTridiag) -> Option<f64> {
     (lo > 0.0).then(|| hi / lo)
 }
 
+/// The reference for the tests and the tolerance registry: eigenvalues of a symmetric
+/// tridiagonal matrix in double-double arithmetic (no system library), resolved far below the
+/// f64 bisection's round-off.
+pub mod reference {
+    use super::padded_gershgorin;
+    use crate::linalg::tridiag::SymTridiag;
+
+    /// Double-double numbers `hi + lo` (Dekker 1971; Hida, Li & Bailey's QD library), about
+    /// 106 bits: a reference for the f64 bisection that needs no system library.
+    #[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]
+    pub struct Dd {
+        /// The leading double.
+        pub hi: f64,
+        /// The trailing double, `|lo| <= ulp(hi)/2`.
+        pub lo: f64,
+    }
+
+    impl Dd {
+        pub fn from(v: f64) -> Self {
+            Self { hi: v, lo: 0.0 }
+        }
+        /// `a + b` exactly as `s + e` (Knuth's two-sum).
+        fn two_sum(a: f64, b: f64) -> Self {
+            let s = a + b;
+            let bb = s - a;
+            Self {
+                hi: s,
+                lo: (a - (s - bb)) + (b - bb),
+            }
+        }
+        /// `s + e` renormalised, `|e| <= ulp(s)/2` assumed.
+        fn quick(s: f64, e: f64) -> Self {
+            let hi = s + e;
+            Self {
+                hi,
+                lo: e - (hi - s),
+            }
+        }
+        pub fn plus(self, o: Self) -> Self {
+            let s = Self::two_sum(self.hi, o.hi);
+            let t = Self::two_sum(self.lo, o.lo);
+            let u = Self::quick(s.hi, s.lo + t.hi);
+            Self::quick(u.hi, u.lo + t.lo)
+        }
+        pub fn negated(self) -> Self {
+            Self {
+                hi: -self.hi,
+                lo: -self.lo,
+            }
+        }
+        pub fn minus(self, o: Self) -> Self {
+            self.plus(o.negated())
+        }
+        pub fn times(self, o: Self) -> Self {
+            let p = self.hi * o.hi;
+            let e = self.hi.mul_add(o.hi, -p) + (self.hi * o.lo + self.lo * o.hi);
+            Self::quick(p, e)
+        }
+        pub fn over(self, o: Self) -> Self {
+            let q1 = self.hi / o.hi;
+            let r = self.minus(o.times(Self::from(q1)));
+            let q2 = r.hi / o.hi;
+            let r = r.minus(o.times(Self::from(q2)));
+            let q3 = r.hi / o.hi;
+            Self::quick(q1, q2).plus(Self::from(q3))
+        }
+        pub fn half(self) -> Self {
+            Self {
+                hi: 0.5 * self.hi,
+                lo: 0.5 * self.lo,
+            }
+        }
+    }
+
+    /// [`count_below`] in double-double arithmetic on the same f64 entries.
+    fn count_below_dd(a: &SymTridiag, x: Dd) -> usize {
+        let pivmin = Dd::from(1e-280);
+        let mut count = 0;
+        let mut d = Dd::from(1.0);
+        for i in 0..a.dim() {
+            let coupling = if i > 0 {
+                let e = Dd::from(a.off[i - 1]);
+                e.times(e).over(d)
+            } else {
+                Dd::from(0.0)
+            };
+            d = Dd::from(a.diag[i]).minus(x).minus(coupling);
+            if d.hi.abs() < pivmin.hi {
+                d = pivmin.negated();
+            }
+            if d.hi < 0.0 {
+                count += 1;
+            }
+        }
+        count
+    }
+
+    /// The `k`-th smallest eigenvalue of `a` (its f64 entries taken exactly) by double-double
+    /// bisection from the padded Gershgorin interval, until the interval is below
+    /// [`DD_WIDTH`] times `‖a‖`.
+    pub fn eigenvalue_dd(a: &SymTridiag, k: usize) -> Dd {
+        let (lo, hi) = padded_gershgorin(a);
+        let norm = lo.abs().max(hi.abs());
+        let (mut lo, mut hi) = (Dd::from(lo), Dd::from(hi));
+        while hi.minus(lo).hi > DD_WIDTH * norm {
+            let mid = lo.plus(hi).half();
+            if count_below_dd(a, mid) > k {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        lo.plus(hi).half()
+    }
+
+    /// Width of the double-double bisection's final interval relative to `‖a‖`: above the
+    /// recurrence's own round-off (a few units of 2⁻¹⁰⁶ ≈ 1.2e-32 of `‖a‖`, backward stable
+    /// as in f64) and far below f64 precision of the smallest eigenvalue at `κ = 4e11`
+    /// (`ε λ_min ≈ 2e-16 · ‖a‖/4e11 ≈ 5e-28 ‖a‖`).
+    pub const DD_WIDTH: f64 = 1e-30;
+
+    /// The f64 bisection's error on an eigenvalue, in units of `ε ‖a‖∞`: the Sturm count is
+    /// exact for a matrix whose entries are perturbed by a few ulps (Kahan 1966; LAPACK
+    /// Working Note 3), so by Weyl's theorem each eigenvalue is within a few `ε ‖a‖`; the
+    /// bisection then stops at one ulp of it. 4 units.
+    pub const STURM_ERROR_ULPS: f64 = 4.0;
+}
+
 #[cfg(test)]
 mod tests {
+    use super::reference::{STURM_ERROR_ULPS, eigenvalue_dd};
     use super::*;
 
     /// Dense symmetric eigenvalues (nalgebra), ascending.
@@ -216,124 +345,6 @@ mod tests {
         }
     }
 
-    /// Double-double numbers `hi + lo` (Dekker 1971; Hida, Li & Bailey's QD library), about
-    /// 106 bits: a reference for the f64 bisection that needs no system library.
-    #[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]
-    struct Dd {
-        hi: f64,
-        lo: f64,
-    }
-
-    impl Dd {
-        fn from(v: f64) -> Self {
-            Self { hi: v, lo: 0.0 }
-        }
-        /// `a + b` exactly as `s + e` (Knuth's two-sum).
-        fn two_sum(a: f64, b: f64) -> Self {
-            let s = a + b;
-            let bb = s - a;
-            Self {
-                hi: s,
-                lo: (a - (s - bb)) + (b - bb),
-            }
-        }
-        /// `s + e` renormalised, `|e| <= ulp(s)/2` assumed.
-        fn quick(s: f64, e: f64) -> Self {
-            let hi = s + e;
-            Self {
-                hi,
-                lo: e - (hi - s),
-            }
-        }
-        fn add(self, o: Self) -> Self {
-            let s = Self::two_sum(self.hi, o.hi);
-            let t = Self::two_sum(self.lo, o.lo);
-            let u = Self::quick(s.hi, s.lo + t.hi);
-            Self::quick(u.hi, u.lo + t.lo)
-        }
-        fn neg(self) -> Self {
-            Self {
-                hi: -self.hi,
-                lo: -self.lo,
-            }
-        }
-        fn sub(self, o: Self) -> Self {
-            self.add(o.neg())
-        }
-        fn mul(self, o: Self) -> Self {
-            let p = self.hi * o.hi;
-            let e = self.hi.mul_add(o.hi, -p) + (self.hi * o.lo + self.lo * o.hi);
-            Self::quick(p, e)
-        }
-        fn div(self, o: Self) -> Self {
-            let q1 = self.hi / o.hi;
-            let r = self.sub(o.mul(Self::from(q1)));
-            let q2 = r.hi / o.hi;
-            let r = r.sub(o.mul(Self::from(q2)));
-            let q3 = r.hi / o.hi;
-            Self::quick(q1, q2).add(Self::from(q3))
-        }
-        fn half(self) -> Self {
-            Self {
-                hi: 0.5 * self.hi,
-                lo: 0.5 * self.lo,
-            }
-        }
-    }
-
-    /// [`count_below`] in double-double arithmetic on the same f64 entries.
-    fn count_below_dd(a: &SymTridiag, x: Dd) -> usize {
-        let pivmin = Dd::from(1e-280);
-        let mut count = 0;
-        let mut d = Dd::from(1.0);
-        for i in 0..a.dim() {
-            let coupling = if i > 0 {
-                let e = Dd::from(a.off[i - 1]);
-                e.mul(e).div(d)
-            } else {
-                Dd::from(0.0)
-            };
-            d = Dd::from(a.diag[i]).sub(x).sub(coupling);
-            if d.hi.abs() < pivmin.hi {
-                d = pivmin.neg();
-            }
-            if d.hi < 0.0 {
-                count += 1;
-            }
-        }
-        count
-    }
-
-    /// The `k`-th smallest eigenvalue of `a` (its f64 entries taken exactly) by double-double
-    /// bisection from the padded Gershgorin interval, until the interval is below
-    /// [`DD_WIDTH`] times `‖a‖`.
-    fn eigenvalue_dd(a: &SymTridiag, k: usize) -> Dd {
-        let (lo, hi) = padded_gershgorin(a);
-        let norm = lo.abs().max(hi.abs());
-        let (mut lo, mut hi) = (Dd::from(lo), Dd::from(hi));
-        while hi.sub(lo).hi > DD_WIDTH * norm {
-            let mid = lo.add(hi).half();
-            if count_below_dd(a, mid) > k {
-                hi = mid;
-            } else {
-                lo = mid;
-            }
-        }
-        lo.add(hi).half()
-    }
-
-    /// Width of the double-double bisection's final interval relative to `‖a‖`: above the
-    /// recurrence's own round-off (a few units of 2⁻¹⁰⁶ ≈ 1.2e-32 of `‖a‖`, backward stable
-    /// as in f64) and far below f64 precision of the smallest eigenvalue at `κ = 4e11`
-    /// (`ε λ_min ≈ 2e-16 · ‖a‖/4e11 ≈ 5e-28 ‖a‖`).
-    const DD_WIDTH: f64 = 1e-30;
-
-    /// The f64 bisection's error on an eigenvalue, in units of `ε ‖a‖∞`: the Sturm count is
-    /// exact for a matrix whose entries are perturbed by a few ulps (Kahan 1966; LAPACK
-    /// Working Note 3), so by Weyl's theorem each eigenvalue is within a few `ε ‖a‖`; the
-    /// bisection then stops at one ulp of it. 4 units.
-    const STURM_ERROR_ULPS: f64 = 4.0;
-
     #[test]
     fn double_double_reference_matches_closed_forms() {
         // R + σI, R the consistent free-free stiffness of 21 nodes: eigenvalues
@@ -368,7 +379,7 @@ mod tests {
     /// double-double reference, and κ within the relative error that implies,
     /// `STURM_ERROR_ULPS ε ‖C‖∞ (1/λ_min + 1/λ_max)` (about 3.7e-4 at κ = 4e11, where the dense
     /// comparison allowed 64 ε κ ≈ 6, i.e. 600 %). Measured worst: 0.69 units on an eigenvalue,
-    /// κ off by 7.7e-6 relative at 4e11 (printed by a copy of this test with the bounds at 0).
+    /// κ off by 7.7e-6 relative at 4e11 (`viscobar verify --tolerances` prints both ratios).
     #[test]
     fn condition_numbers_match_the_double_double_reference() {
         use crate::bar::matrices::{MatrixVariant, mass, stiffness};
@@ -388,7 +399,7 @@ mod tests {
                     "α {alpha:e}, Δt/Δx {ratio:e}: {got:e} against {reference:?}"
                 );
             }
-            let kappa_ref = hi.div(lo).hi;
+            let kappa_ref = hi.over(lo).hi;
             let kappa = condition_number(&c).unwrap();
             let rtol = tol * (1.0 / lo.hi + 1.0 / hi.hi);
             assert!(

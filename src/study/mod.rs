@@ -13,6 +13,7 @@ pub mod figures;
 pub mod sampled_run;
 pub mod stiff;
 pub mod stiff_runs;
+pub mod tolerances;
 pub mod verify;
 pub mod viscosity_sweep;
 pub mod viscous_contact;
