@@ -104,6 +104,9 @@ enum Command {
         /// The stiff and extreme case matrix instead (full size: 1e6 nodes, 1e6-step runs).
         #[arg(long)]
         stiff: bool,
+        /// The tolerance registry instead: each tolerance's measured worst / tolerance.
+        #[arg(long, conflicts_with = "stiff")]
+        tolerances: bool,
     },
 }
 
@@ -127,7 +130,11 @@ fn main() {
                 2
             }
         },
-        Command::Verify { update, stiff } => verify(update, stiff),
+        Command::Verify {
+            update,
+            stiff,
+            tolerances,
+        } => verify(update, stiff, tolerances),
         Command::Converge {
             scene,
             solvers,
@@ -440,11 +447,16 @@ fn compare(name: &str, solvers: &str, set: &[String]) -> Result<(), viscobar::Ru
     Ok(())
 }
 
-fn verify(update: Option<PathBuf>, stiff: bool) -> i32 {
-    let sections = if stiff {
-        Ok(vec![viscobar::study::verify::stiff_section(
-            viscobar::study::stiff::Size::Full,
-        )])
+fn verify(update: Option<PathBuf>, stiff: bool, tolerances: bool) -> i32 {
+    let sections = if stiff || tolerances {
+        let results = viscobar::study::stiff_runs::run_all(viscobar::study::stiff::Size::Full);
+        if stiff {
+            Ok(vec![viscobar::study::verify::stiff_section(&results)])
+        } else {
+            viscobar::study::verify::tolerances_section(&results)
+                .map(|s| vec![s])
+                .map_err(Into::into)
+        }
     } else {
         viscobar::study::verify::sections()
     };

@@ -340,6 +340,147 @@ impl ClosedForm for ForcedMode {
 /// that still counts as the same load: the scene's text rounds `π` and its products once more.
 const LOAD_MATCH_TOL: f64 = 1e-12;
 
+/// Viscous contact, manufactured (issue #22): a Kelvin–Voigt bar (`α > 0`) on `[0, L]`,
+/// Signorini at `x = 0` with gap `a0`, free at `x = L`, with the exact solution
+/// `u(x, t) = g(t) + h(t) w(x)`, `w = sin(kx)/k`, `k = π/(2L)` (so `w(0) = 0`, `w'(0) = 1`,
+/// `w'(L) = 0`, `w'' = −k² w`), under the load `l = u_tt − u_xx − α u_xxt` it defines.
+/// Derivation and choices: [docs/viscous-contact.md](../../docs/viscous-contact.md). In short:
+///
+/// - `u(0, t) = g(t)`, `s(0, t) = u_x + α u_xt = h + α h'`, `s(L, t) = 0`.
+/// - `g = −a0 + a0 ((t1 − t)⁺/t1)³ + a0 ((t − t2)⁺/t1)³`: released at `g(0) = 0` with
+///   velocity `−3a0/t1`, on the obstacle exactly on `[t1, t2]`, `C²` at both joins.
+/// - The stress at the obstacle `σ(t) = s(0, t)` is `−P sin²(π(t − t1)/(t2 − t1))` on
+///   `[t1, t2]` and `0` outside (`C¹`), and `h` solves `α h' + h = σ`, `h(0) = h0`:
+///   `h = h0 e^{−t/α} + (1/α)∫_{t1}^t e^{−(t−τ)/α} σ(τ) dτ` (the integral in closed form; after
+///   `t2` its value at `t2` decays as `e^{−(t−t2)/α}`); so `h ∈ C²`. `h0 ≠ 0` keeps the bar
+///   moving when it lands (with `h0 = 0` it is at rest at `t1` and the energy identity's
+///   relative residual is round-off over an energy of 1e-29).
+/// - Load: `l = g'' + q(t) w(x)`, `q = h'' + k² σ`, `h' = (σ − h)/α`,
+///   `h'' = (σ' − h')/α`.
+/// - Complementarity: gap `g + a0 ≥ 0`, zero exactly on `[t1, t2]`; reaction `−σ ≥ 0`, zero
+///   outside.
+#[derive(Clone, Copy, Debug)]
+pub struct ViscousContact {
+    pub length: f64,
+    pub alpha: f64,
+    pub gap: f64,
+    /// The contact window `[t1, t2]`, `0 < t1 < t2`.
+    pub t1: f64,
+    pub t2: f64,
+    /// `P > 0`: the peak reaction, `−σ((t1 + t2)/2)`.
+    pub pulse: f64,
+    /// `h0 = h(0)`: the initial shape `h0 w(x)` and velocity `g'(0) − (h0/α) w(x)`.
+    pub initial_amplitude: f64,
+}
+
+impl ViscousContact {
+    /// `k = π/(2L)`.
+    pub fn wavenumber(&self) -> f64 {
+        0.5 * std::f64::consts::PI / self.length
+    }
+    /// The shape `w(x) = sin(kx)/k`.
+    pub fn shape(&self, x: f64) -> f64 {
+        let k = self.wavenumber();
+        (k * x).sin() / k
+    }
+    /// `(g, g', g'')` at `t`.
+    pub fn rigid(&self, t: f64) -> [f64; 3] {
+        let c = self.gap / self.t1.powi(3);
+        let (before, after) = ((self.t1 - t).max(0.0), (t - self.t2).max(0.0));
+        [
+            -self.gap + c * (before.powi(3) + after.powi(3)),
+            3.0 * c * (after * after - before * before),
+            6.0 * c * (before + after),
+        ]
+    }
+    /// `ω = 2π/(t2 − t1)`: `sin²(π τ/T) = (1 − cos ωτ)/2`.
+    fn omega(&self) -> f64 {
+        2.0 * std::f64::consts::PI / (self.t2 - self.t1)
+    }
+    /// `(σ, σ')`: the stress `s(0, t)` and its rate.
+    pub fn stress(&self, t: f64) -> [f64; 2] {
+        if t <= self.t1 || t >= self.t2 {
+            return [0.0, 0.0];
+        }
+        let (w, tau) = (self.omega(), t - self.t1);
+        [
+            -0.5 * self.pulse * (1.0 - (w * tau).cos()),
+            -0.5 * self.pulse * w * (w * tau).sin(),
+        ]
+    }
+    /// `h(t)`: the free decay of `h0` plus the response to `σ` (0 before the window, the
+    /// convolution on it, its decay after it).
+    pub fn amplitude(&self, t: f64) -> f64 {
+        let a = self.alpha;
+        let on_window = |tau: f64| {
+            let (w, e) = (self.omega(), (-tau / a).exp());
+            let resonance = 1.0 + a * a * w * w;
+            -0.5 * self.pulse
+                * ((1.0 - e) - ((w * tau).cos() + a * w * (w * tau).sin() - e) / resonance)
+        };
+        let free = self.initial_amplitude * (-t / a).exp();
+        free + if t <= self.t1 {
+            0.0
+        } else if t <= self.t2 {
+            on_window(t - self.t1)
+        } else {
+            on_window(self.t2 - self.t1) * (-(t - self.t2) / a).exp()
+        }
+    }
+    /// `(h, h', h'')` from `α h' + h = σ`.
+    pub fn amplitude_rates(&self, t: f64) -> [f64; 3] {
+        let h = self.amplitude(t);
+        let [s, ds] = self.stress(t);
+        let dh = (s - h) / self.alpha;
+        [h, dh, (ds - dh) / self.alpha]
+    }
+    /// The load `l(x, t) = g'' + (h'' + k² σ) w(x)`.
+    pub fn load(&self, x: f64, t: f64) -> f64 {
+        let k = self.wavenumber();
+        let [_, _, ddh] = self.amplitude_rates(t);
+        self.rigid(t)[2] + (ddh + k * k * self.stress(t)[0]) * self.shape(x)
+    }
+    /// `u_t(x, t) = g' + h' w`.
+    pub fn velocity(&self, x: f64, t: f64) -> f64 {
+        self.rigid(t)[1] + self.amplitude_rates(t)[1] * self.shape(x)
+    }
+    /// `−s(0, t) = −σ(t) ≥ 0`: the obstacle's reaction.
+    pub fn reaction(&self, t: f64) -> f64 {
+        -self.stress(t)[0]
+    }
+}
+
+impl ClosedForm for ViscousContact {
+    fn displacement(&self, x: f64, t: f64) -> f64 {
+        self.rigid(t)[0] + self.amplitude(t) * self.shape(x)
+    }
+    /// `u_t = g' + h' w`, `u_x = h cos(kx)`, with `∫w = 1/k²`, `∫w² = L/(2k²)`,
+    /// `∫cos²(kx) = L/2`.
+    fn energy(&self, t: f64) -> Option<f64> {
+        let (l, k) = (self.length, self.wavenumber());
+        let [_, dg, _] = self.rigid(t);
+        let [h, dh, _] = self.amplitude_rates(t);
+        let kinetic = l * dg * dg + 2.0 * dg * dh / (k * k) + dh * dh * l / (2.0 * k * k);
+        Some(0.5 * kinetic + 0.25 * h * h * l)
+    }
+    fn contact_intervals(&self, t_end: f64) -> Option<Vec<[f64; 2]>> {
+        Some(clip(&[[self.t1, self.t2]], t_end))
+    }
+}
+
+/// The contact window, peak reaction and `h0` of the built-in `viscous-contact` scene (its
+/// description; the load expression there is written for these, `L = 1`, `α = 0.1`,
+/// `a0 = 0.25`, and [`for_scene`] checks it against [`ViscousContact::load`]).
+pub const VISCOUS_CONTACT_WINDOW: [f64; 2] = [0.5, 1.5];
+pub const VISCOUS_CONTACT_PULSE: f64 = 1.0;
+pub const VISCOUS_CONTACT_INITIAL_AMPLITUDE: f64 = -0.2;
+/// Load sample points per direction at which the scene's expression must equal the closed
+/// form's load (an `(x, t)` grid over the bar and the run).
+const LOAD_CHECK_POINTS: usize = 41;
+/// Relative agreement of the scene's load expression with [`ViscousContact::load`]: the same
+/// formula, evaluated in another order (terms up to `100 |h| ~ 100`), so a few hundred ulps.
+const LOAD_CHECK_RTOL: f64 = 1e-12;
+
 /// The closed form of a built-in scene, with its parameters read from the scene (so that
 /// `--set` overrides of the length, gap, speed, gravity or viscosity are honoured). `None` for
 /// scenes without one, or when overrides have made the scene leave the closed form's
@@ -352,8 +493,8 @@ pub fn for_scene(name: &str, scene: &Scene) -> Option<Box<dyn ClosedForm>> {
     let unloaded = scene.load.density.is_none();
     let elastic = scene.bar.viscosity == 0.0 && unloaded;
     let velocity = Expression::parse("initial.velocity", &scene.initial.velocity, false).ok()?;
-    // Every closed form here starts from a uniform velocity.
-    if velocity.depends_on_x() || scene.obstacle.is_some() {
+    // Every closed form here but the manufactured one starts from a uniform velocity.
+    if (velocity.depends_on_x() && name != "viscous-contact") || scene.obstacle.is_some() {
         return None;
     }
     let velocity0 = velocity.eval(0.0, 0.0).ok()?;
@@ -407,6 +548,40 @@ pub fn for_scene(name: &str, scene: &Scene) -> Option<Box<dyn ClosedForm>> {
             }
             let gravity = -load.eval(0.0, 0.0).ok()?;
             Box::new(FallingBar::new(scene.bar.length, gravity, scene.left.gap?)?)
+        }
+        "viscous-contact" if ends == (Signorini, Free) && scene.bar.viscosity > 0.0 => {
+            let [t1, t2] = VISCOUS_CONTACT_WINDOW;
+            let vc = ViscousContact {
+                length: scene.bar.length,
+                alpha: scene.bar.viscosity,
+                gap: scene.left.gap?,
+                t1,
+                t2,
+                pulse: VISCOUS_CONTACT_PULSE,
+                initial_amplitude: VISCOUS_CONTACT_INITIAL_AMPLITUDE,
+            };
+            let load =
+                Expression::parse("load.density", scene.load.density.as_ref()?, true).ok()?;
+            let n = LOAD_CHECK_POINTS - 1;
+            let end = scene.time.end;
+            let same_load = (0..=n).all(|i| {
+                (0..=n).all(|j| {
+                    let (x, t) = (vc.length * i as f64 / n as f64, end * j as f64 / n as f64);
+                    let exact = vc.load(x, t);
+                    load.eval(x, t)
+                        .is_ok_and(|v| (v - exact).abs() <= LOAD_CHECK_RTOL * exact.abs().max(1.0))
+                })
+            });
+            let same_velocity = (0..=100).all(|i| {
+                let x = vc.length * i as f64 / 100.0;
+                velocity
+                    .eval(x, 0.0)
+                    .is_ok_and(|v| (v - vc.velocity(x, 0.0)).abs() <= 1e-12)
+            });
+            if !(same_load && same_velocity) {
+                return None;
+            }
+            Box::new(vc)
         }
         _ => return None,
     };

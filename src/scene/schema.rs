@@ -476,6 +476,10 @@ pub const BUILTIN: &[(&str, &str)] = &[
         "clamped-impact",
         include_str!("../../scenes/clamped-impact.toml"),
     ),
+    (
+        "viscous-contact",
+        include_str!("../../scenes/viscous-contact.toml"),
+    ),
     ("both-ends", include_str!("../../scenes/both-ends.toml")),
     (
         "both-ends-forced",

@@ -266,4 +266,41 @@ mod tests {
             );
         }
     }
+
+    /// Pins the reaction-form choice of [`PenaltySolver::solve_on_support`]: the rigid flight
+    /// of `exact::rigid_flight` (`Δt v = −500` per step) stopped by springs under both ends at
+    /// `lo = −400`. With a soft spring (`1/ε = 1e-6 C_jj`) the reaction must come from the gap:
+    /// from stationarity the law is off by `ε δ`, about 1e4 times its floor. With a stiff one
+    /// (`1/ε = 1e6 C_jj`) it must come from stationarity: from the gap, stationarity is off by
+    /// the gap's rounding times `1/ε`, about 1e3 times its floor. Each form swapped fails the
+    /// audit (run inside `solve`) on the check named; the chosen form passes.
+    #[test]
+    fn each_spring_regime_needs_its_reaction_form() {
+        let (c, b) = crate::step::exact::rigid_flight();
+        let n = c.dim();
+        let ends = [0, n - 1];
+        let lower = [-400.0; 2];
+        let cases = [(1e6, true, "penalty law"), (1e-6, false, "stationarity")];
+        for (ratio, from_gap, swapped_fails) in cases {
+            let epsilon = ratio / c.diag[0];
+            for swap in [false, true] {
+                let mut solver =
+                    PenaltySolver::new(&c, &ends, PenaltySettings { epsilon }).unwrap();
+                assert_eq!(solver.from_gap, [from_gap; 2], "ε = {epsilon:e}");
+                if swap {
+                    solver.from_gap = [!from_gap; 2];
+                }
+                let (mut z, mut r) = (vec![0.0; n], [0.0; 2]);
+                let result = solver.solve(&b, &lower, &mut z, &mut r);
+                match (swap, result) {
+                    (false, Ok(_)) => {}
+                    (true, Err(StepFailure::AuditFailed { what, .. })) => assert!(
+                        what.starts_with(swapped_fails),
+                        "ε = {epsilon:e}, swapped form: {what}"
+                    ),
+                    (swap, other) => panic!("ε = {epsilon:e}, swapped {swap}: {other:?}"),
+                }
+            }
+        }
+    }
 }

@@ -15,6 +15,8 @@ pub mod mass_variants;
 pub mod sampled_run;
 pub mod stiff;
 pub mod stiff_runs;
+pub mod tolerances;
 pub mod verify;
 pub mod viscosity_sweep;
+pub mod viscous_contact;
 pub mod work_precision;

@@ -28,6 +28,7 @@ pub const RIGID_STEPS: usize = 26_000;
 /// All sections, in document order.
 /// Errors are those of the runs and of the α-sweep (both carry their exit code).
 pub fn sections() -> Result<Vec<Section>, crate::study::converge::ConvergeError> {
+    let stiff = crate::study::stiff_runs::run_all(crate::study::stiff::Size::Full);
     Ok(vec![
         matrices_section(),
         solve_section(),
@@ -38,9 +39,16 @@ pub fn sections() -> Result<Vec<Section>, crate::study::converge::ConvergeError>
         },
         convergence_section()?,
         falling_bar_section()?,
+        Section {
+            id: "viscous-contact",
+            markdown: crate::study::viscous_contact::markdown(
+                &crate::study::viscous_contact::study(CONVERGENCE_LEVELS)?,
+            ),
+        },
         roundoff_section()?,
         viscosity_section()?,
-        stiff_section(crate::study::stiff::Size::Full),
+        stiff_section(&stiff),
+        tolerances_section(&stiff)?,
         mass_variants_section()?,
     ])
 }
@@ -349,12 +357,12 @@ fn viscosity_section() -> Result<Section, crate::study::converge::ConvergeError>
     })
 }
 
-/// The stiff and extreme case matrix at full size (about 40 s on 2 cores; alone:
+/// The stiff and extreme case matrix from its runs (full size: about 40 s on 2 cores; alone:
 /// `viscobar verify --stiff`); `tests/stiff.rs` runs the reduced size.
-pub fn stiff_section(size: crate::study::stiff::Size) -> Section {
+pub fn stiff_section(results: &[crate::study::stiff::CaseResult]) -> Section {
     Section {
         id: "stiff",
-        markdown: crate::study::stiff::markdown(&crate::study::stiff_runs::run_all(size)),
+        markdown: crate::study::stiff::markdown(results),
     }
 }
 
@@ -372,5 +380,16 @@ fn mass_variants_section() -> Result<Section, crate::study::converge::ConvergeEr
     Ok(Section {
         id: "mass-variants",
         markdown,
+    })
+}
+
+/// The tolerance registry (`viscobar verify --tolerances`, `study::tolerances`), with the stiff
+/// matrix's checks read from `results`.
+pub fn tolerances_section(
+    results: &[crate::study::stiff::CaseResult],
+) -> Result<Section, RunError> {
+    Ok(Section {
+        id: "tolerances",
+        markdown: crate::study::tolerances::registry_markdown(results)?,
     })
 }

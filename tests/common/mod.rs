@@ -10,19 +10,12 @@ use viscobar::study::agreement::{MAX_MARGIN, diagonally_dominant};
 
 // ---- tolerances shared by several test files -----------------------------------------------
 
-/// Relative residual of the energy identity for a solver exact to round-off (exact, penalty):
-/// the identity is exact algebra given `C z = b + r`, so only round-off remains (measured below
-/// 1e-14 on every built-in scene, VERIFICATION.md, sections "Scenes" and "Step solvers").
-pub const IDENTITY_TOL: f64 = 1e-12;
-/// An energy increase of an unforced run, relative to `E^{1/2}`, that round-off can make.
-pub const ENERGY_RISE_TOL: f64 = 1e-13;
-/// Gap negative by round-off only: the exact solver puts an active node on the obstacle up to
-/// the rounding of `u^n + z` with |u| <= 1.
-pub const GAP_TOL: f64 = 1e-14;
-/// Reaction negative by round-off only (reactions of order 10).
-pub const REACTION_TOL: f64 = 1e-12;
-/// `|gap · reaction|`: round-off in the gap times a reaction of order 10.
-pub const COMPLEMENTARITY_TOL: f64 = 1e-12;
+/// Scene-wide round-off tolerances, defined beside their measurement in the tolerance registry
+/// (`viscobar verify --tolerances`).
+#[allow(unused_imports)] // each test file uses some of them
+pub use viscobar::study::tolerances::{
+    COMPLEMENTARITY_TOL, ENERGY_RISE_TOL, GAP_TOL, IDENTITY_TOL, REACTION_TOL,
+};
 /// The scheme is second order in (dx, dt) for smooth solutions (the card asks for 2 ± 0.15).
 pub const MODAL_ORDER: f64 = 2.0;
 /// Allowed distance of a smooth solution's observed order from [`MODAL_ORDER`] (the card's 0.15).
