@@ -602,7 +602,10 @@ mod tests {
         let shade = over_white(CONTACT_COLOUR, EPISODE_OPACITY);
         assert_eq!(pixels(&h, &[], shade), 0);
         let episode = [[0.7, 0.8]]; // the third bin's time, 0.75
-        let (shaded, dark) = (pixels(&h, &episode, shade), pixels(&h, &episode, CONTACT_COLOUR));
+        let (shaded, dark) = (
+            pixels(&h, &episode, shade),
+            pixels(&h, &episode, CONTACT_COLOUR),
+        );
         assert_eq!(dark, contact_pixels(&h), "the contact set keeps its colour");
         // The band: the third of 4 time bins across the whole bar; node 3's column (a quarter
         // of the width: nodes 0 and 4 own half columns) stays dark, so 3x its pixels are shaded
