@@ -113,6 +113,13 @@ enum Command {
         /// The stiff and extreme case matrix instead (full size: 1e6 nodes, 1e6-step runs).
         #[arg(long)]
         stiff: bool,
+        /// "Error against run time" instead: its error and timing blocks (machine-dependent:
+        /// the machine and date are written beside the times).
+        #[arg(long, conflicts_with = "stiff")]
+        timings: bool,
+        /// With --timings: also write work-precision-<scene>.png into this folder.
+        #[arg(long, value_name = "DIR", requires = "timings")]
+        figures: Option<PathBuf>,
     },
 }
 
@@ -136,7 +143,12 @@ fn main() {
                 2
             }
         },
-        Command::Verify { update, stiff } => verify(update, stiff),
+        Command::Verify {
+            update,
+            stiff,
+            timings,
+            figures,
+        } => verify(update, stiff, timings.then_some(figures)),
         Command::Converge {
             scene,
             solvers,
@@ -457,8 +469,11 @@ fn compare(name: &str, solvers: &str, set: &[String]) -> Result<(), viscobar::Ru
     Ok(())
 }
 
-fn verify(update: Option<PathBuf>, stiff: bool) -> i32 {
-    let sections = if stiff {
+/// `timings`: `Some(figures folder)` for `--timings`.
+fn verify(update: Option<PathBuf>, stiff: bool, timings: Option<Option<PathBuf>>) -> i32 {
+    let sections = if let Some(figures) = timings {
+        viscobar::study::timings::sections(figures.as_deref())
+    } else if stiff {
         Ok(vec![viscobar::study::verify::stiff_section(
             viscobar::study::stiff::Size::Full,
         )])

@@ -87,7 +87,8 @@ impl SolverSetting {
             SolverSetting::Penalty(e) => format!("epsilon={e:e}"),
         }
     }
-    fn label(&self) -> String {
+    /// `exact`, `osqp eps=1e-7`, `penalty epsilon=1e-5`.
+    pub fn label(&self) -> String {
         match self {
             SolverSetting::Exact => "exact".into(),
             _ => format!("{} {}", self.solver(), self.setting()),

@@ -13,6 +13,7 @@ pub mod figures;
 pub mod sampled_run;
 pub mod stiff;
 pub mod stiff_runs;
+pub mod timings;
 pub mod verify;
 pub mod viscosity_sweep;
 pub mod work_precision;
