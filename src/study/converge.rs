@@ -2,10 +2,12 @@
 //! scene's closed form, or a finer run of the exact solver) and the data of the work-precision
 //! diagram (drawn by `study::work_precision`). The `α → 0` sweep is `study::viscosity_sweep`.
 //!
-//! Runs are independent and go to rayon's pool; each worker builds its own [`Simulation`]
-//! (OSQP's workspace is not `Send`), and results are sorted before anything is written, so the
-//! files do not depend on the scheduling. Wall times do: they are the only non-deterministic
-//! column.
+//! The error runs are independent and go to rayon's pool (both cores); each worker builds its
+//! own [`Simulation`] (OSQP's workspace is not `Send`), and results are sorted before anything
+//! is written, so the files do not depend on the scheduling. The wall times come from a second,
+//! serial pass that runs each setting and level alone `repeats` times and keeps the median
+//! ([`study_with`]): no timed run shares the cores with another run of the study. They are the
+//! only non-deterministic columns.
 
 use crate::bar::closed_form::{self, ClosedForm};
 use crate::scene::{Scene, SolverMethod, SolverSpec};
