@@ -59,10 +59,29 @@ enum Command {
     Converge {
         /// A built-in scene (a name from `viscobar scenes`) or the path of a TOML scene file.
         scene: String,
-        /// Comma-separated solvers: exact, osqp (eps 1e-4, 1e-7, 1e-10), penalty (epsilon 1e-3,
-        /// 1e-5, 1e-7).
+        /// Comma-separated solvers: exact, osqp (once per --osqp-eps), penalty (once per
+        /// --penalty-epsilon).
         #[arg(long, default_value = "exact,osqp,penalty")]
         solvers: String,
+        /// OSQP tolerances (eps_abs = eps_rel), comma-separated.
+        #[arg(long, default_value = "1e-4,1e-7,1e-10", value_name = "LIST")]
+        osqp_eps: String,
+        /// Penalty parameters epsilon, comma-separated.
+        #[arg(long, default_value = "1e-3,1e-5,1e-7", value_name = "LIST")]
+        penalty_epsilon: String,
+        /// Refinement level of the exact reference run (the scene's mesh is level 0; finer
+        /// than the finest level) [default: the closed form of a built-in scene that has one,
+        /// else 2 levels above the finest, 4x finer in space and time]. Given, the reference is
+        /// a run even where a closed form exists.
+        #[arg(long, value_name = "LEVEL")]
+        reference_level: Option<u32>,
+        /// Timing repeats per run, taken one run at a time after the parallel error pass; the
+        /// median is kept (0: the times of the parallel pass).
+        #[arg(long, default_value_t = viscobar::study::converge::DEFAULT_REPEATS)]
+        repeats: usize,
+        /// Override a scene key, e.g. --set time.end=2 (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
         /// Levels of refinement (elements doubled per level from the scene's mesh).
         #[arg(long, default_value_t = viscobar::study::converge::DEFAULT_LEVELS)]
         levels: u32,
@@ -105,8 +124,15 @@ enum Command {
         #[arg(long)]
         stiff: bool,
         /// The tolerance registry instead: each tolerance's measured worst / tolerance.
-        #[arg(long, conflicts_with = "stiff")]
+        #[arg(long, conflicts_with_all = ["stiff", "timings"])]
         tolerances: bool,
+        /// "Error against run time" instead: its error and timing blocks (machine-dependent:
+        /// the machine and date are written beside the times).
+        #[arg(long, conflicts_with = "stiff")]
+        timings: bool,
+        /// With --timings: also write work-precision-<scene>.png into this folder.
+        #[arg(long, value_name = "DIR", requires = "timings")]
+        figures: Option<PathBuf>,
     },
 }
 
@@ -134,15 +160,34 @@ fn main() {
             update,
             stiff,
             tolerances,
-        } => verify(update, stiff, tolerances),
+            timings,
+            figures,
+        } => verify(update, stiff, tolerances, timings.then_some(figures)),
         Command::Converge {
             scene,
             solvers,
+            osqp_eps,
+            penalty_epsilon,
+            reference_level,
+            repeats,
+            set,
             levels,
             ratio,
             out,
             viscosity_sweep,
-        } => match converge(&scene, &solvers, levels, ratio, out, viscosity_sweep) {
+        } => match converge(
+            &scene,
+            [&solvers, &osqp_eps, &penalty_epsilon],
+            &set,
+            viscobar::study::converge::StudyOptions {
+                levels,
+                ratio,
+                reference_level,
+                repeats,
+            },
+            out,
+            viscosity_sweep,
+        ) {
             Ok(()) => 0,
             Err(e) => {
                 eprintln!("error: {e}");
@@ -311,17 +356,22 @@ fn run(name: &str, out: Option<PathBuf>, set: &[String]) -> Result<(), viscobar:
     Ok(())
 }
 
+/// `[solvers, osqp_eps, penalty_epsilon]`: the three lists of `converge`.
 fn converge(
     name: &str,
-    solvers: &str,
-    levels: u32,
-    ratio: Option<f64>,
+    [solvers, osqp_eps, penalty_epsilon]: [&str; 3],
+    set: &[String],
+    options: viscobar::study::converge::StudyOptions,
     out: Option<PathBuf>,
     viscosity_sweep: bool,
 ) -> Result<(), viscobar::study::converge::ConvergeError> {
     use viscobar::study::{converge, viscosity_sweep as sweep};
-    let settings = converge::parse_solvers(solvers)?;
-    let (scene_name, scene) = scene::load(name, &[])?;
+    let settings = converge::parse_solvers_with(
+        solvers,
+        &converge::parse_tolerances("--osqp-eps", osqp_eps)?,
+        &converge::parse_tolerances("--penalty-epsilon", penalty_epsilon)?,
+    )?;
+    let (scene_name, scene) = scene::load(name, set)?;
     let out = out.unwrap_or_else(|| PathBuf::from("out").join(format!("converge-{scene_name}")));
     let files = if viscosity_sweep {
         let sweep = sweep::viscosity_sweep(
@@ -333,7 +383,7 @@ fn converge(
         print!("{}", sweep.markdown());
         sweep.write(&out)?
     } else {
-        let study = converge::study(&scene_name, &scene, &settings, levels, ratio)?;
+        let study = converge::study_with(&scene_name, &scene, &settings, &options)?;
         print!("{}", study.markdown());
         study.write(&out)?
     };
@@ -447,8 +497,16 @@ fn compare(name: &str, solvers: &str, set: &[String]) -> Result<(), viscobar::Ru
     Ok(())
 }
 
-fn verify(update: Option<PathBuf>, stiff: bool, tolerances: bool) -> i32 {
-    let sections = if stiff || tolerances {
+/// `timings`: `Some(figures folder)` for `--timings`.
+fn verify(
+    update: Option<PathBuf>,
+    stiff: bool,
+    tolerances: bool,
+    timings: Option<Option<PathBuf>>,
+) -> i32 {
+    let sections = if let Some(figures) = timings {
+        viscobar::study::timings::sections(figures.as_deref())
+    } else if stiff || tolerances {
         let results = viscobar::study::stiff_runs::run_all(viscobar::study::stiff::Size::Full);
         if stiff {
             Ok(vec![viscobar::study::verify::stiff_section(&results)])

@@ -477,3 +477,169 @@ fn compare_refuses_bad_input_with_2_and_a_failing_run_with_1() {
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("osqp") && err.contains("step"), "{err}");
 }
+
+/// A strict RFC 4180 reader (the `csv` crate is not in the offline registry of this build, so
+/// the test carries its own): records end at a line feed (the files are written with LF, not
+/// CRLF, on every platform), fields are split at commas; a field is either unquoted, holding
+/// no double quote, comma or line break, or wholly quoted, its quotes doubled, followed by a
+/// comma or the end of the record. Anything else panics, naming where.
+fn read_csv_strictly(text: &str) -> Vec<Vec<String>> {
+    let mut records = Vec::new();
+    let mut record = Vec::new();
+    let mut field = String::new();
+    let mut chars = text.chars().enumerate().peekable();
+    let mut at_field_start = true;
+    while let Some((i, c)) = chars.next() {
+        match c {
+            '"' if at_field_start => {
+                loop {
+                    match chars.next() {
+                        Some((_, '"')) if matches!(chars.peek(), Some((_, '"'))) => {
+                            chars.next();
+                            field.push('"');
+                        }
+                        Some((_, '"')) => break,
+                        Some((_, c)) => field.push(c),
+                        None => panic!("unterminated quoted field starting at character {i}"),
+                    }
+                }
+                match chars.peek() {
+                    Some((_, ',' | '\n')) | None => {}
+                    Some((j, c)) => panic!("{c:?} after a closing quote at character {j}"),
+                }
+                at_field_start = false;
+            }
+            '"' => panic!("a double quote inside an unquoted field at character {i}"),
+            '\r' => panic!("a carriage return at character {i} (records end with LF)"),
+            ',' => {
+                record.push(std::mem::take(&mut field));
+                at_field_start = true;
+            }
+            '\n' => {
+                record.push(std::mem::take(&mut field));
+                records.push(std::mem::take(&mut record));
+                at_field_start = true;
+            }
+            c => {
+                field.push(c);
+                at_field_start = false;
+            }
+        }
+    }
+    assert!(
+        record.is_empty() && field.is_empty(),
+        "the last record does not end with a line feed"
+    );
+    records
+}
+
+#[test]
+fn the_strict_csv_reader_refuses_what_rfc_4180_refuses() {
+    assert_eq!(
+        read_csv_strictly("a,\"b, \"\"c\"\"\",\n1,2,3\n"),
+        [vec!["a", "b, \"c\"", ""], vec!["1", "2", "3"]]
+    );
+    for bad in ["a,b\"c\n", "\"a\"b,c\n", "\"a,b\n", "a,b", "a,b\r\n"] {
+        assert!(
+            std::panic::catch_unwind(|| read_csv_strictly(bad)).is_err(),
+            "accepted {bad:?}"
+        );
+    }
+}
+
+/// `converge` as a researcher uses it on their own scene: a scene file (no closed form, so the
+/// reference is an exact run), `--set`, the reference level, a list of OSQP tolerances; the CSV
+/// reads back with one field per header (the reference cell holds commas), and the energy and
+/// contact-time errors are measured against the reference run.
+#[test]
+fn converge_on_a_scene_file_writes_valid_csv_with_energy_and_contact_errors() {
+    let out = tmpdir("converge-user");
+    std::fs::create_dir_all(&out).unwrap();
+    let file = out.join("my-impact.toml");
+    std::fs::write(&file, viscobar::scene::builtin_text("impact").unwrap()).unwrap();
+    let csv_dir = out.join("study");
+    let (code, stdout, err) = outcome(&[
+        "converge",
+        file.to_str().unwrap(),
+        "--set",
+        "time.end=1",
+        "--set",
+        "mesh.elements=50",
+        "--set",
+        "time.step=0.02",
+        "--solvers",
+        "exact,osqp",
+        "--osqp-eps",
+        "1e-6,1e-9",
+        "--levels",
+        "2",
+        "--reference-level",
+        "3",
+        "--repeats",
+        "1",
+        "--out",
+        csv_dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("level 3"), "{stdout}");
+    let records =
+        read_csv_strictly(&std::fs::read_to_string(csv_dir.join("convergence.csv")).unwrap());
+    let header = &records[0];
+    assert_eq!(header.len(), viscobar::study::converge::CSV_HEADER.len());
+    let column = |name: &str| header.iter().position(|h| h == name).unwrap();
+    // exact, osqp 1e-6, osqp 1e-9 at 2 levels.
+    assert_eq!(records.len(), 1 + 3 * 2, "{records:?}");
+    let settings: Vec<&str> = records[1..]
+        .iter()
+        .map(|r| r[column("setting")].as_str())
+        .collect();
+    assert_eq!(
+        settings,
+        ["-", "-", "eps=1e-6", "eps=1e-6", "eps=1e-9", "eps=1e-9"]
+    );
+    for r in &records[1..] {
+        assert_eq!(r.len(), header.len(), "{r:?}");
+        // Level 3 of 50 elements, dt halved with dx: 400 elements.
+        assert!(
+            r[column("reference")].starts_with("exact solver, 400 elements"),
+            "{r:?}"
+        );
+        assert_eq!(
+            r[column("steps")],
+            ["50", "100"][r[column("level")].parse::<usize>().unwrap()]
+        );
+        for name in [
+            "l2_error",
+            "energy_error",
+            "contact_time_error",
+            "wall_time_s",
+            "time_relative_to_exact",
+            "reference_l2_error_estimate",
+        ] {
+            let v: f64 = r[column(name)]
+                .parse()
+                .unwrap_or_else(|_| panic!("{name} is not a number: {r:?}"));
+            assert!(v.is_finite() && v >= 0.0, "{name} = {v}: {r:?}");
+        }
+    }
+}
+
+#[test]
+fn converge_refuses_bad_lists_and_levels_naming_the_flag() {
+    for (args, flag) in [
+        (&["--osqp-eps", "1e-4,0"][..], "--osqp-eps"),
+        (&["--penalty-epsilon", "small"][..], "--penalty-epsilon"),
+        (&["--reference-level", "1"][..], "--reference-level"),
+        (&["--repeats", "1000"][..], "--repeats"),
+        (&["--set", "time.step=10"][..], "time.step"),
+    ] {
+        let mut all = vec!["converge", "impact", "--levels", "2", "--out"];
+        let out = tmpdir("converge-bad");
+        all.push(out.to_str().unwrap());
+        all.extend(args);
+        let (code, _, err) = outcome(&all);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(flag), "{args:?}: {err}");
+        assert!(!out.exists(), "{args:?}: a refused study writes nothing");
+    }
+}

@@ -535,8 +535,11 @@ pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(String, Scene),
 }
 
 impl Scene {
-    /// Parses TOML text, applies `key=value` overrides (dotted keys, TOML values; a bare word
-    /// is taken as a string) and validates.
+    /// Parses TOML text, applies `key=value` overrides and validates. An override's key is
+    /// `section.field`; its value is read as a TOML value (`0.1`, `"x*(1 - x)"`, `true`), and a
+    /// value that is not valid TOML (a bare word such as `osqp`) is taken as a string. A number
+    /// is accepted wherever an expression is (`initial.displacement = 0.1`, in the file or
+    /// through `--set`), kept as its text ([`number_text`]).
     pub fn from_toml(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
         let syntax = |e: toml::de::Error| SceneError::Syntax(e.to_string().trim_end().to_string());
         let mut table: toml::Table = toml::from_str(text).map_err(syntax)?;

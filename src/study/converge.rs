@@ -2,10 +2,12 @@
 //! scene's closed form, or a finer run of the exact solver) and the data of the work-precision
 //! diagram (drawn by `study::work_precision`). The `α → 0` sweep is `study::viscosity_sweep`.
 //!
-//! Runs are independent and go to rayon's pool; each worker builds its own [`Simulation`]
-//! (OSQP's workspace is not `Send`), and results are sorted before anything is written, so the
-//! files do not depend on the scheduling. Wall times do: they are the only non-deterministic
-//! column.
+//! The error runs are independent and go to rayon's pool (both cores); each worker builds its
+//! own [`Simulation`] (OSQP's workspace is not `Send`), and results are sorted before anything
+//! is written, so the files do not depend on the scheduling. The wall times come from a second,
+//! serial pass that runs each setting and level alone `repeats` times and keeps the median
+//! ([`study_with`]): no timed run shares the cores with another run of the study. They are the
+//! only non-deterministic columns.
 
 use crate::bar::closed_form::{self, ClosedForm};
 use crate::scene::{Scene, SolverMethod, SolverSpec};
@@ -15,6 +17,7 @@ use crate::time::run::write_atomically;
 use crate::time::simulation::Simulation;
 use crate::time::summary::Tracker;
 use rayon::prelude::*;
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -86,7 +89,8 @@ impl SolverSetting {
             SolverSetting::Penalty(e) => format!("epsilon={e:e}"),
         }
     }
-    fn label(&self) -> String {
+    /// `exact`, `osqp eps=1e-7`, `penalty epsilon=1e-5`.
+    pub fn label(&self) -> String {
         match self {
             SolverSetting::Exact => "exact".into(),
             _ => format!("{} {}", self.solver(), self.setting()),
@@ -113,14 +117,25 @@ impl SolverSetting {
     }
 }
 
-/// The settings of a comma-separated solver list (`exact,osqp,penalty`), in that order.
+/// The settings of a comma-separated solver list (`exact,osqp,penalty`), in that order, with
+/// the default tolerances ([`OSQP_EPS`], [`PENALTY_EPSILON`]).
 pub fn parse_solvers(list: &str) -> Result<Vec<SolverSetting>, ConvergeError> {
+    parse_solvers_with(list, &OSQP_EPS, &PENALTY_EPSILON)
+}
+
+/// The settings of a comma-separated solver list: `osqp` once per tolerance of `osqp_eps`,
+/// `penalty` once per ε of `penalty_epsilon`.
+pub fn parse_solvers_with(
+    list: &str,
+    osqp_eps: &[f64],
+    penalty_epsilon: &[f64],
+) -> Result<Vec<SolverSetting>, ConvergeError> {
     let mut out = Vec::new();
     for name in list.split(',').map(str::trim) {
         match name {
             "exact" => out.push(SolverSetting::Exact),
-            "osqp" => out.extend(OSQP_EPS.iter().map(|e| SolverSetting::Osqp(*e))),
-            "penalty" => out.extend(PENALTY_EPSILON.iter().map(|e| SolverSetting::Penalty(*e))),
+            "osqp" => out.extend(osqp_eps.iter().map(|e| SolverSetting::Osqp(*e))),
+            "penalty" => out.extend(penalty_epsilon.iter().map(|e| SolverSetting::Penalty(*e))),
             _ => {
                 return Err(ConvergeError::BadInput(format!(
                     "--solvers: unknown solver `{name}` (known: exact, osqp, penalty)"
@@ -128,7 +143,32 @@ pub fn parse_solvers(list: &str) -> Result<Vec<SolverSetting>, ConvergeError> {
             }
         }
     }
-    out.dedup();
+    let mut unique: Vec<SolverSetting> = Vec::new();
+    for s in out {
+        if !unique.contains(&s) {
+            unique.push(s);
+        }
+    }
+    Ok(unique)
+}
+
+/// A comma-separated list of tolerances for the flag `flag` (`--osqp-eps 1e-4,1e-7`): each a
+/// finite number > 0; at least one.
+pub fn parse_tolerances(flag: &str, list: &str) -> Result<Vec<f64>, ConvergeError> {
+    let mut out = Vec::new();
+    for item in list.split(',').map(str::trim) {
+        let v: f64 = item.parse().map_err(|_| {
+            ConvergeError::BadInput(format!(
+                "{flag} {list}: `{item}` is not a number (a comma-separated list, e.g. 1e-4,1e-7)"
+            ))
+        })?;
+        if !(v.is_finite() && v > 0.0) {
+            return Err(ConvergeError::BadInput(format!(
+                "{flag} {list}: `{item}` must be a finite number > 0"
+            )));
+        }
+        out.push(v);
+    }
     Ok(out)
 }
 
@@ -143,7 +183,7 @@ pub fn refined(base: &Scene, level: u32, ratio: f64) -> Scene {
 pub enum Reference {
     /// The closed form of the built-in scene `name`.
     ClosedForm { name: String },
-    /// A run of the exact solver at `elements` elements, sampled at `times` on the nodes of the
+    /// A run of the exact solver at a finer level, sampled at `times` on the nodes of the
     /// finest level of the study.
     Run(Arc<SampledReference>),
 }
@@ -152,21 +192,33 @@ impl Reference {
     pub fn describe(&self) -> String {
         match self {
             Reference::ClosedForm { name } => format!("closed form ({name})"),
-            Reference::Run(r) => format!("exact solver, {} elements", r.elements),
+            Reference::Run(r) => format!(
+                "exact solver, {} elements, dt = {:e} (level {})",
+                r.elements, r.dt, r.level
+            ),
         }
     }
 }
 
-/// A reference run kept at a few times on a coarser node set.
+/// A reference run of the exact solver, kept at a few times on a coarser node set, with its
+/// energy at every one of its time steps and its contact intervals.
 pub struct SampledReference {
     pub elements: usize,
-    /// The step indices (of the coarsest level) at which `values` are kept.
-    pub coarse_steps: Vec<usize>,
-    /// Steps of the coarsest level.
-    pub coarse_dt: f64,
-    /// Nodes of the finest level.
+    /// Its refinement level (the scene's mesh is level 0).
+    pub level: u32,
+    pub dt: f64,
+    /// The time indices of the coarsest level (`t = c · Δt_0`, `c >= 1`) at which `values`
+    /// are kept.
+    pub coarse_times: Vec<usize>,
+    /// Nodes of the finest level of the study.
     pub nodes: usize,
     pub values: Vec<Vec<f64>>,
+    /// `E(t_m)` at the reference's own time steps `t_m = m · dt`, as the mean of its
+    /// `E^{m−1/2}` and `E^{m+1/2}` (`NaN` where a neighbour was not measured); index `m`.
+    pub energy: Vec<f64>,
+    /// Its contact intervals per Signorini end (and `obstacle` for the whole contact set), as in
+    /// `summary.json`.
+    pub contact: BTreeMap<String, Vec<[f64; 2]>>,
 }
 
 /// One row of `convergence.csv`.
@@ -182,6 +234,8 @@ pub struct Row {
     pub h1_error: f64,
     pub energy_error: Option<f64>,
     pub contact_time_error: Option<f64>,
+    /// Wall time of the steps (set-up excluded), seconds: the median of the serial timing
+    /// pass (or, with no repeats asked, the time measured during the parallel error pass).
     pub wall_time_s: f64,
 }
 
@@ -201,7 +255,7 @@ fn h1_seminorm(e: &[f64], dx: f64) -> f64 {
 }
 
 /// Runs `scene` (already set to its solver and level), measuring against `reference`. Only
-/// the steps are timed.
+/// the steps are timed. `finest`: the finest level of the study.
 fn measure(
     scene_name: &str,
     scene: &Scene,
@@ -214,8 +268,13 @@ fn measure(
         Reference::ClosedForm { name } => closed_form::for_scene(name, scene),
         Reference::Run(_) => None,
     };
-    // Compared only where the closed form states its energy.
+    let run = match reference {
+        Reference::Run(r) => Some(r.as_ref()),
+        Reference::ClosedForm { .. } => None,
+    };
+    // Compared only where the closed form states its energy, or against the reference run.
     let energy = closed.as_deref().filter(|c| c.energy(0.0).is_some());
+    let compare_energy = energy.is_some() || run.is_some();
     let mut sim = Simulation::new(scene)?;
     let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
     let nodes = sim.discretisation().nodes;
@@ -225,8 +284,9 @@ fn measure(
     let mut e = vec![0.0; nodes];
     let (mut l2, mut h1, mut en) = (0.0f64, 0.0f64, 0.0f64);
     let mut sample = 0usize;
-    let mut observe = |sim: &Simulation, step: usize, u: &mut Vec<f64>, e: &mut Vec<f64>| {
-        let have = match (&closed, reference) {
+    // `k`: the time index of the state `u^k` the simulation holds (`u^1` after the start-up).
+    let mut observe = |sim: &Simulation, k: usize, u: &mut Vec<f64>, e: &mut Vec<f64>| {
+        let have = match (&closed, run) {
             (Some(c), _) => {
                 sim.displacement_into(u);
                 let t = sim.time();
@@ -235,11 +295,11 @@ fn measure(
                 }
                 true
             }
-            (None, Reference::Run(r)) => {
-                // Steps of this level per coarse step, and finest-level nodes per node here.
-                let per = 1usize << level;
+            (None, Some(r)) => {
+                // The same time t = c·Δt_0 at this level and in the reference; the reference's
+                // values are on the finest level's nodes.
                 let stride = 1usize << (finest - level);
-                if sample < r.coarse_steps.len() && step == r.coarse_steps[sample] * per {
+                if sample < r.coarse_times.len() && k == r.coarse_times[sample] << level {
                     sim.displacement_into(u);
                     let v = &r.values[sample];
                     for i in 0..nodes {
@@ -251,14 +311,14 @@ fn measure(
                     false
                 }
             }
-            (None, Reference::ClosedForm { .. }) => false,
+            (None, None) => false,
         };
         if have {
             l2 = l2.max(l2_norm(e, dx));
             h1 = h1.max(h1_seminorm(e, dx));
         }
     };
-    observe(&sim, 0, &mut u, &mut e);
+    observe(&sim, 1, &mut u, &mut e);
     let mut wall = 0.0;
     for n in 1..scene.steps() {
         let start = Instant::now();
@@ -266,24 +326,44 @@ fn measure(
         wall += start.elapsed().as_secs_f64();
         tracker.observe(&r);
         // E^{n+1/2} lives at t_{n+1} − Δt/2.
-        if let Some(exact) = energy.and_then(|c| c.energy(r.time - 0.5 * dt)) {
-            en = en.max((r.energy - exact).abs());
+        if r.measured {
+            let exact = match (energy, run) {
+                (Some(c), _) => c.energy(r.time - 0.5 * dt),
+                // t_{n+1} − Δt/2 = (2n + 1)·2^(R − l − 1) reference steps.
+                (None, Some(rf)) => {
+                    let m = (2 * n + 1) << (rf.level - level - 1);
+                    rf.energy.get(m).copied().filter(|v| v.is_finite())
+                }
+                (None, None) => None,
+            };
+            if let Some(exact) = exact {
+                en = en.max((r.energy - exact).abs());
+            }
         }
-        observe(&sim, n, &mut u, &mut e);
+        observe(&sim, n + 1, &mut u, &mut e);
     }
-    let contact_time_error = match closed
-        .as_ref()
-        .and_then(|c| c.contact_intervals(sim.time()))
-    {
-        Some(exact) => {
-            let summary = tracker.finish(scene_name, &sim, wall);
+    let summary = tracker.finish(scene_name, &sim, wall);
+    let contact_time_error = match (&closed, run) {
+        (Some(c), _) => c.contact_intervals(sim.time()).and_then(|exact| {
             let discrete = summary
                 .contact_intervals
                 .get("left")
                 .map_or(&[][..], |v| &v[..]);
             contact_time_error(&exact, discrete)
-        }
-        _ => None,
+        }),
+        // Every side on which the reference touches; the worst.
+        (None, Some(rf)) => rf
+            .contact
+            .iter()
+            .filter_map(|(side, exact)| {
+                let discrete = summary
+                    .contact_intervals
+                    .get(side)
+                    .map_or(&[][..], |v| &v[..]);
+                contact_time_error(exact, discrete)
+            })
+            .reduce(f64::max),
+        (None, None) => None,
     };
     Ok(Row {
         setting,
@@ -294,7 +374,7 @@ fn measure(
         steps: scene.steps(),
         l2_error: l2,
         h1_error: h1,
-        energy_error: energy.map(|_| en),
+        energy_error: compare_energy.then_some(en),
         contact_time_error,
         wall_time_s: wall,
     })
@@ -325,42 +405,73 @@ pub fn contact_time_error(exact: &[[f64; 2]], discrete: &[[f64; 2]]) -> Option<f
     }))
 }
 
-/// The exact solver at `levels − 1 + REFERENCE_EXTRA_LEVELS`, kept at (at most
-/// [`REFERENCE_MAX_SAMPLES`]) steps of the coarsest level, on the finest level's nodes.
-fn reference_run(base: &Scene, levels: u32, ratio: f64) -> Result<SampledReference, RunError> {
-    let finest = levels - 1;
-    let scene = SolverSetting::Exact.apply(&refined(base, finest + REFERENCE_EXTRA_LEVELS, ratio));
-    let coarse = refined(base, 0, ratio);
-    let coarse_steps_total = coarse.steps();
+/// The exact solver at level `level` (above the study's finest, `finest`), kept at (at most
+/// [`REFERENCE_MAX_SAMPLES`]) times of the coarsest level on the finest level's nodes, with
+/// its energy at every step and its contact intervals.
+fn reference_run(
+    scene_name: &str,
+    base: &Scene,
+    finest: u32,
+    level: u32,
+    ratio: f64,
+) -> Result<SampledReference, RunError> {
+    let scene = SolverSetting::Exact.apply(&refined(base, level, ratio));
+    let coarse_steps_total = refined(base, 0, ratio).steps();
     let every = coarse_steps_total.div_ceil(REFERENCE_MAX_SAMPLES).max(1);
-    let coarse_steps: Vec<usize> = (0..coarse_steps_total).step_by(every).collect();
-    let per = 1usize << (finest + REFERENCE_EXTRA_LEVELS);
-    let stride = 1usize << REFERENCE_EXTRA_LEVELS;
+    let coarse_times: Vec<usize> = (every..=coarse_steps_total).step_by(every).collect();
+    let stride = 1usize << (level - finest);
     let mut sim = Simulation::new(&scene)?;
+    let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
     let all = sim.discretisation().nodes;
     let mut u = vec![0.0; all];
-    let mut values = Vec::with_capacity(coarse_steps.len());
-    let mut next = 0usize;
-    let mut n = 0usize;
-    loop {
-        if next < coarse_steps.len() && n == coarse_steps[next] * per {
+    let mut values = Vec::with_capacity(coarse_times.len());
+    // E^{k−1/2} by step k (index 0 unused).
+    let first = sim.first_record();
+    let mut half = vec![f64::NAN; scene.steps() + 1];
+    half[1] = if first.measured {
+        first.energy
+    } else {
+        f64::NAN
+    };
+    let mut keep = |k: usize, sim: &Simulation, values: &mut Vec<Vec<f64>>| {
+        if values.len() < coarse_times.len() && k == coarse_times[values.len()] << level {
             sim.displacement_into(&mut u);
             values.push(u.iter().step_by(stride).copied().collect::<Vec<f64>>());
-            next += 1;
         }
-        if next == coarse_steps.len() || n + 1 >= scene.steps() {
-            break;
+    };
+    keep(1, &sim, &mut values);
+    for n in 1..scene.steps() {
+        let r = sim.step()?;
+        tracker.observe(&r);
+        if r.measured {
+            half[n + 1] = r.energy;
         }
-        sim.step()?;
-        n += 1;
+        keep(n + 1, &sim, &mut values);
     }
     let kept = values.len();
+    let energy: Vec<f64> = (0..half.len())
+        .map(|m| {
+            if m >= 1 && m + 1 < half.len() {
+                0.5 * (half[m] + half[m + 1])
+            } else {
+                f64::NAN
+            }
+        })
+        .collect();
+    let summary = tracker.finish(scene_name, &sim, 0.0);
     Ok(SampledReference {
         elements: scene.mesh.elements as usize,
-        coarse_steps: coarse_steps[..kept].to_vec(),
-        coarse_dt: coarse.time.step,
+        level,
+        dt: scene.time.step,
+        coarse_times: coarse_times[..kept].to_vec(),
         nodes: (all - 1) / stride + 1,
         values,
+        energy,
+        contact: summary
+            .contact_intervals
+            .into_iter()
+            .filter(|(_, v)| !v.is_empty())
+            .collect(),
     })
 }
 
@@ -369,10 +480,52 @@ fn reference_run(base: &Scene, levels: u32, ratio: f64) -> Result<SampledReferen
 pub struct Study {
     pub scene: String,
     pub reference: String,
+    /// The reference's own estimated L2 error (max over t): 0 for a closed form; for a run,
+    /// Richardson's estimate `e_F / (2^(p·(R − F)) − 1)` from the exact solver's error `e_F` at
+    /// the finest level `F` of the study, its observed L2 order `p` and the reference level
+    /// `R` (`None` without the exact solver in the study or without a positive order).
+    pub reference_error: Option<f64>,
+    /// Timing repeats per run of the serial pass (0: timed in the parallel error pass).
+    pub repeats: usize,
     pub rows: Vec<Row>,
 }
 
-/// Runs every setting at every level in parallel. `ratio`: `dt/dx` (default: the scene's).
+/// Default timing repeats of `viscobar converge` (the median is kept).
+pub const DEFAULT_REPEATS: usize = 3;
+/// Most timing repeats accepted (each repeats the whole study's runs serially).
+pub const MAX_REPEATS: usize = 15;
+/// Finest reference level accepted: `2^16` times the scene's elements and steps.
+pub const MAX_REFERENCE_LEVEL: u32 = 16;
+
+/// How a study is run.
+#[derive(Clone, Debug)]
+pub struct StudyOptions {
+    /// Levels of refinement (`dx` and `dt` halved per level from the scene's mesh).
+    pub levels: u32,
+    /// `dt/dx` at every level (default: the scene's).
+    pub ratio: Option<f64>,
+    /// The level of the exact reference run (the scene's mesh is level 0). `None`: the closed
+    /// form when the scene has one, else `levels − 1 + REFERENCE_EXTRA_LEVELS`. Given, the
+    /// reference is a run even for a scene with a closed form.
+    pub reference_level: Option<u32>,
+    /// Timing repeats per run in the serial pass, median kept; 0: no serial pass (wall times
+    /// of the parallel error pass, disturbed by the runs beside them).
+    pub repeats: usize,
+}
+
+impl StudyOptions {
+    pub fn new(levels: u32, ratio: Option<f64>) -> Self {
+        Self {
+            levels,
+            ratio,
+            reference_level: None,
+            repeats: 1,
+        }
+    }
+}
+
+/// Runs every setting at every level; one serial timing repeat
+/// ([`study_with`] and [`StudyOptions`] for the other choices).
 pub fn study(
     scene_name: &str,
     base: &Scene,
@@ -380,6 +533,46 @@ pub fn study(
     levels: u32,
     ratio: Option<f64>,
 ) -> Result<Study, ConvergeError> {
+    study_with(
+        scene_name,
+        base,
+        settings,
+        &StudyOptions::new(levels, ratio),
+    )
+}
+
+/// Wall time of the steps of one run of `scene` (set-up excluded), seconds.
+pub fn time_steps(scene: &Scene) -> Result<f64, RunError> {
+    let mut sim = Simulation::new(scene)?;
+    let start = Instant::now();
+    for _ in 1..scene.steps() {
+        sim.step()?;
+    }
+    Ok(start.elapsed().as_secs_f64())
+}
+
+/// The median of `v` (the mean of the middle two for an even count); `v` not empty.
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Runs every setting at every level: the errors in parallel on rayon's pool (each run is
+/// independent and deterministic), then, with `repeats > 0`, a serial pass that times each
+/// run alone `repeats` times and keeps the median, so no run is timed while another shares
+/// the machine's cores.
+pub fn study_with(
+    scene_name: &str,
+    base: &Scene,
+    settings: &[SolverSetting],
+    options: &StudyOptions,
+) -> Result<Study, ConvergeError> {
+    let levels = options.levels;
     if levels < 2 {
         return Err(ConvergeError::BadInput(format!(
             "--levels {levels}: at least 2 levels are needed for an observed order"
@@ -390,18 +583,38 @@ pub fn study(
             "--levels {levels}: at most 12 (each level doubles the elements)"
         )));
     }
-    let ratio = ratio.unwrap_or(base.time.step / base.dx());
+    let ratio = options.ratio.unwrap_or(base.time.step / base.dx());
     if !(ratio.is_finite() && ratio > 0.0) {
         return Err(ConvergeError::BadInput(format!(
             "--ratio {ratio}: dt/dx must be positive and finite"
         )));
     }
-    let reference = if closed_form::for_scene(scene_name, base).is_some() {
-        Reference::ClosedForm {
+    if options.repeats > MAX_REPEATS {
+        return Err(ConvergeError::BadInput(format!(
+            "--repeats {}: at most {MAX_REPEATS} (each repeat times every run again)",
+            options.repeats
+        )));
+    }
+    let finest = levels - 1;
+    if let Some(r) = options.reference_level
+        && (r <= finest || r > MAX_REFERENCE_LEVEL)
+    {
+        return Err(ConvergeError::BadInput(format!(
+            "--reference-level {r}: must be finer than the finest level of the study ({finest}, \
+             with --levels {levels}) and at most {MAX_REFERENCE_LEVEL}"
+        )));
+    }
+    let reference = match options.reference_level {
+        None if closed_form::for_scene(scene_name, base).is_some() => Reference::ClosedForm {
             name: scene_name.to_string(),
-        }
-    } else {
-        Reference::Run(Arc::new(reference_run(base, levels, ratio)?))
+        },
+        level => Reference::Run(Arc::new(reference_run(
+            scene_name,
+            base,
+            finest,
+            level.unwrap_or(finest + REFERENCE_EXTRA_LEVELS),
+            ratio,
+        )?)),
     };
     let tasks: Vec<(SolverSetting, u32)> = settings
         .iter()
@@ -415,15 +628,75 @@ pub fn study(
         .map(|&i| {
             let (setting, level) = tasks[i];
             let scene = setting.apply(&refined(base, level, ratio));
-            measure(scene_name, &scene, setting, level, levels - 1, &reference).map(|r| (i, r))
+            measure(scene_name, &scene, setting, level, finest, &reference).map(|r| (i, r))
         })
         .collect::<Result<Vec<_>, RunError>>()?;
     rows.sort_by_key(|(i, _)| *i);
+    let mut rows: Vec<Row> = rows.into_iter().map(|(_, r)| r).collect();
+    if options.repeats > 0 {
+        for row in &mut rows {
+            let scene = row.setting.apply(&refined(base, row.level, ratio));
+            let times = (0..options.repeats)
+                .map(|_| time_steps(&scene))
+                .collect::<Result<Vec<f64>, RunError>>()?;
+            row.wall_time_s = median(times);
+        }
+    }
+    let reference_error = match &reference {
+        Reference::ClosedForm { .. } => Some(0.0),
+        Reference::Run(r) => {
+            let exact: Vec<&Row> = rows
+                .iter()
+                .filter(|r| r.setting == SolverSetting::Exact)
+                .collect();
+            let h: Vec<f64> = exact.iter().map(|r| r.dx).collect();
+            let e: Vec<f64> = exact.iter().map(|r| r.l2_error).collect();
+            let p = if exact.len() >= 2 {
+                observed_order(&h, &e)
+            } else {
+                f64::NAN
+            };
+            exact
+                .last()
+                .filter(|_| p.is_finite() && p > 0.0)
+                .map(|f| f.l2_error / (2f64.powf(p * f64::from(r.level - f.level)) - 1.0))
+        }
+    };
     Ok(Study {
         scene: scene_name.to_string(),
         reference: reference.describe(),
-        rows: rows.into_iter().map(|(_, r)| r).collect(),
+        reference_error,
+        repeats: options.repeats,
+        rows,
     })
+}
+
+/// The columns of `convergence.csv` (README, "Refinement study").
+pub const CSV_HEADER: [&str; 14] = [
+    "solver",
+    "setting",
+    "level",
+    "elements",
+    "dt",
+    "steps",
+    "l2_error",
+    "h1_error",
+    "energy_error",
+    "contact_time_error",
+    "wall_time_s",
+    "time_relative_to_exact",
+    "reference",
+    "reference_l2_error_estimate",
+];
+
+/// One CSV cell per RFC 4180: quoted (its quotes doubled) when it holds a comma, a double
+/// quote, a carriage return or a line feed; as is otherwise.
+pub fn csv_cell(text: &str) -> String {
+    if text.contains([',', '"', '\r', '\n']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
 }
 
 /// The settings in the order they first appear.
@@ -455,29 +728,51 @@ impl Study {
             .collect()
     }
 
+    /// `convergence.csv`: RFC 4180 (comma-separated, a cell with a comma, a double quote or a
+    /// line break quoted, its quotes doubled; CRLF-free, one header line). One row per run; the
+    /// reference and its estimated error repeated on every row so each row stands alone.
     pub fn csv(&self) -> String {
-        let mut out = String::from(
-            "solver,setting,elements,dt,steps,l2_error,h1_error,energy_error,contact_time_error,wall_time_s,reference\n",
-        );
+        let mut out = CSV_HEADER.join(",");
+        out.push('\n');
         let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:e}"));
-        for r in &self.rows {
-            let _ = writeln!(
-                out,
-                "{},{},{},{:e},{},{:e},{:e},{},{},{:.6},{}",
-                r.setting.solver(),
+        let relative = self.time_relative_to_exact();
+        for (r, rel) in self.rows.iter().zip(relative) {
+            let cells = [
+                r.setting.solver().to_string(),
                 r.setting.setting(),
-                r.elements,
-                r.dt,
-                r.steps,
-                r.l2_error,
-                r.h1_error,
+                r.level.to_string(),
+                r.elements.to_string(),
+                format!("{:e}", r.dt),
+                r.steps.to_string(),
+                format!("{:e}", r.l2_error),
+                format!("{:e}", r.h1_error),
                 opt(r.energy_error),
                 opt(r.contact_time_error),
-                r.wall_time_s,
-                self.reference
-            );
+                format!("{:.6}", r.wall_time_s),
+                opt(rel),
+                self.reference.clone(),
+                opt(self.reference_error),
+            ];
+            let cells: Vec<String> = cells.iter().map(|c| csv_cell(c)).collect();
+            out.push_str(&cells.join(","));
+            out.push('\n');
         }
         out
+    }
+
+    /// Each row's wall time over the exact solver's on the same level (`None` without an
+    /// exact row at that level).
+    pub fn time_relative_to_exact(&self) -> Vec<Option<f64>> {
+        self.rows
+            .iter()
+            .map(|r| {
+                self.rows
+                    .iter()
+                    .find(|e| e.setting == SolverSetting::Exact && e.level == r.level)
+                    .filter(|e| e.wall_time_s > 0.0)
+                    .map(|e| r.wall_time_s / e.wall_time_s)
+            })
+            .collect()
     }
 
     /// The Markdown table of the runs, one row each: the `lead` columns, the four errors
@@ -510,7 +805,18 @@ impl Study {
     }
 
     pub fn markdown(&self) -> String {
-        let mut md = format!("Scene `{}`, reference: {}\n\n", self.scene, self.reference);
+        let mut md = format!(
+            "Scene `{}`, reference: {} (its estimated L2 error: {}); wall time of the steps: {}\n\n",
+            self.scene,
+            self.reference,
+            self.reference_error
+                .map_or("not estimated".to_string(), |e| format!("{e:.3e}")),
+            if self.repeats == 0 {
+                "timed in the parallel error pass".to_string()
+            } else {
+                format!("median of {} serial repeats", self.repeats)
+            }
+        );
         md.push_str(&self.table(
             &[
                 ("solver", |r| r.setting.solver().to_string()),

@@ -367,7 +367,13 @@ where
     match ContactPanel::for_history(&run.contact) {
         ContactPanel::Reactions => draw_reactions(area, run, run.final_time()),
         ContactPanel::ContactSet => {
-            draw_contact_set(area, &run.contact, run.length, run.final_time())
+            let episodes = run.summary.contact_episodes.get(OBSTACLE_EPISODES);
+            let spans: Vec<[f64; 2]> = episodes
+                .into_iter()
+                .flatten()
+                .map(|e| [e.start, e.end])
+                .collect();
+            draw_contact_set(area, &run.contact, &spans, run.length, run.final_time())
         }
     }
 }
@@ -462,27 +468,47 @@ where
     Ok(())
 }
 
-/// The contact set over `(x, t)`: dark where a constraint touched its obstacle in a time bin.
-/// For distributed obstacles (more constraints than [`MAX_REACTION_LINES`]).
+/// The key of the whole obstacle's contact episodes in `summary.json` (one list for the whole
+/// contact set: an episode lasts while any node is in contact).
+const OBSTACLE_EPISODES: &str = "obstacle";
+
+/// The contact set over `(x, t)`: dark where a constraint touched its obstacle in a time bin,
+/// over the contact episodes of the whole set (`summary.json`, `obstacle`) shaded as bands
+/// across the bar, in the contact colour at the reaction panels' [`EPISODE_OPACITY`]. For
+/// distributed obstacles (more constraints than [`MAX_REACTION_LINES`]).
 fn draw_contact_set<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     h: &ContactHistory,
+    episodes: &[[f64; 2]],
     length: f64,
     t_end: f64,
 ) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
-    let area = area.titled("contact set (dark: u + a = 0)", sans(PANEL_FONT))?;
+    let area = area.titled(
+        "contact set (dark: u + a = 0; shaded: contact episodes)",
+        sans(PANEL_FONT),
+    )?;
     let extent = (length, t_end);
     let mut chart = space_time_chart(&area, extent)?;
+    let shade = over_white(CONTACT_COLOUR, EPISODE_OPACITY);
     draw_raster(&mut chart, extent, &h.xs, &h.times, |j, bin| {
+        let t = h.times[bin];
         if h.in_contact(bin, j) {
             CONTACT_COLOUR
+        } else if episodes.iter().any(|e| e[0] <= t && t <= e[1]) {
+            shade
         } else {
             WHITE
         }
     })
+}
+
+/// `colour` at `opacity` over white, as one opaque colour (the raster has no alpha).
+fn over_white(colour: RGBColor, opacity: f64) -> RGBColor {
+    let mix = |c: u8| (opacity * f64::from(c) + (1.0 - opacity) * 255.0).round() as u8;
+    RGBColor(mix(colour.0), mix(colour.1), mix(colour.2))
 }
 
 /// Opacity of the fill under a reaction line.
@@ -511,18 +537,22 @@ const CONTACT_COLOUR: RGBColor = RGBColor(68, 1, 84);
 mod tests {
     use super::*;
 
-    /// Pixels of `colour` in a drawing of the contact set of `h`.
-    fn contact_pixels(h: &ContactHistory) -> usize {
+    /// Pixels of `colour` in a drawing of the contact set of `h` over `episodes`.
+    fn pixels(h: &ContactHistory, episodes: &[[f64; 2]], colour: RGBColor) -> usize {
         const SIZE: (u32, u32) = (400, 300);
         let mut buf = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
         {
             let root = BitMapBackend::with_buffer(&mut buf, SIZE).into_drawing_area();
             root.fill(&WHITE).unwrap();
-            draw_contact_set(&root, h, 1.0, 1.0).unwrap();
+            draw_contact_set(&root, h, episodes, 1.0, 1.0).unwrap();
             root.present().unwrap();
         }
-        let c = CONTACT_COLOUR;
+        let c = colour;
         buf.chunks(3).filter(|p| *p == [c.0, c.1, c.2]).count()
+    }
+
+    fn contact_pixels(h: &ContactHistory) -> usize {
+        pixels(h, &[], CONTACT_COLOUR)
     }
 
     /// The hook for distributed obstacles: with more constraints than the reaction panel can
@@ -551,5 +581,38 @@ mod tests {
         // One of 5 columns by one of 4 rows of the plot area (about 320 x 220 pixels).
         let n = contact_pixels(&touching);
         assert!((2000..6000).contains(&n), "{n} contact pixels");
+    }
+
+    /// The obstacle's contact episodes are shaded as bands across the bar, behind the contact
+    /// set (which keeps its colour): none without episodes, the whole time bin of an episode
+    /// across the bar but the touching cell.
+    #[test]
+    fn the_obstacle_episodes_are_shaded_behind_the_contact_set() {
+        register_font().unwrap();
+        let names = (0..5).map(|i| format!("node {i}")).collect();
+        let xs = (0..5).map(|i| f64::from(i) * 0.25).collect();
+        let mut h = ContactHistory::new(names, xs);
+        for (bin, t) in [0.25, 0.5, 0.75, 1.0].into_iter().enumerate() {
+            let mut gaps = [1.0; 5];
+            if bin == 2 {
+                gaps[3] = 0.0;
+            }
+            h.observe(t, &gaps, &[0.0; 5], true);
+        }
+        let shade = over_white(CONTACT_COLOUR, EPISODE_OPACITY);
+        assert_eq!(pixels(&h, &[], shade), 0);
+        let episode = [[0.7, 0.8]]; // the third bin's time, 0.75
+        let (shaded, dark) = (
+            pixels(&h, &episode, shade),
+            pixels(&h, &episode, CONTACT_COLOUR),
+        );
+        assert_eq!(dark, contact_pixels(&h), "the contact set keeps its colour");
+        // The band: the third of 4 time bins across the whole bar; node 3's column (a quarter
+        // of the width: nodes 0 and 4 own half columns) stays dark, so 3x its pixels are shaded
+        // (±10% for the pixel rounding of the bin edges).
+        assert!(
+            (27 * dark / 10..33 * dark / 10).contains(&shaded),
+            "{shaded} shaded pixels, {dark} dark"
+        );
     }
 }

@@ -16,6 +16,7 @@ pub mod sampled_run;
 pub mod stiff;
 pub mod stiff_runs;
 pub mod tolerances;
+pub mod timings;
 pub mod verify;
 pub mod viscosity_sweep;
 pub mod viscous_contact;
