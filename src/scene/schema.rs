@@ -152,7 +152,7 @@ pub fn number_text(v: f64) -> String {
 /// Serde: an expression field given as a string (the expression) or as a number (TOML integer
 /// or float, kept as [`number_text`]). A non-finite float is kept as `inf`/`NaN`, which the
 /// expression parser then refuses with the field's name.
-fn number_or_expression<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+pub(crate) fn number_or_expression<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error> {
     struct Visitor;
     impl serde::de::Visitor<'_> for Visitor {
         type Value = String;
@@ -357,10 +357,10 @@ pub const MAX_ELEMENTS: u64 = 100_000_000;
 /// Memory per node of a run: about 40 vectors of f64 (state, products, matrices, factors,
 /// solver columns, output buffers) with a margin for the solver's own work space.
 pub const BYTES_PER_NODE: u64 = 512;
-const GIB: f64 = (1u64 << 30) as f64;
+pub(crate) const GIB: f64 = (1u64 << 30) as f64;
 
 /// `MemAvailable` from /proc/meminfo, or 24 GiB (this project's machines) where unreadable.
-fn available_memory_bytes() -> u64 {
+pub(crate) fn available_memory_bytes() -> u64 {
     std::fs::read_to_string("/proc/meminfo")
         .ok()
         .and_then(|t| {
@@ -630,7 +630,7 @@ const SUGGESTION_DIGITS: usize = 12;
 /// `time.step` must divide `time.end` (up to [`TIME_GRID_TOL`]): the run then ends at
 /// `time.end` exactly instead of at the nearest multiple of the step. Refused otherwise, with
 /// the nearest valid ends for this step and the nearest valid steps for this end.
-fn check_time_grid(step: f64, end: f64) -> Result<(), SceneError> {
+pub(crate) fn check_time_grid(step: f64, end: f64) -> Result<(), SceneError> {
     let ratio = end / step;
     let n = ratio.round();
     if n >= 1.0 && (ratio - n).abs() <= TIME_GRID_TOL * n {
@@ -668,7 +668,7 @@ fn check_time_grid(step: f64, end: f64) -> Result<(), SceneError> {
     })
 }
 
-fn invalid(field: &str, value: f64, allowed: &str) -> SceneError {
+pub(crate) fn invalid(field: &str, value: f64, allowed: &str) -> SceneError {
     SceneError::Invalid {
         field: field.to_string(),
         value: value.to_string(),
@@ -676,7 +676,7 @@ fn invalid(field: &str, value: f64, allowed: &str) -> SceneError {
     }
 }
 
-fn positive(field: &str, value: f64) -> Result<(), SceneError> {
+pub(crate) fn positive(field: &str, value: f64) -> Result<(), SceneError> {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
@@ -684,7 +684,7 @@ fn positive(field: &str, value: f64) -> Result<(), SceneError> {
     }
 }
 
-fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), SceneError> {
+pub(crate) fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), SceneError> {
     let fail = |reason: &str| SceneError::Override {
         assignment: assignment.to_string(),
         reason: reason.to_string(),
