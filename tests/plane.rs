@@ -58,7 +58,10 @@ fn energy_identity_holds_at_every_step_of_every_builtin_plane_scene_and_the_manu
             assert!(records.iter().any(|r| r.work != 0.0), "{name}");
         }
         if scene.plane.viscosity > 0.0 {
-            assert!(records[1..].iter().all(|r| r.viscous_dissipation > 0.0), "{name}");
+            assert!(
+                records[1..].iter().all(|r| r.viscous_dissipation > 0.0),
+                "{name}"
+            );
         }
     }
 }
@@ -203,5 +206,8 @@ fn manufactured_solution_converges_at_order_two_with_dt_proportional_to_h() {
     );
     let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
         / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
-    assert!((slope - 2.0).abs() <= ORDER_TOL, "order {slope}: {levels:?}");
+    assert!(
+        (slope - 2.0).abs() <= ORDER_TOL,
+        "order {slope}: {levels:?}"
+    );
 }

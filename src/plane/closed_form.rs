@@ -79,7 +79,11 @@ impl Manufactured {
     fn g(&self, t: f64) -> [f64; 3] {
         let (s, c) = (self.omega * t).sin_cos();
         let g = c + self.beta * s;
-        [g, self.omega * (self.beta * c - s), -self.omega * self.omega * g]
+        [
+            g,
+            self.omega * (self.beta * c - s),
+            -self.omega * self.omega * g,
+        ]
     }
 
     /// `Φ(x, y)`.
@@ -276,7 +280,12 @@ mod tests {
         let mut scale = 0.0f64;
         let mut worst_fd = 0.0f64;
         let mut worst_text = 0.0f64;
-        for (x, y, t) in [(0.3, 0.2, 0.1), (1.1, 0.7, 0.45), (1.7, 0.55, 1.3), (0.9, 0.35, 0.0)] {
+        for (x, y, t) in [
+            (0.3, 0.2, 0.1),
+            (1.1, 0.7, 0.45),
+            (1.7, 0.55, 1.3),
+            (0.9, 0.35, 0.0),
+        ] {
             let exact = m.load(x, y, t);
             let fd = residual_load(&m, x, y, t);
             for c in 0..2 {
@@ -286,10 +295,18 @@ mod tests {
             }
         }
         assert!(worst_fd <= FD_TOL * scale, "{worst_fd:e} vs {scale:e}");
-        assert!(worst_text <= TEXT_TOL * scale, "{worst_text:e} vs {scale:e}");
+        assert!(
+            worst_text <= TEXT_TOL * scale,
+            "{worst_text:e} vs {scale:e}"
+        );
         // The boundary: Φ vanishes on every edge (clamped data are exact).
         for s in [0.0, 0.37, 1.0] {
-            for [x, y] in [[0.0, s], [m.width, s], [s * m.width, 0.0], [s * m.width, m.height]] {
+            for [x, y] in [
+                [0.0, s],
+                [m.width, s],
+                [s * m.width, 0.0],
+                [s * m.width, m.height],
+            ] {
                 let u = m.displacement(x, y, 0.3);
                 assert!(u[0].abs() <= 1e-16 && u[1].abs() <= 1e-16, "{x} {y} {u:?}");
             }

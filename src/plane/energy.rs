@@ -212,7 +212,9 @@ mod tests {
         let (pattern, from) = full.pattern.restrict(&index);
         let k: Vec<f64> = from.iter().map(|&f| full.stiffness[f]).collect();
         let forms = StrainForms::new(&grid, material, &index);
-        let x: Vec<f64> = (0..next).map(|i| ((i * 37) % 11) as f64 / 11.0 - 0.4).collect();
+        let x: Vec<f64> = (0..next)
+            .map(|i| ((i * 37) % 11) as f64 / 11.0 - 0.4)
+            .collect();
         let (a, b) = (forms.quad(&x), pattern.quad(&k, &x));
         assert!((a - b).abs() <= FORM_TOL * b, "{a} {b}");
         // A rotation of the free body: the cell form gives round-off of the strains squared.

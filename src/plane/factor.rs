@@ -159,14 +159,20 @@ mod tests {
             .map(|(mm, k)| mm / (dt * dt) + (0.5 + alpha / (2.0 * dt)) * k)
             .collect();
         let mut chol = SparseCholesky::new(&m.pattern, &c, "C").unwrap();
-        let b: Vec<f64> = (0..m.pattern.n).map(|i| ((i * 7919) % 13) as f64 - 6.0).collect();
+        let b: Vec<f64> = (0..m.pattern.n)
+            .map(|i| ((i * 7919) % 13) as f64 - 6.0)
+            .collect();
         let mut x = b.clone();
         chol.solve_in_place(&mut x);
         let mut ax = vec![0.0; x.len()];
         m.pattern.mul_into(&c, &x, &mut ax);
         let inf = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let norm_a = (0..m.pattern.n)
-            .map(|r| (m.pattern.row_ptr[r]..m.pattern.row_ptr[r + 1]).map(|k| c[k].abs()).sum())
+            .map(|r| {
+                (m.pattern.row_ptr[r]..m.pattern.row_ptr[r + 1])
+                    .map(|k| c[k].abs())
+                    .sum()
+            })
             .fold(0.0f64, f64::max);
         let r: Vec<f64> = b.iter().zip(&ax).map(|(b, a)| b - a).collect();
         let backward = inf(&r) / ((norm_a * inf(&x) + inf(&b)) * f64::EPSILON);

@@ -284,7 +284,10 @@ mod tests {
             m.pattern.mul_into(&m.stiffness, &r, &mut kr);
             let scale = norm * r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             let worst = kr.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            assert!(worst <= KERNEL_TOL * scale, "{name}: {worst:e} vs {scale:e}");
+            assert!(
+                worst <= KERNEL_TOL * scale,
+                "{name}: {worst:e} vs {scale:e}"
+            );
         }
         // And K is not zero on a stretch: the kernel test can fail.
         let mut s = vec![0.0; g.dofs()];

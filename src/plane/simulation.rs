@@ -239,12 +239,14 @@ impl PlaneSimulation {
         let mut chol = SparseCholesky::new(&disc.pattern, &disc.mass, "M")?;
         chol.solve_in_place(&mut acc);
         chol.factor(&disc.pattern, &disc.step_matrix(), "C")?;
-        let z: Vec<f64> = (0..n).map(|i| dt * v0[i] + 0.5 * dt * dt * acc[i]).collect();
+        let z: Vec<f64> = (0..n)
+            .map(|i| dt * v0[i] + 0.5 * dt * dt * acc[i])
+            .collect();
         let u: Vec<f64> = u0.iter().zip(&z).map(|(a, b)| a + b).collect();
         let potential0 = disc.forms.quad(&u0);
         let potential = disc.forms.quad(&u);
-        let energy = 0.5 * disc.pattern.quad(&disc.mass, &z) / (dt * dt)
-            + 0.25 * (potential + potential0);
+        let energy =
+            0.5 * disc.pattern.quad(&disc.mass, &z) / (dt * dt) + 0.25 * (potential + potential0);
         if !energy.is_finite() {
             return Err(PlaneError::NonFinite { step: 1, time: dt });
         }

@@ -6,8 +6,8 @@
 
 use crate::scene::expr::Expression;
 use crate::scene::schema::{
-    GIB, MAX_STEPS, Scene, Time, apply_override, available_memory_bytes, check_time_grid,
-    invalid, number_or_expression, number_text, positive,
+    GIB, MAX_STEPS, Scene, Time, apply_override, available_memory_bytes, check_time_grid, invalid,
+    number_or_expression, number_text, positive,
 };
 use crate::scene::{SceneError, builtin_names, builtin_text};
 use serde::{Deserialize, Serialize};
@@ -90,7 +90,8 @@ pub struct Edges {
 impl Edges {
     /// `[left, right, bottom, top]` clamped.
     pub fn clamped(&self) -> [bool; 4] {
-        [self.left, self.right, self.bottom, self.top].map(|e| e.condition == EdgeCondition::Clamped)
+        [self.left, self.right, self.bottom, self.top]
+            .map(|e| e.condition == EdgeCondition::Clamped)
     }
 }
 
@@ -205,7 +206,10 @@ pub const PLANE_BUILTIN: &[(&str, &str)] = &[
 
 /// The TOML text of a built-in plane scene.
 pub fn plane_builtin_text(name: &str) -> Option<&'static str> {
-    PLANE_BUILTIN.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
+    PLANE_BUILTIN
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, t)| *t)
 }
 
 /// A scene of either kind.
@@ -218,7 +222,10 @@ pub enum AnyScene {
 /// Reads a bar or plane scene by built-in name or path, applies `key=value` overrides and
 /// validates; returns its name (built-in name or file stem). A file with both `[bar]` and
 /// `[plane]`, or neither, is refused naming both.
-pub fn load_any(name_or_path: &str, overrides: &[String]) -> Result<(String, AnyScene), SceneError> {
+pub fn load_any(
+    name_or_path: &str,
+    overrides: &[String],
+) -> Result<(String, AnyScene), SceneError> {
     if let Some(text) = builtin_text(name_or_path) {
         let scene = Scene::from_toml(text, overrides)?;
         return Ok((name_or_path.into(), AnyScene::Bar(Box::new(scene))));
@@ -309,7 +316,10 @@ impl PlaneScene {
             return Err(invalid(
                 "mesh.y_grading",
                 g,
-                &format!("must lie between {} and {MAX_Y_GRADING}", 1.0 / MAX_Y_GRADING),
+                &format!(
+                    "must lie between {} and {MAX_Y_GRADING}",
+                    1.0 / MAX_Y_GRADING
+                ),
             ));
         }
         for (field, n) in [("mesh.nx", self.mesh.nx), ("mesh.ny", self.mesh.ny)] {
@@ -322,8 +332,7 @@ impl PlaneScene {
             return Err(SceneError::Invalid {
                 field: "mesh.nx".into(),
                 value: self.mesh.nx.to_string(),
-                allowed: "with these clamped edges no node is free to move: refine the mesh"
-                    .into(),
+                allowed: "with these clamped edges no node is free to move: refine the mesh".into(),
             });
         }
         if unknowns > MAX_PLANE_UNKNOWNS {
@@ -371,10 +380,12 @@ impl PlaneScene {
 
     /// The parsed expressions: initial displacement and velocity, and the load (if any).
     pub fn expressions(&self) -> Result<PlaneExpressions, SceneError> {
-        let vector = |name: &str, v: &Vector, allow_t: bool| -> Result<[Expression; 2], SceneError> {
-            let f = |c: usize| Expression::parse_plane(&format!("{name}[{c}]"), &v.0[c], allow_t);
-            Ok([f(0)?, f(1)?])
-        };
+        let vector =
+            |name: &str, v: &Vector, allow_t: bool| -> Result<[Expression; 2], SceneError> {
+                let f =
+                    |c: usize| Expression::parse_plane(&format!("{name}[{c}]"), &v.0[c], allow_t);
+                Ok([f(0)?, f(1)?])
+            };
         Ok(PlaneExpressions {
             displacement: vector("initial.displacement", &self.initial.displacement, false)?,
             velocity: vector("initial.velocity", &self.initial.velocity, false)?,
@@ -437,18 +448,23 @@ mod tests {
         let both = format!("{strip}\n[bar]\nlength = 1.0\n");
         let e = any_from_toml(&both, &[]).unwrap_err().to_string();
         assert!(e.contains("both") && e.contains("[plane]"), "{e}");
-        let e = any_from_toml("[mesh]\nnx = 2\n", &[]).unwrap_err().to_string();
+        let e = any_from_toml("[mesh]\nnx = 2\n", &[])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("neither"), "{e}");
         // Numbers are accepted as components; y is a variable.
-        let s = PlaneScene::from_toml(
-            strip,
-            &["initial.displacement=[0.5, \"y*x\"]".to_string()],
-        )
-        .unwrap();
-        assert_eq!(s.initial.displacement.0, ["0.5".to_string(), "y*x".to_string()]);
+        let s = PlaneScene::from_toml(strip, &["initial.displacement=[0.5, \"y*x\"]".to_string()])
+            .unwrap();
+        assert_eq!(
+            s.initial.displacement.0,
+            ["0.5".to_string(), "y*x".to_string()]
+        );
         let e = PlaneScene::from_toml(strip, &["initial.velocity=[\"t\", \"0\"]".into()])
             .unwrap_err()
             .to_string();
-        assert!(e.contains("initial.velocity[0]") && e.contains("x and y only"), "{e}");
+        assert!(
+            e.contains("initial.velocity[0]") && e.contains("x and y only"),
+            "{e}"
+        );
     }
 }

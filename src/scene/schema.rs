@@ -152,7 +152,9 @@ pub fn number_text(v: f64) -> String {
 /// Serde: an expression field given as a string (the expression) or as a number (TOML integer
 /// or float, kept as [`number_text`]). A non-finite float is kept as `inf`/`NaN`, which the
 /// expression parser then refuses with the field's name.
-pub(crate) fn number_or_expression<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+pub(crate) fn number_or_expression<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<String, D::Error> {
     struct Visitor;
     impl serde::de::Visitor<'_> for Visitor {
         type Value = String;
