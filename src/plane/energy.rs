@@ -27,6 +27,9 @@ pub struct StepSums {
     pub work: f64,
 }
 
+/// `∂N_a/∂x[g][a]`, `∂N_a/∂y[g][a]` at the Gauss points `g` of a cell row, and the weight.
+type RowGradients = ([[f64; 4]; 4], [[f64; 4]; 4], f64);
+
 /// `|u|²_K` cell by cell: `Σ_cells Σ_g w_g (λ (tr ε)² + 2μ ε:ε)` at the 2 × 2 Gauss points
 /// that built `K`, the strains from differences to the cell's first node.
 pub struct StrainForms {
@@ -34,7 +37,7 @@ pub struct StrainForms {
     ny: usize,
     material: Material,
     /// Per cell row: `∂N_a/∂x`, `∂N_a/∂y` at each Gauss point, and the weight.
-    rows: Vec<([[f64; 4]; 4], [[f64; 4]; 4], f64)>,
+    rows: Vec<RowGradients>,
     /// The unknown of each full degree of freedom.
     index: Vec<Option<usize>>,
     /// The full degrees of freedom of each cell's nodes.
@@ -203,9 +206,9 @@ mod tests {
         // Left edge clamped.
         let mut index = vec![None; grid.dofs()];
         let mut next = 0;
-        for d in 0..grid.dofs() {
+        for (d, i) in index.iter_mut().enumerate() {
             if grid.position(d / 2).0 != 0 {
-                index[d] = Some(next);
+                *i = Some(next);
                 next += 1;
             }
         }

@@ -220,9 +220,9 @@ mod tests {
 
     fn dense(p: &Pattern, a: &[f64]) -> Vec<Vec<f64>> {
         let mut d = vec![vec![0.0; p.n]; p.n];
-        for r in 0..p.n {
+        for (r, row) in d.iter_mut().enumerate() {
             for k in p.row_ptr[r]..p.row_ptr[r + 1] {
-                d[r][p.cols[k]] = a[k];
+                row[p.cols[k]] = a[k];
             }
         }
         d
@@ -233,9 +233,9 @@ mod tests {
         let m = assemble(&grid(), MATERIAL);
         for a in [&m.mass, &m.stiffness] {
             let d = dense(&m.pattern, a);
-            for r in 0..d.len() {
-                for c in 0..d.len() {
-                    assert_eq!(d[r][c].to_bits(), d[c][r].to_bits(), "({r}, {c})");
+            for (r, row) in d.iter().enumerate() {
+                for (c, v) in row.iter().enumerate() {
+                    assert_eq!(v.to_bits(), d[c][r].to_bits(), "({r}, {c})");
                 }
             }
         }
@@ -269,7 +269,8 @@ mod tests {
                     .sum::<f64>()
             })
             .fold(0.0, f64::max);
-        let motions: [(&str, fn(f64, f64) -> (f64, f64)); 3] = [
+        type Motion = fn(f64, f64) -> (f64, f64);
+        let motions: [(&str, Motion); 3] = [
             ("x translation", |_, _| (1.0, 0.0)),
             ("y translation", |_, _| (0.0, 1.0)),
             ("rotation", |x, y| (-y, x)),

@@ -101,7 +101,7 @@ impl Tracker {
 fn forced(scene: &PlaneScene) -> bool {
     scene.load.density.as_ref().is_some_and(|v| {
         v.0.iter()
-            .any(|c| c.trim().parse::<f64>().map_or(true, |x| x != 0.0))
+            .any(|c| c.trim().parse::<f64>().ok().is_none_or(|x| x != 0.0))
     })
 }
 
