@@ -6,7 +6,7 @@
 //! | What | Written | Example | Value |
 //! |---|---|---|---|
 //! | numbers | `12`, `0.5`, `.5`, `5.`, `1e6`, `2.5E-3` | `1e-2` | 0.01 |
-//! | variables | `x` in every field; `t` only in `load.density` | `2*x` at x = 0.25 | 0.5 |
+//! | variables | `x` in every field; `y` in plane scenes ([`Expression::parse_plane`]); `t` only in `load.density` | `2*x` at x = 0.25 | 0.5 |
 //! | constants | `pi` (also `PI`, `π`), `e` (also `E`), `tau` (also `TAU`, `τ`) | `2*pi` | 6.283185307179586 |
 //! | arithmetic | `+ - * /`, left-associative; `*` `/` bind tighter than `+` `-` | `8/4/2` | 1 |
 //! | power | `^`, right-associative, tighter than unary minus: `-a^b` is `-(a^b)` | `2^3^2`, `-2^2` | 512, −4 |

@@ -10,6 +10,7 @@ pub mod compare;
 pub mod converge;
 pub mod figure_writer;
 pub mod figures;
+pub mod plane_checks;
 pub mod plane_figure;
 pub mod sampled_run;
 pub mod stiff;
