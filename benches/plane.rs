@@ -80,9 +80,10 @@ fn bench(c: &mut Criterion) {
     }
 }
 
+// No HTML plots, as in benches/step.rs (criterion's plotters backend would need a font).
 criterion_group! {
     name = benches;
-    config = Criterion::default();
+    config = Criterion::default().without_plots();
     targets = bench
 }
 criterion_main!(benches);
