@@ -86,35 +86,47 @@ impl StrainForms {
 
     /// `|x|²_K` for `x` on the unknowns (clamped degrees of freedom 0).
     pub fn quad(&self, x: &[f64]) -> f64 {
-        self.quad_with(|k| x[k])
+        self.quad_pair(|k| x[k], |_| 0.0).0
     }
 
-    /// `|x|²_K` for `x(k)` the value of unknown `k`.
-    pub fn quad_with(&self, x: impl Fn(usize) -> f64) -> f64 {
+    /// `(|x|²_K, |y|²_K)` in one pass over the cells, `x(k)`, `y(k)` the values of unknown
+    /// `k` (each sum in the order of a pass of its own: the same bits).
+    pub fn quad_pair(&self, x: impl Fn(usize) -> f64, y: impl Fn(usize) -> f64) -> (f64, f64) {
         let (lam, mu) = (self.material.lambda, self.material.mu);
-        let value = |dof: usize| self.index[dof].map_or(0.0, &x);
-        let mut total = 0.0;
+        let density = |ux: [f64; 4], uy: [f64; 4], gx: &[f64; 4], gy: &[f64; 4]| {
+            let (mut exx, mut eyy, mut gxy) = (0.0, 0.0, 0.0);
+            for a in 1..4 {
+                let (dx, dy) = (ux[a] - ux[0], uy[a] - uy[0]);
+                exx += gx[a] * dx;
+                eyy += gy[a] * dy;
+                gxy += gy[a] * dx + gx[a] * dy;
+            }
+            let tr = exx + eyy;
+            lam * tr * tr + mu * (2.0 * (exx * exx + eyy * eyy) + gxy * gxy)
+        };
+        let (mut total_x, mut total_y) = (0.0, 0.0);
         for j in 0..self.ny {
             let (gx, gy, weight) = &self.rows[j];
-            let mut row = 0.0;
+            let (mut row_x, mut row_y) = (0.0, 0.0);
             for cell in &self.nodes[j * self.nx..(j + 1) * self.nx] {
-                let ux = cell.map(|n| value(2 * n));
-                let uy = cell.map(|n| value(2 * n + 1));
+                let dof = |n: usize, c: usize| self.index[2 * n + c];
+                let (xx, xy) = (
+                    cell.map(|n| dof(n, 0).map_or(0.0, &x)),
+                    cell.map(|n| dof(n, 1).map_or(0.0, &x)),
+                );
+                let (yx, yy) = (
+                    cell.map(|n| dof(n, 0).map_or(0.0, &y)),
+                    cell.map(|n| dof(n, 1).map_or(0.0, &y)),
+                );
                 for g in 0..4 {
-                    let (mut exx, mut eyy, mut gxy) = (0.0, 0.0, 0.0);
-                    for a in 1..4 {
-                        let (dx, dy) = (ux[a] - ux[0], uy[a] - uy[0]);
-                        exx += gx[g][a] * dx;
-                        eyy += gy[g][a] * dy;
-                        gxy += gy[g][a] * dx + gx[g][a] * dy;
-                    }
-                    let tr = exx + eyy;
-                    row += lam * tr * tr + mu * (2.0 * (exx * exx + eyy * eyy) + gxy * gxy);
+                    row_x += density(xx, xy, &gx[g], &gy[g]);
+                    row_y += density(yx, yy, &gx[g], &gy[g]);
                 }
             }
-            total += weight * row;
+            total_x += weight * row_x;
+            total_y += weight * row_y;
         }
-        total
+        (total_x, total_y)
     }
 }
 
@@ -138,8 +150,7 @@ pub fn measure(
         s.kinetic += z[r] * mz;
         s.work += force[r] * (z[r] + w[r]);
     }
-    s.potential = forms.quad(u);
-    s.viscous = forms.quad_with(|k| z[k] + w[k]);
+    (s.potential, s.viscous) = forms.quad_pair(|k| u[k], |k| z[k] + w[k]);
     s
 }
 
