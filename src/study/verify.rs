@@ -41,7 +41,10 @@ pub fn sections() -> Result<Vec<Section>, crate::study::converge::ConvergeError>
         roundoff_section()?,
         viscosity_section()?,
         stiff_section(crate::study::stiff::Size::Full),
-        crate::study::plane_checks::section()?,
+        Section {
+            id: "plane",
+            markdown: crate::study::plane_checks::markdown()?,
+        },
     ])
 }
 
