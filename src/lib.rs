@@ -70,7 +70,8 @@ pub mod step;
 pub mod study;
 pub mod time;
 
-pub use scene::{Scene, SceneError, SolverMethod};
+pub use plane::{PlaneError, PlaneSimulation};
+pub use scene::{AnyScene, PlaneScene, Scene, SceneError, SolverMethod};
 pub use step::{StepFailure, StepSolver};
 pub use time::{
     ContactEpisode, RunError, Simulation, StepRecord, Summary, run_in_memory, run_to_dir,

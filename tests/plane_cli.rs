@@ -4,6 +4,11 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// The bar's `IDENTITY_TOL`, as in tests/plane.rs: only round-off remains.
+const IDENTITY_TOL: f64 = 1e-12;
+/// A drawn figure is more than its headers: the smallest plausible PNG or SVG of a mesh.
+const MIN_FIGURE_BYTES: u64 = 1000;
+
 fn viscobar(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_viscobar"))
         .args(args)
@@ -38,7 +43,7 @@ fn run_writes_the_plane_outputs_and_the_figure() {
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["steps"], 40);
     assert_eq!(summary["unknowns"], 2 * 64 * 9);
-    assert!(summary["max_identity_residual"].as_f64().unwrap() <= 1e-12);
+    assert!(summary["max_identity_residual"].as_f64().unwrap() <= IDENTITY_TOL);
     let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
     assert_eq!(history.lines().count(), 41);
     assert!(history.starts_with("step,t,energy,work,viscous_dissipation,identity_residual\n"));
@@ -52,7 +57,7 @@ fn run_writes_the_plane_outputs_and_the_figure() {
     assert_eq!(times, ["0", "1", "2"].into_iter().collect());
     for f in ["deformed.png", "deformed.svg"] {
         let len = std::fs::metadata(out.join(f)).unwrap().len();
-        assert!(len > 1000, "{f}: {len} bytes");
+        assert!(len > MIN_FIGURE_BYTES, "{f}: {len} bytes");
     }
     let _ = std::fs::remove_dir_all(&out);
 }
@@ -166,5 +171,18 @@ fn a_scene_file_with_both_or_neither_table_is_refused() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(String::from_utf8_lossy(&o.stdout).starts_with("mine: 10 steps"));
+    // Commands that take bar scenes only refuse a plane scene, naming it.
+    for args in [
+        vec!["converge", "plane-strip"],
+        vec!["compare", path.to_str().unwrap()],
+    ] {
+        let o = viscobar(&args);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("only `viscobar run` takes plane scenes"),
+            "{stderr}"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

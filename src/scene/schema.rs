@@ -413,11 +413,25 @@ pub fn builtin_text(name: &str) -> Option<&'static str> {
     BUILTIN.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
 }
 
+/// A plane scene given where only bar scenes are taken (`converge`, `compare`, `figures`).
+fn plane_not_here(name: &str) -> SceneError {
+    SceneError::Invalid {
+        field: "plane".into(),
+        value: name.to_string(),
+        allowed: "a plane scene: only `viscobar run` takes plane scenes (this command takes \
+                  bar scenes)"
+            .into(),
+    }
+}
+
 /// Reads a scene by built-in name or path, applies `key=value` overrides, and returns its name
 /// (the built-in name or the file stem) and the validated scene.
 pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(String, Scene), SceneError> {
     let (name, text) = match builtin_text(name_or_path) {
         Some(t) => (name_or_path.to_string(), t.to_string()),
+        None if crate::scene::plane::plane_builtin_text(name_or_path).is_some() => {
+            return Err(plane_not_here(name_or_path));
+        }
         None => {
             let path = Path::new(name_or_path);
             if !path.is_file() {
@@ -446,6 +460,9 @@ impl Scene {
     pub fn from_toml(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
         let syntax = |e: toml::de::Error| SceneError::Syntax(e.to_string().trim_end().to_string());
         let mut table: toml::Table = toml::from_str(text).map_err(syntax)?;
+        if table.contains_key("plane") && !table.contains_key("bar") {
+            return Err(plane_not_here("this scene"));
+        }
         for assignment in overrides {
             apply_override(&mut table, assignment)?;
         }
