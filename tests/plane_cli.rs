@@ -110,6 +110,25 @@ const CASES: &[(&str, &[&str], &str)] = &[
         "load.density[0]",
     ),
     ("solver on a plane", &["solver.method=\"osqp\""], "solver"),
+    (
+        "a number for a vector",
+        &["initial.displacement=0.1"],
+        "initial.displacement",
+    ),
+    (
+        "an edge as a word",
+        &["edges.left=\"clamped\""],
+        "edges.left",
+    ),
+    (
+        "no free node",
+        &[
+            "mesh.nx=1",
+            "edges.left={condition=\"clamped\"}",
+            "edges.right={condition=\"clamped\"}",
+        ],
+        "no node is free",
+    ),
 ];
 
 #[test]
