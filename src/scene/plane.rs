@@ -9,6 +9,8 @@ use crate::scene::schema::{
     GIB, MAX_STEPS, Scene, Time, apply_override, available_memory_bytes, check_time_grid, invalid,
     number_or_expression, number_text, positive,
 };
+/// The built-in plane scenes (kept beside the bar's list in [`crate::scene::schema`]).
+pub use crate::scene::schema::{PLANE_BUILTIN, plane_builtin_text};
 use crate::scene::{SceneError, builtin_names, builtin_text};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -193,24 +195,6 @@ pub const PLANE_BYTES_PER_UNKNOWN: u64 = 2048;
 /// Largest `y_grading` (or smallest, inverted): beyond, the thinnest cells make C needlessly
 /// ill-conditioned.
 pub const MAX_Y_GRADING: f64 = 1e6;
-
-/// Built-in plane scenes, embedded from `scenes/*.toml` (listed apart from the bar's
-/// [`crate::scene::BUILTIN`], whose users expect bar scenes).
-pub const PLANE_BUILTIN: &[(&str, &str)] = &[
-    ("plane-strip", include_str!("../../scenes/plane-strip.toml")),
-    (
-        "plane-cantilever",
-        include_str!("../../scenes/plane-cantilever.toml"),
-    ),
-];
-
-/// The TOML text of a built-in plane scene.
-pub fn plane_builtin_text(name: &str) -> Option<&'static str> {
-    PLANE_BUILTIN
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, t)| *t)
-}
 
 /// A scene of either kind.
 #[derive(Clone, Debug)]

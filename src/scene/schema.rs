@@ -403,6 +403,24 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ),
 ];
 
+/// Built-in plane scenes, embedded from `scenes/*.toml` (listed apart from the bar's
+/// [`crate::scene::BUILTIN`], whose users expect bar scenes).
+pub const PLANE_BUILTIN: &[(&str, &str)] = &[
+    ("plane-strip", include_str!("../../scenes/plane-strip.toml")),
+    (
+        "plane-cantilever",
+        include_str!("../../scenes/plane-cantilever.toml"),
+    ),
+];
+
+/// The TOML text of a built-in plane scene.
+pub fn plane_builtin_text(name: &str) -> Option<&'static str> {
+    PLANE_BUILTIN
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, t)| *t)
+}
+
 /// The names of the built-in scenes, in order.
 pub fn builtin_names() -> Vec<&'static str> {
     BUILTIN.iter().map(|(n, _)| *n).collect()
@@ -429,7 +447,7 @@ fn plane_not_here(name: &str) -> SceneError {
 pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(String, Scene), SceneError> {
     let (name, text) = match builtin_text(name_or_path) {
         Some(t) => (name_or_path.to_string(), t.to_string()),
-        None if crate::scene::plane::plane_builtin_text(name_or_path).is_some() => {
+        None if plane_builtin_text(name_or_path).is_some() => {
             return Err(plane_not_here(name_or_path));
         }
         None => {
