@@ -38,11 +38,13 @@ pub struct StrainForms {
     material: Material,
     /// Per cell row: `∂N_a/∂x`, `∂N_a/∂y` at each Gauss point, and the weight.
     rows: Vec<RowGradients>,
-    /// The unknown of each full degree of freedom.
-    index: Vec<Option<usize>>,
-    /// The full degrees of freedom of each cell's nodes.
-    nodes: Vec<[usize; 4]>,
+    /// Per cell (row by row), the unknown of each local degree of freedom `2a + c`
+    /// ([`CLAMPED`] when clamped).
+    cells: Vec<[u32; 8]>,
 }
+
+/// The unknown of a clamped degree of freedom in [`StrainForms`] (value 0).
+const CLAMPED: u32 = u32::MAX;
 
 impl StrainForms {
     pub fn new(grid: &Grid, material: Material, index: &[Option<usize>]) -> Self {
@@ -68,10 +70,13 @@ impl StrainForms {
                 (gx, gy, 0.25 * hx * hy)
             })
             .collect();
-        let mut nodes = Vec::with_capacity(grid.cells());
+        let mut cells = Vec::with_capacity(grid.cells());
         for j in 0..grid.ny {
             for i in 0..grid.nx {
-                nodes.push(grid.cell_nodes(i, j));
+                let nodes = grid.cell_nodes(i, j);
+                // Unknowns fit in u32: a scene has at most MAX_PLANE_UNKNOWNS of them.
+                let unknown = |d: usize| index[d].map_or(CLAMPED, |k| k as u32);
+                cells.push(std::array::from_fn(|l| unknown(2 * nodes[l / 2] + l % 2)));
             }
         }
         Self {
@@ -79,8 +84,7 @@ impl StrainForms {
             ny: grid.ny,
             material,
             rows,
-            index: index.to_vec(),
-            nodes,
+            cells,
         }
     }
 
@@ -108,16 +112,9 @@ impl StrainForms {
         for j in 0..self.ny {
             let (gx, gy, weight) = &self.rows[j];
             let (mut row_x, mut row_y) = (0.0, 0.0);
-            for cell in &self.nodes[j * self.nx..(j + 1) * self.nx] {
-                let dof = |n: usize, c: usize| self.index[2 * n + c];
-                let (xx, xy) = (
-                    cell.map(|n| dof(n, 0).map_or(0.0, &x)),
-                    cell.map(|n| dof(n, 1).map_or(0.0, &x)),
-                );
-                let (yx, yy) = (
-                    cell.map(|n| dof(n, 0).map_or(0.0, &y)),
-                    cell.map(|n| dof(n, 1).map_or(0.0, &y)),
-                );
+            for cell in &self.cells[j * self.nx..(j + 1) * self.nx] {
+                let (xx, xy) = (gather(cell, &x, 0), gather(cell, &x, 1));
+                let (yx, yy) = (gather(cell, &y, 0), gather(cell, &y, 1));
                 for g in 0..4 {
                     row_x += density(xx, xy, &gx[g], &gy[g]);
                     row_y += density(yx, yy, &gx[g], &gy[g]);
@@ -128,6 +125,15 @@ impl StrainForms {
         }
         (total_x, total_y)
     }
+}
+
+/// Component `c` of `f` at a cell's four nodes (0 where clamped).
+#[inline(always)]
+fn gather(cell: &[u32; 8], f: &impl Fn(usize) -> f64, c: usize) -> [f64; 4] {
+    std::array::from_fn(|a| match cell[2 * a + c] {
+        CLAMPED => 0.0,
+        k => f(k as usize),
+    })
 }
 
 /// The sums of [`StepSums`], after `u += z` (`u = u^{n+1}`), with `w` the previous increment.
