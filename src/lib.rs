@@ -16,7 +16,8 @@
 //! (`tests/layers.rs` checks it):
 //! [`linalg`] (tridiagonal kernels) → [`step`] (the step solvers and their audit) →
 //! [`scene`] (input) → [`bar`] (matrices, closed forms) → [`time`] (the time loop, energy
-//! balance and outputs) → [`study`] (the verification studies).
+//! balance and outputs) → [`plane`] (the plane Kelvin–Voigt body, Q1, sparse Cholesky) →
+//! [`study`] (the verification studies).
 
 //! # Use as a library
 //!
@@ -63,12 +64,14 @@
 
 pub mod bar;
 pub mod linalg;
+pub mod plane;
 pub mod scene;
 pub mod step;
 pub mod study;
 pub mod time;
 
-pub use scene::{Scene, SceneError, SolverMethod};
+pub use plane::{PlaneError, PlaneSimulation};
+pub use scene::{AnyScene, PlaneScene, Scene, SceneError, SolverMethod};
 pub use step::{StepFailure, StepSolver};
 pub use time::{
     ContactEpisode, RunError, Simulation, StepRecord, Summary, run_in_memory, run_to_dir,

@@ -19,8 +19,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run a scene (built-in name or TOML file) and write summary.json, history.csv and
-    /// displacement.csv.
+    /// Run a scene, bar or plane (built-in name or TOML file), and write summary.json,
+    /// history.csv and displacement.csv.
     Run {
         /// A built-in scene (a name from `viscobar scenes`) or the path of a TOML scene file.
         scene: String,
@@ -33,6 +33,10 @@ enum Command {
         /// Override a scene key, e.g. --set time.step=0.001 (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        /// Plane scenes: also draw the deformed mesh coloured by the von Mises stress at
+        /// 6 times (plane.png, plane.svg in the output folder).
+        #[arg(long)]
+        figure: bool,
     },
     /// Run the talk's scenes and draw their figures (PNG and SVG): one per scene (colour map of
     /// u(x, t) and contact history) and one per talk figure (l = 0 beside forced).
@@ -143,19 +147,21 @@ fn main() {
             print!("{}", scene_list());
             0
         }
-        Command::Show { name } => match scene::builtin_text(&name) {
-            Some(text) => {
-                print!("{text}");
-                0
+        Command::Show { name } => {
+            match scene::builtin_text(&name).or_else(|| scene::plane::plane_builtin_text(&name)) {
+                Some(text) => {
+                    print!("{text}");
+                    0
+                }
+                None => {
+                    eprintln!(
+                        "error: unknown scene `{name}` (built-in scenes: {})",
+                        all_builtin_names().join(", ")
+                    );
+                    2
+                }
             }
-            None => {
-                eprintln!(
-                    "error: unknown scene `{name}` (built-in scenes: {})",
-                    scene::builtin_names().join(", ")
-                );
-                2
-            }
-        },
+        }
         Command::Verify {
             update,
             stiff,
@@ -210,16 +216,14 @@ fn main() {
             out,
             solver,
             mut set,
+            figure,
         } => {
             if let Some(s) = solver {
                 set.push(format!("solver.method=\"{s}\""));
             }
-            match run(&name, out, &set) {
+            match run_any(&name, out, &set, figure) {
                 Ok(()) => 0,
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    e.exit_code()
-                }
+                Err(code) => code,
             }
         }
         Command::Mass { out, set } => {
@@ -266,19 +270,20 @@ const LIST_GAP: usize = 2;
 /// The `scenes` listing: each built-in name, in a column as wide as the longest, beside the
 /// first sentence of its description, wrapped onto indented continuation lines.
 fn scene_list() -> String {
-    let width = scene::BUILTIN
-        .iter()
+    let all = || scene::BUILTIN.iter().chain(scene::plane::PLANE_BUILTIN);
+    let width = all()
         .map(|(name, _)| name.chars().count())
         .max()
         .unwrap_or(0);
     let indent = width + LIST_GAP;
     let mut list = String::new();
-    for (name, text) in scene::BUILTIN {
-        let sentence = scene::Scene::from_toml(text, &[])
-            .ok()
-            .and_then(|s| s.description)
-            .map(|d| first_sentence(&d))
-            .unwrap_or_default();
+    for (name, text) in all() {
+        let description = match scene::plane::any_from_toml(text, &[]) {
+            Ok(scene::AnyScene::Bar(s)) => s.description,
+            Ok(scene::AnyScene::Plane(s)) => s.description,
+            Err(_) => None,
+        };
+        let sentence = description.map(|d| first_sentence(&d)).unwrap_or_default();
         let mut line = format!("{name:width$}");
         let mut empty = true;
         for word in sentence.split_whitespace() {
@@ -323,15 +328,80 @@ fn first_sentence(text: &str) -> String {
     joined
 }
 
-fn run(name: &str, out: Option<PathBuf>, set: &[String]) -> Result<(), viscobar::RunError> {
-    let (scene_name, scene) = scene::load(name, set)?;
-    let out = out.unwrap_or_else(|| PathBuf::from("out").join(&scene_name));
-    let summary = viscobar::time::run::run_to_dir(
-        &scene_name,
-        &scene,
-        &out,
-        std::io::stderr().is_terminal(),
-    )?;
+/// The names of the built-in scenes, bar and plane.
+fn all_builtin_names() -> Vec<&'static str> {
+    let mut names = scene::builtin_names();
+    names.extend(scene::plane::PLANE_BUILTIN.iter().map(|(n, _)| *n));
+    names
+}
+
+/// `viscobar run` of a bar or plane scene; the exit code on failure.
+fn run_any(name: &str, out: Option<PathBuf>, set: &[String], figure: bool) -> Result<(), i32> {
+    let fail = |message: String, code: i32| {
+        eprintln!("error: {message}");
+        code
+    };
+    let (scene_name, any) = scene::load_any(name, set).map_err(|e| fail(e.to_string(), 2))?;
+    match any {
+        scene::AnyScene::Bar(bar) => {
+            if figure {
+                return Err(fail(
+                    "--figure draws plane scenes; for a bar scene use `viscobar figures`".into(),
+                    2,
+                ));
+            }
+            run(&scene_name, *bar, out).map_err(|e| fail(e.to_string(), e.exit_code()))
+        }
+        scene::AnyScene::Plane(plane) => {
+            let out = out.unwrap_or_else(|| PathBuf::from("out").join(&scene_name));
+            let summary = viscobar::plane::run::run_plane_to_dir(&scene_name, &plane, &out)
+                .map_err(|e| fail(e.to_string(), e.exit_code()))?;
+            println!(
+                "{}: {} steps of {} unknowns ({} nodes) with `{}` in {:.3} s ({:.1} ns per \
+                 unknown-step); max identity residual {:.1e}; results in {}",
+                summary.scene,
+                summary.steps,
+                summary.unknowns,
+                summary.nodes,
+                summary.solver,
+                summary.wall_time_s,
+                summary.ns_per_unknown_step,
+                summary.max_identity_residual,
+                out.display()
+            );
+            if figure {
+                plane_figure(&scene_name, &plane, &out)?;
+            }
+            Ok(())
+        }
+    }
+}
+
+/// Draws the deformed-mesh figure of a plane scene into `out` (the scene is run again in
+/// memory, keeping six snapshots).
+fn plane_figure(name: &str, scene: &scene::PlaneScene, out: &std::path::Path) -> Result<(), i32> {
+    match viscobar::study::plane_figure::write(name, scene, out) {
+        Ok(files) => {
+            for f in &files {
+                println!("wrote {}", f.display());
+            }
+            Ok(())
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            Err(e.exit_code())
+        }
+    }
+}
+
+fn run(
+    scene_name: &str,
+    scene: viscobar::Scene,
+    out: Option<PathBuf>,
+) -> Result<(), viscobar::RunError> {
+    let out = out.unwrap_or_else(|| PathBuf::from("out").join(scene_name));
+    let summary =
+        viscobar::time::run::run_to_dir(scene_name, &scene, &out, std::io::stderr().is_terminal())?;
     println!(
         "{}: {} steps of {} nodes with `{}` in {:.3} s ({:.1} ns per node-step); \
          max identity residual {:.1e}; results in {}",

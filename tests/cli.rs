@@ -76,7 +76,13 @@ fn scenes_lists_every_builtin_with_a_whole_first_sentence() {
     let o = viscobar(&["scenes"]);
     assert!(o.status.success());
     let text = String::from_utf8_lossy(&o.stdout);
-    let names = viscobar::scene::builtin_names();
+    // Bar scenes, then plane scenes.
+    let mut names = viscobar::scene::builtin_names();
+    names.extend(
+        viscobar::scene::plane::PLANE_BUILTIN
+            .iter()
+            .map(|(n, _)| *n),
+    );
     let longest = names.iter().map(|n| n.len()).max().unwrap();
     let indent = |line: &str| line.len() - line.trim_start().len();
     // Entries: a line starting with a name, then its indented continuation lines; every
@@ -106,10 +112,11 @@ fn scenes_lists_every_builtin_with_a_whole_first_sentence() {
             description.ends_with('.') || description.ends_with(')'),
             "{name}: description cut mid-sentence: {description:?}"
         );
-        let full = viscobar::Scene::from_toml(viscobar::scene::builtin_text(name).unwrap(), &[])
-            .unwrap()
-            .description
-            .unwrap();
+        let full = match viscobar::scene::load_any(name, &[]).unwrap().1 {
+            viscobar::scene::AnyScene::Bar(s) => s.description,
+            viscobar::scene::AnyScene::Plane(s) => s.description,
+        }
+        .unwrap();
         let full = full.split_whitespace().collect::<Vec<_>>().join(" ");
         assert!(
             full.starts_with(description.as_str()),

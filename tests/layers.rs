@@ -10,7 +10,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 /// The layers, bottom first.
-const LAYERS: [&str; 6] = ["linalg", "step", "scene", "bar", "time", "study"];
+const LAYERS: [&str; 7] = ["linalg", "step", "scene", "bar", "time", "plane", "study"];
 
 /// A source file: its layer, its module name inside the layer (`mod` for `mod.rs`) and its text.
 struct Source {

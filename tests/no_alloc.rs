@@ -54,3 +54,34 @@ fn steps_do_not_allocate() {
         );
     }
 }
+
+#[test]
+fn plane_steps_do_not_allocate() {
+    use viscobar::scene::plane::PLANE_BUILTIN;
+    use viscobar::scene::{AnyScene, load_any};
+    // The built-in plane scenes (no load, constant load) and a time-dependent load.
+    let mut scenes = Vec::new();
+    for (name, _) in PLANE_BUILTIN {
+        let AnyScene::Plane(scene) = load_any(name, &[]).unwrap().1 else {
+            panic!("{name} is a plane scene");
+        };
+        scenes.push((name.to_string(), *scene));
+    }
+    scenes.push((
+        "manufactured".into(),
+        viscobar::plane::closed_form::Manufactured::default().scene(8, 4, 2.0, 0.125, 20.0),
+    ));
+    for (name, scene) in scenes {
+        let mut sim = viscobar::plane::PlaneSimulation::new(&scene).unwrap();
+        sim.step().unwrap(); // warm-up outside the count
+        let before = allocations();
+        for _ in 0..100 {
+            sim.step().unwrap();
+        }
+        let allocations = allocations() - before;
+        assert_eq!(
+            allocations, 0,
+            "{name}: {allocations} allocations in 100 plane steps"
+        );
+    }
+}

@@ -36,6 +36,15 @@ pub enum SceneError {
         t: f64,
         value: f64,
     },
+    #[error("`{field}` = \"{text}\" evaluates to {value} at x = {x}, y = {y}, t = {t}")]
+    NonFinitePlane {
+        field: String,
+        text: String,
+        x: f64,
+        y: f64,
+        t: f64,
+        value: f64,
+    },
     #[error(
         "inadmissible initial state: `{field}` gives u = {value} at node {node} (x = {x}), \
          below the obstacle -{gap} (`{gap_field}`)"

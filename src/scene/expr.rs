@@ -6,7 +6,7 @@
 //! | What | Written | Example | Value |
 //! |---|---|---|---|
 //! | numbers | `12`, `0.5`, `.5`, `5.`, `1e6`, `2.5E-3` | `1e-2` | 0.01 |
-//! | variables | `x` in every field; `t` only in `load.density` | `2*x` at x = 0.25 | 0.5 |
+//! | variables | `x` in every field; `y` in plane scenes ([`Expression::parse_plane`]); `t` only in `load.density` | `2*x` at x = 0.25 | 0.5 |
 //! | constants | `pi` (also `PI`, `π`), `e` (also `E`), `tau` (also `TAU`, `τ`) | `2*pi` | 6.283185307179586 |
 //! | arithmetic | `+ - * /`, left-associative; `*` `/` bind tighter than `+` `-` | `8/4/2` | 1 |
 //! | power | `^`, right-associative, tighter than unary minus: `-a^b` is `-(a^b)` | `2^3^2`, `-2^2` | 512, −4 |
@@ -42,6 +42,7 @@ pub struct Expression {
     field: String,
     root: Node,
     uses_x: bool,
+    uses_y: bool,
     uses_t: bool,
 }
 
@@ -49,6 +50,8 @@ pub struct Expression {
 pub(super) enum Node {
     Num(f64),
     X,
+    /// `y`: plane scenes only.
+    Y,
     T,
     Neg(Box<Node>),
     Bin(BinOp, Box<Node>, Box<Node>),
@@ -220,14 +223,15 @@ pub(super) fn truth(b: bool) -> f64 {
 }
 
 impl Node {
-    pub(super) fn eval(&self, x: f64, t: f64) -> f64 {
+    pub(super) fn eval(&self, x: f64, y: f64, t: f64) -> f64 {
         match self {
             Node::Num(v) => *v,
             Node::X => x,
+            Node::Y => y,
             Node::T => t,
-            Node::Neg(a) => -a.eval(x, t),
+            Node::Neg(a) => -a.eval(x, y, t),
             Node::Bin(op, a, b) => {
-                let (a, b) = (a.eval(x, t), b.eval(x, t));
+                let (a, b) = (a.eval(x, y, t), b.eval(x, y, t));
                 match op {
                     BinOp::Add => a + b,
                     BinOp::Sub => a - b,
@@ -237,7 +241,7 @@ impl Node {
                 }
             }
             Node::Cmp(op, a, b) => {
-                let (a, b) = (a.eval(x, t), b.eval(x, t));
+                let (a, b) = (a.eval(x, y, t), b.eval(x, y, t));
                 if a.is_nan() || b.is_nan() {
                     return f64::NAN;
                 }
@@ -250,9 +254,9 @@ impl Node {
                     CmpOp::Ne => a != b,
                 })
             }
-            Node::Call1(f, a) => f.apply(a.eval(x, t)),
+            Node::Call1(f, a) => f.apply(a.eval(x, y, t)),
             Node::Call2(f, a, b) => {
-                let (a, b) = (a.eval(x, t), b.eval(x, t));
+                let (a, b) = (a.eval(x, y, t), b.eval(x, y, t));
                 match f {
                     Func2::Min => a.min(b),
                     Func2::Max => a.max(b),
@@ -260,13 +264,13 @@ impl Node {
                 }
             }
             Node::If(c, a, b) => {
-                let c = c.eval(x, t);
+                let c = c.eval(x, y, t);
                 if c.is_nan() {
                     f64::NAN
                 } else if c != 0.0 {
-                    a.eval(x, t)
+                    a.eval(x, y, t)
                 } else {
-                    b.eval(x, t)
+                    b.eval(x, y, t)
                 }
             }
         }
@@ -441,8 +445,10 @@ struct Parser<'a> {
     pos: usize,
     depth: usize,
     allow_t: bool,
+    allow_y: bool,
     field: &'a str,
     uses_x: bool,
+    uses_y: bool,
     uses_t: bool,
 }
 
@@ -646,6 +652,10 @@ impl Parser<'_> {
                 self.uses_x = true;
                 return Ok(Node::X);
             }
+            "y" if self.allow_y => {
+                self.uses_y = true;
+                return Ok(Node::Y);
+            }
             "t" if self.allow_t => {
                 self.uses_t = true;
                 return Ok(Node::T);
@@ -660,12 +670,18 @@ impl Parser<'_> {
                 "`{name}` at column {col} is a function: write {name}(...)"
             ));
         }
-        let vars = if self.allow_t { "x, t" } else { "x" };
+        let vars = match (self.allow_y, self.allow_t) {
+            (false, false) => "x",
+            (false, true) => "x, t",
+            (true, false) => "x, y",
+            (true, true) => "x, y, t",
+        };
         let mut msg = format!(
             "unknown variable `{name}` at column {col} (allowed: {vars}, constants pi, e, tau)"
         );
         if name == "t" {
-            msg.push_str(&format!("; `{}` may depend on x only", self.field));
+            let only = if self.allow_y { "x and y" } else { "x" };
+            msg.push_str(&format!("; `{}` may depend on {only} only", self.field));
         } else if matches!(name, "inf" | "infinity" | "nan" | "NaN") {
             msg.push_str("; a value must be a finite number");
         }
@@ -756,6 +772,20 @@ impl Expression {
     /// Parses `text` for the scene field `field` (named in every error). `allow_t` is false for
     /// initial data and gaps, which may depend on `x` only.
     pub fn parse(field: &str, text: &str, allow_t: bool) -> Result<Self, SceneError> {
+        Self::parse_with(field, text, allow_t, false)
+    }
+
+    /// [`Expression::parse`] for a plane scene: `y` is a variable too (see [`Expression::eval_xy`]).
+    pub fn parse_plane(field: &str, text: &str, allow_t: bool) -> Result<Self, SceneError> {
+        Self::parse_with(field, text, allow_t, true)
+    }
+
+    fn parse_with(
+        field: &str,
+        text: &str,
+        allow_t: bool,
+        allow_y: bool,
+    ) -> Result<Self, SceneError> {
         let bad = |reason: String| SceneError::Expression {
             field: field.to_string(),
             text: text.to_string(),
@@ -767,8 +797,10 @@ impl Expression {
             pos: 0,
             depth: 0,
             allow_t,
+            allow_y,
             field,
             uses_x: false,
+            uses_y: false,
             uses_t: false,
         };
         let root = parser.parse_all().map_err(bad)?;
@@ -777,6 +809,7 @@ impl Expression {
             field: field.to_string(),
             root,
             uses_x: parser.uses_x,
+            uses_y: parser.uses_y,
             uses_t: parser.uses_t,
         })
     }
@@ -790,6 +823,8 @@ impl Expression {
             field: field.to_string(),
             root,
             uses_x,
+            // Parts come from separating a bar load, which never reads `y`.
+            uses_y: false,
             uses_t,
         }
     }
@@ -810,6 +845,10 @@ impl Expression {
         self.uses_x
     }
 
+    pub fn depends_on_y(&self) -> bool {
+        self.uses_y
+    }
+
     pub fn depends_on_t(&self) -> bool {
         self.uses_t
     }
@@ -817,7 +856,7 @@ impl Expression {
     /// `f(x, t)`; an error names the field, the expression and the point when the value is not
     /// a finite number.
     pub fn eval(&self, x: f64, t: f64) -> Result<f64, SceneError> {
-        let v = self.root.eval(x, t);
+        let v = self.root.eval(x, 0.0, t);
         if v.is_finite() {
             Ok(v)
         } else {
@@ -825,6 +864,24 @@ impl Expression {
                 field: self.field.clone(),
                 text: self.text.clone(),
                 x,
+                t,
+                value: v,
+            })
+        }
+    }
+
+    /// `f(x, y, t)` of an expression parsed with [`Expression::parse_plane`]; an error names
+    /// the field, the expression and the point when the value is not a finite number.
+    pub fn eval_xy(&self, x: f64, y: f64, t: f64) -> Result<f64, SceneError> {
+        let v = self.root.eval(x, y, t);
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(SceneError::NonFinitePlane {
+                field: self.field.clone(),
+                text: self.text.clone(),
+                x,
+                y,
                 t,
                 value: v,
             })

@@ -19,7 +19,7 @@ pub struct NodalEvaluator {
 /// Scratch arrays the evaluation of `node` needs besides its output.
 fn scratch(node: &Node) -> usize {
     match node {
-        Node::Num(_) | Node::X | Node::T => 0,
+        Node::Num(_) | Node::X | Node::Y | Node::T => 0,
         Node::Neg(a) | Node::Call1(_, a) => scratch(a),
         Node::Bin(_, a, b) | Node::Cmp(_, a, b) | Node::Call2(_, a, b) => {
             scratch(a).max(1 + scratch(b))
@@ -34,6 +34,8 @@ fn eval_into(node: &Node, xs: &[f64], t: f64, out: &mut [f64], pool: &mut [Vec<f
         Node::Num(v) => out.fill(*v),
         Node::X => out.copy_from_slice(xs),
         Node::T => out.fill(t),
+        // A bar expression is evaluated at `y = 0`, as `Expression::eval` does.
+        Node::Y => out.fill(0.0),
         Node::Neg(a) => {
             eval_into(a, xs, t, out, pool);
             out.iter_mut().for_each(|v| *v = -*v);

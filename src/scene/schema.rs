@@ -206,7 +206,9 @@ pub fn number_text(v: f64) -> String {
 /// Serde: an expression field given as a string (the expression) or as a number (TOML integer
 /// or float, kept as [`number_text`]). A non-finite float is kept as `inf`/`NaN`, which the
 /// expression parser then refuses with the field's name.
-fn number_or_expression<'de, D: serde::Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+pub(crate) fn number_or_expression<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<String, D::Error> {
     struct Visitor;
     impl serde::de::Visitor<'_> for Visitor {
         type Value = String;
@@ -448,10 +450,10 @@ pub const MAX_ELEMENTS: u64 = 100_000_000;
 /// Memory per node of a run: about 40 vectors of f64 (state, products, matrices, factors,
 /// solver columns, output buffers) with a margin for the solver's own work space.
 pub const BYTES_PER_NODE: u64 = 512;
-const GIB: f64 = (1u64 << 30) as f64;
+pub(crate) const GIB: f64 = (1u64 << 30) as f64;
 
 /// `MemAvailable` from /proc/meminfo, or 24 GiB (this project's machines) where unreadable.
-fn available_memory_bytes() -> u64 {
+pub(crate) fn available_memory_bytes() -> u64 {
     std::fs::read_to_string("/proc/meminfo")
         .ok()
         .and_then(|t| {
@@ -497,6 +499,24 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ),
 ];
 
+/// Built-in plane scenes, embedded from `scenes/*.toml` (listed apart from the bar's
+/// [`crate::scene::BUILTIN`], whose users expect bar scenes).
+pub const PLANE_BUILTIN: &[(&str, &str)] = &[
+    ("plane-strip", include_str!("../../scenes/plane-strip.toml")),
+    (
+        "plane-cantilever",
+        include_str!("../../scenes/plane-cantilever.toml"),
+    ),
+];
+
+/// The TOML text of a built-in plane scene.
+pub fn plane_builtin_text(name: &str) -> Option<&'static str> {
+    PLANE_BUILTIN
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, t)| *t)
+}
+
 /// The names of the built-in scenes, in order.
 pub fn builtin_names() -> Vec<&'static str> {
     BUILTIN.iter().map(|(n, _)| *n).collect()
@@ -507,11 +527,25 @@ pub fn builtin_text(name: &str) -> Option<&'static str> {
     BUILTIN.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
 }
 
+/// A plane scene given where only bar scenes are taken (`converge`, `compare`, `figures`).
+fn plane_not_here(name: &str) -> SceneError {
+    SceneError::Invalid {
+        field: "plane".into(),
+        value: name.to_string(),
+        allowed: "a plane scene: only `viscobar run` takes plane scenes (this command takes \
+                  bar scenes)"
+            .into(),
+    }
+}
+
 /// Reads a scene by built-in name or path, applies `key=value` overrides, and returns its name
 /// (the built-in name or the file stem) and the validated scene.
 pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(String, Scene), SceneError> {
     let (name, text) = match builtin_text(name_or_path) {
         Some(t) => (name_or_path.to_string(), t.to_string()),
+        None if plane_builtin_text(name_or_path).is_some() => {
+            return Err(plane_not_here(name_or_path));
+        }
         None => {
             let path = Path::new(name_or_path);
             if !path.is_file() {
@@ -543,6 +577,9 @@ impl Scene {
     pub fn from_toml(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
         let syntax = |e: toml::de::Error| SceneError::Syntax(e.to_string().trim_end().to_string());
         let mut table: toml::Table = toml::from_str(text).map_err(syntax)?;
+        if table.contains_key("plane") && !table.contains_key("bar") {
+            return Err(plane_not_here("this scene"));
+        }
         for assignment in overrides {
             apply_override(&mut table, assignment)?;
         }
@@ -825,7 +862,7 @@ const SUGGESTION_DIGITS: usize = 12;
 /// `time.step` must divide `time.end` (up to [`TIME_GRID_TOL`]): the run then ends at
 /// `time.end` exactly instead of at the nearest multiple of the step. Refused otherwise, with
 /// the nearest valid ends for this step and the nearest valid steps for this end.
-fn check_time_grid(step: f64, end: f64) -> Result<(), SceneError> {
+pub(crate) fn check_time_grid(step: f64, end: f64) -> Result<(), SceneError> {
     let ratio = end / step;
     let n = ratio.round();
     if n >= 1.0 && (ratio - n).abs() <= TIME_GRID_TOL * n {
@@ -863,7 +900,7 @@ fn check_time_grid(step: f64, end: f64) -> Result<(), SceneError> {
     })
 }
 
-fn invalid(field: &str, value: f64, allowed: &str) -> SceneError {
+pub(crate) fn invalid(field: &str, value: f64, allowed: &str) -> SceneError {
     SceneError::Invalid {
         field: field.to_string(),
         value: value.to_string(),
@@ -871,7 +908,7 @@ fn invalid(field: &str, value: f64, allowed: &str) -> SceneError {
     }
 }
 
-fn positive(field: &str, value: f64) -> Result<(), SceneError> {
+pub(crate) fn positive(field: &str, value: f64) -> Result<(), SceneError> {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
@@ -879,7 +916,7 @@ fn positive(field: &str, value: f64) -> Result<(), SceneError> {
     }
 }
 
-fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), SceneError> {
+pub(crate) fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), SceneError> {
     let fail = |reason: &str| SceneError::Override {
         assignment: assignment.to_string(),
         reason: reason.to_string(),

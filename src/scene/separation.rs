@@ -27,12 +27,14 @@ pub struct SeparatedTerm {
 type Factor = Option<Node>;
 
 impl Node {
-    /// Whether the tree reads `x` and `t`.
+    /// Whether the tree reads `x` and `t` (a bar expression; see `Node::Y` below).
     pub(super) fn uses(&self) -> (bool, bool) {
         match self {
             Node::Num(_) => (false, false),
             Node::X => (true, false),
             Node::T => (false, true),
+            // The plane's `y` counts as both, so that a tree reading it never separates.
+            Node::Y => (true, true),
             Node::Neg(a) | Node::Call1(_, a) => a.uses(),
             Node::Bin(_, a, b) | Node::Cmp(_, a, b) | Node::Call2(_, a, b) => {
                 let (p, q) = (a.uses(), b.uses());

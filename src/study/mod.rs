@@ -12,6 +12,8 @@ pub mod figure_writer;
 pub mod figures;
 pub mod mass_figure;
 pub mod mass_variants;
+pub mod plane_checks;
+pub mod plane_figure;
 pub mod sampled_run;
 pub mod stiff;
 pub mod stiff_runs;

@@ -50,6 +50,10 @@ pub fn sections() -> Result<Vec<Section>, crate::study::converge::ConvergeError>
         stiff_section(&stiff),
         tolerances_section(&stiff)?,
         mass_variants_section()?,
+        Section {
+            id: "plane",
+            markdown: crate::study::plane_checks::markdown()?,
+        },
     ])
 }
 

@@ -74,7 +74,7 @@ pub fn run_to_dir(
 }
 
 /// `out` and those of its parents that do not exist yet, deepest first.
-fn missing_folders(out: &Path) -> Vec<PathBuf> {
+pub(crate) fn missing_folders(out: &Path) -> Vec<PathBuf> {
     out.ancestors()
         .filter(|p| !p.as_os_str().is_empty())
         .take_while(|p| !p.exists())
@@ -309,7 +309,7 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 
 /// Removes the temporary folders that interrupted runs (killed before they could clean up)
 /// left in `out`, unless their process is still running.
-fn remove_stale_partials(out: &Path) {
+pub(crate) fn remove_stale_partials(out: &Path) {
     let Ok(entries) = std::fs::read_dir(out) else {
         return;
     };

@@ -1,0 +1,269 @@
+//! Running a plane scene end to end: the step loop and the output files, as for the bar
+//! (`summary.json`, `history.csv`, `displacement.csv` in long format `t,x,y,ux,uy,vx,vy`),
+//! written into a temporary folder and moved into place only when the run succeeds.
+
+use crate::plane::error::PlaneError;
+use crate::plane::simulation::{PlaneRecord, PlaneSimulation};
+use crate::scene::plane::PlaneScene;
+use crate::time::run::{missing_folders, remove_stale_partials};
+use crate::time::summary::output_time;
+use serde::Serialize;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The name of the plane's linear solver in `summary.json`.
+pub const SOLVER_NAME: &str = "sparse-cholesky";
+
+/// `summary.json` of a plane run: the bar's fields where they apply.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlaneSummary {
+    pub scene: String,
+    /// [`SOLVER_NAME`]: one solve with the factor of `C` per step.
+    pub solver: String,
+    /// `(nx + 1)(ny + 1)`.
+    pub nodes: usize,
+    /// Cells, `nx · ny`.
+    pub elements: usize,
+    /// Degrees of freedom not clamped.
+    pub unknowns: usize,
+    /// Stored values of the factor of `C` (supernodal, AMD ordering).
+    pub factor_values: usize,
+    pub dt: f64,
+    pub steps: usize,
+    pub final_time: f64,
+    pub wall_time_s: f64,
+    /// `wall_time_s` / (steps × unknowns), nanoseconds.
+    pub ns_per_unknown_step: f64,
+    /// `E^{1/2}`, `E^{N−1/2}`.
+    pub energy_initial: f64,
+    pub energy_final: f64,
+    /// Largest `E^{n+1/2} − E^{n−1/2}` over `E^{1/2}`; `null` with a load.
+    pub max_energy_rise: Option<f64>,
+    pub max_identity_residual: f64,
+}
+
+/// Collects the summary's figures over the records.
+struct Tracker {
+    energy_initial: f64,
+    last_energy: f64,
+    max_rise: f64,
+    max_residual: f64,
+    forced: bool,
+}
+
+impl Tracker {
+    fn new(first: &PlaneRecord, forced: bool) -> Self {
+        Self {
+            energy_initial: first.energy,
+            last_energy: first.energy,
+            max_rise: f64::NEG_INFINITY,
+            max_residual: 0.0,
+            forced,
+        }
+    }
+
+    fn observe(&mut self, r: &PlaneRecord) {
+        self.max_rise = self.max_rise.max(r.energy - self.last_energy);
+        self.max_residual = self.max_residual.max(r.identity_residual);
+        self.last_energy = r.energy;
+    }
+
+    fn finish(self, name: &str, sim: &PlaneSimulation, wall: f64) -> PlaneSummary {
+        let d = sim.discretisation();
+        let steps = sim.step_index();
+        let rise = if self.max_rise.is_finite() {
+            self.max_rise / self.energy_initial
+        } else {
+            0.0
+        };
+        PlaneSummary {
+            scene: name.to_string(),
+            solver: SOLVER_NAME.into(),
+            nodes: d.grid.nodes(),
+            elements: d.grid.cells(),
+            unknowns: d.unknowns(),
+            factor_values: sim.factor_len(),
+            dt: d.dt,
+            steps,
+            final_time: output_time(sim.time()),
+            wall_time_s: wall,
+            ns_per_unknown_step: wall * 1e9 / (steps as f64 * d.unknowns() as f64),
+            energy_initial: self.energy_initial,
+            energy_final: self.last_energy,
+            max_energy_rise: (!self.forced).then_some(rise),
+            max_identity_residual: self.max_residual,
+        }
+    }
+}
+
+/// Whether a scene has a load (which can feed energy in).
+fn forced(scene: &PlaneScene) -> bool {
+    scene.load.density.as_ref().is_some_and(|v| {
+        v.0.iter()
+            .any(|c| c.trim().parse::<f64>().ok().is_none_or(|x| x != 0.0))
+    })
+}
+
+/// Runs a plane scene in memory: every record (the start-up step first), the summary and the
+/// final simulation.
+pub fn run_plane_in_memory(
+    name: &str,
+    scene: &PlaneScene,
+) -> Result<(Vec<PlaneRecord>, PlaneSummary, PlaneSimulation), PlaneError> {
+    let start = Instant::now();
+    let mut sim = PlaneSimulation::new(scene)?;
+    let mut tracker = Tracker::new(&sim.first_record(), forced(scene));
+    let mut records = vec![sim.first_record()];
+    for _ in 1..scene.steps() {
+        let r = sim.step()?;
+        tracker.observe(&r);
+        records.push(r);
+    }
+    let summary = tracker.finish(name, &sim, start.elapsed().as_secs_f64());
+    Ok((records, summary, sim))
+}
+
+/// Runs a plane scene and writes `summary.json`, `history.csv` and `displacement.csv` into
+/// `out`, whole or not at all (the bar's [`crate::time::run::run_to_dir`] discipline: the scene
+/// is set up before anything is created; folders created for `out` are removed on failure).
+pub fn run_plane_to_dir(
+    name: &str,
+    scene: &PlaneScene,
+    out: &Path,
+) -> Result<PlaneSummary, PlaneError> {
+    let write_err = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| PlaneError::Write { path, source }
+    };
+    let start = Instant::now();
+    let sim = PlaneSimulation::new(scene)?;
+    let created = missing_folders(out);
+    let outcome = (|| {
+        std::fs::create_dir_all(out).map_err(write_err(out))?;
+        remove_stale_partials(out);
+        let tmp = out.join(format!(".viscobar-partial-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&tmp);
+        std::fs::create_dir_all(&tmp).map_err(write_err(&tmp))?;
+        let outcome = write_run(name, scene, sim, start, &tmp).and_then(|summary| {
+            for file in ["history.csv", "displacement.csv", "summary.json"] {
+                std::fs::rename(tmp.join(file), out.join(file))
+                    .map_err(write_err(&out.join(file)))?;
+            }
+            Ok(summary)
+        });
+        let _ = std::fs::remove_dir_all(&tmp);
+        outcome
+    })();
+    if outcome.is_err() {
+        for folder in &created {
+            let _ = std::fs::remove_dir(folder);
+        }
+    }
+    outcome
+}
+
+fn write_run(
+    name: &str,
+    scene: &PlaneScene,
+    mut sim: PlaneSimulation,
+    start: Instant,
+    dir: &Path,
+) -> Result<PlaneSummary, PlaneError> {
+    let open = |file: &str| -> Result<(PathBuf, std::io::BufWriter<std::fs::File>), PlaneError> {
+        let path = dir.join(file);
+        let f = std::fs::File::create(&path).map_err(|source| PlaneError::Write {
+            path: path.clone(),
+            source,
+        })?;
+        Ok((path, std::io::BufWriter::with_capacity(1 << 20, f)))
+    };
+    let io = |path: &PathBuf| {
+        let path = path.clone();
+        move |source| PlaneError::Write { path, source }
+    };
+    let (hist_path, mut hist) = open("history.csv")?;
+    let (disp_path, mut disp) = open("displacement.csv")?;
+    writeln!(
+        hist,
+        "step,t,energy,work,viscous_dissipation,identity_residual"
+    )
+    .map_err(io(&hist_path))?;
+    let first = sim.first_record();
+    write_history_row(&mut hist, &first).map_err(io(&hist_path))?;
+    let mut tracker = Tracker::new(&first, forced(scene));
+
+    let grid = sim.discretisation().grid.clone();
+    // Coordinates rounded once per run, as the bar's x.
+    let points: Vec<(f64, f64)> = (0..grid.nodes())
+        .map(|k| {
+            let (x, y) = grid.point(k);
+            (output_time(x), output_time(y))
+        })
+        .collect();
+    writeln!(disp, "t,x,y,ux,uy,vx,vy").map_err(io(&disp_path))?;
+    let (u0, v0) = sim.initial_state();
+    write_field(&mut disp, 0.0, &points, u0, v0).map_err(io(&disp_path))?;
+    let mut u = vec![0.0; grid.dofs()];
+    let mut v = vec![0.0; grid.dofs()];
+    let steps = scene.steps();
+    let every = scene.output.every as usize;
+    let keep = |n: usize| n.is_multiple_of(every) || n == steps;
+    if keep(1) {
+        sim.displacement_into(&mut u);
+        sim.velocity_into(&mut v);
+        write_field(&mut disp, sim.time(), &points, &u, &v).map_err(io(&disp_path))?;
+    }
+    for _ in 1..steps {
+        let r = sim.step()?;
+        tracker.observe(&r);
+        write_history_row(&mut hist, &r).map_err(io(&hist_path))?;
+        if keep(r.step) {
+            sim.displacement_into(&mut u);
+            sim.velocity_into(&mut v);
+            write_field(&mut disp, sim.time(), &points, &u, &v).map_err(io(&disp_path))?;
+        }
+    }
+    hist.flush().map_err(io(&hist_path))?;
+    disp.flush().map_err(io(&disp_path))?;
+    let summary = tracker.finish(name, &sim, start.elapsed().as_secs_f64());
+    let json_path = dir.join("summary.json");
+    let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
+    std::fs::write(&json_path, json + "\n").map_err(io(&json_path))?;
+    Ok(summary)
+}
+
+fn write_history_row(w: &mut impl Write, r: &PlaneRecord) -> std::io::Result<()> {
+    writeln!(
+        w,
+        "{},{},{},{},{},{}",
+        r.step,
+        output_time(r.time),
+        r.energy,
+        r.work,
+        r.viscous_dissipation,
+        r.identity_residual
+    )
+}
+
+/// One row a node: `t,x,y,ux,uy,vx,vy`.
+fn write_field(
+    w: &mut impl Write,
+    t: f64,
+    points: &[(f64, f64)],
+    u: &[f64],
+    v: &[f64],
+) -> std::io::Result<()> {
+    let t = output_time(t);
+    for (k, (x, y)) in points.iter().enumerate() {
+        writeln!(
+            w,
+            "{t},{x},{y},{},{},{},{}",
+            u[2 * k],
+            u[2 * k + 1],
+            v[2 * k],
+            v[2 * k + 1]
+        )?;
+    }
+    Ok(())
+}
