@@ -92,6 +92,10 @@ enum Command {
         /// dt/dx at every level [default: the scene's].
         #[arg(long)]
         ratio: Option<f64>,
+        /// Comma-separated mass matrices (consistent, redistributed, lumped): one study each,
+        /// in `<out>/mass-<variant>/` when more than one [default: the scene's `bar.mass`].
+        #[arg(long, value_name = "LIST")]
+        mass: Option<String>,
         /// Output folder [default: out/converge-<scene>].
         #[arg(long)]
         out: Option<PathBuf>,
@@ -181,9 +185,11 @@ fn main() {
             ratio,
             out,
             viscosity_sweep,
+            mass,
         } => match converge(
             &scene,
             [&solvers, &osqp_eps, &penalty_epsilon],
+            mass.as_deref(),
             &set,
             viscobar::study::converge::StudyOptions {
                 levels,
@@ -430,6 +436,7 @@ fn run(
 fn converge(
     name: &str,
     [solvers, osqp_eps, penalty_epsilon]: [&str; 3],
+    mass: Option<&str>,
     set: &[String],
     options: viscobar::study::converge::StudyOptions,
     out: Option<PathBuf>,
@@ -452,6 +459,27 @@ fn converge(
         )?;
         print!("{}", sweep.markdown());
         sweep.write(&out)?
+    } else if let Some(list) = mass {
+        use viscobar::study::mass_variants::{parse_mass_list, with_mass};
+        let variants = parse_mass_list(list)?;
+        // Every variant validated (e.g. redistributed with an obstacle) before any is run.
+        let scenes = variants
+            .iter()
+            .map(|&v| with_mass(&scene, v))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut files = Vec::new();
+        for (variant, scene) in variants.iter().zip(&scenes) {
+            let study = converge::study_with(&scene_name, scene, &settings, &options)?;
+            let dir = if variants.len() > 1 {
+                println!("## bar.mass = {}\n", variant.name());
+                out.join(format!("mass-{}", variant.name()))
+            } else {
+                out.clone()
+            };
+            print!("{}", study.markdown());
+            files.extend(study.write(&dir)?);
+        }
+        files
     } else {
         let study = converge::study_with(&scene_name, &scene, &settings, &options)?;
         print!("{}", study.markdown());

@@ -650,3 +650,57 @@ fn converge_refuses_bad_lists_and_levels_naming_the_flag() {
         assert!(!out.exists(), "{args:?}: a refused study writes nothing");
     }
 }
+
+/// `converge --mass`: one study per mass matrix, each in its own folder with its own
+/// `convergence.csv`; an unknown variant, or one the scene refuses, exits 2 naming the key and
+/// writes nothing.
+#[test]
+fn converge_mass_runs_one_study_per_variant() {
+    let out = tmpdir("converge-mass");
+    let o = viscobar(&[
+        "converge",
+        "impact",
+        "--mass",
+        "consistent,lumped",
+        "--solvers",
+        "exact",
+        "--levels",
+        "2",
+        "--repeats",
+        "0",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut l2 = Vec::new();
+    for v in ["consistent", "lumped"] {
+        let csv = std::fs::read_to_string(out.join(format!("mass-{v}/convergence.csv"))).unwrap();
+        assert!(csv.lines().count() >= 3, "{v}: {csv}");
+        l2.push(csv);
+    }
+    // Different mass matrices, different errors.
+    assert_ne!(l2[0], l2[1]);
+    for (args, key) in [
+        (&["impact", "--mass", "heavy"][..], "--mass"),
+        (
+            &["distributed", "--mass", "consistent,redistributed"][..],
+            "bar.mass",
+        ),
+    ] {
+        let bad = tmpdir("converge-mass-bad");
+        let mut a = vec!["converge"];
+        a.extend_from_slice(args);
+        a.extend_from_slice(&[
+            "--solvers",
+            "exact",
+            "--levels",
+            "2",
+            "--out",
+            bad.to_str().unwrap(),
+        ]);
+        let o = viscobar(&a);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(String::from_utf8_lossy(&o.stderr).contains(key), "{args:?}");
+        assert!(!bad.exists(), "{args:?}: nothing written");
+    }
+}
