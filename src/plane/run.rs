@@ -5,7 +5,7 @@
 use crate::plane::error::PlaneError;
 use crate::plane::simulation::{PlaneRecord, PlaneSimulation};
 use crate::scene::plane::PlaneScene;
-use crate::time::run::{missing_folders, remove_stale_partials};
+use crate::time::run::{RUN_FILES, write_whole};
 use crate::time::summary::output_time;
 use serde::Serialize;
 use std::io::Write;
@@ -132,35 +132,14 @@ pub fn run_plane_to_dir(
     scene: &PlaneScene,
     out: &Path,
 ) -> Result<PlaneSummary, PlaneError> {
-    let write_err = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| PlaneError::Write { path, source }
-    };
     let start = Instant::now();
     let sim = PlaneSimulation::new(scene)?;
-    let created = missing_folders(out);
-    let outcome = (|| {
-        std::fs::create_dir_all(out).map_err(write_err(out))?;
-        remove_stale_partials(out);
-        let tmp = out.join(format!(".viscobar-partial-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&tmp);
-        std::fs::create_dir_all(&tmp).map_err(write_err(&tmp))?;
-        let outcome = write_run(name, scene, sim, start, &tmp).and_then(|summary| {
-            for file in ["history.csv", "displacement.csv", "summary.json"] {
-                std::fs::rename(tmp.join(file), out.join(file))
-                    .map_err(write_err(&out.join(file)))?;
-            }
-            Ok(summary)
-        });
-        let _ = std::fs::remove_dir_all(&tmp);
-        outcome
-    })();
-    if outcome.is_err() {
-        for folder in &created {
-            let _ = std::fs::remove_dir(folder);
-        }
-    }
-    outcome
+    write_whole(
+        out,
+        &RUN_FILES,
+        |path, source| PlaneError::Write { path, source },
+        |tmp| write_run(name, scene, sim, start, tmp),
+    )
 }
 
 fn write_run(

@@ -218,6 +218,23 @@ pub(super) fn pow(a: f64, b: f64) -> f64 {
     if b == 2.0 { a * a } else { a.powf(b) }
 }
 
+impl CmpOp {
+    /// `1` or `0`, and NaN when either side is NaN (never read as false).
+    pub(super) fn apply(self, a: f64, b: f64) -> f64 {
+        if a.is_nan() || b.is_nan() {
+            return f64::NAN;
+        }
+        truth(match self {
+            CmpOp::Lt => a < b,
+            CmpOp::Le => a <= b,
+            CmpOp::Gt => a > b,
+            CmpOp::Ge => a >= b,
+            CmpOp::Eq => a == b,
+            CmpOp::Ne => a != b,
+        })
+    }
+}
+
 pub(super) fn truth(b: bool) -> f64 {
     if b { 1.0 } else { 0.0 }
 }
@@ -240,20 +257,7 @@ impl Node {
                     BinOp::Pow => pow(a, b),
                 }
             }
-            Node::Cmp(op, a, b) => {
-                let (a, b) = (a.eval(x, y, t), b.eval(x, y, t));
-                if a.is_nan() || b.is_nan() {
-                    return f64::NAN;
-                }
-                truth(match op {
-                    CmpOp::Lt => a < b,
-                    CmpOp::Le => a <= b,
-                    CmpOp::Gt => a > b,
-                    CmpOp::Ge => a >= b,
-                    CmpOp::Eq => a == b,
-                    CmpOp::Ne => a != b,
-                })
-            }
+            Node::Cmp(op, a, b) => op.apply(a.eval(x, y, t), b.eval(x, y, t)),
             Node::Call1(f, a) => f.apply(a.eval(x, y, t)),
             Node::Call2(f, a, b) => {
                 let (a, b) = (a.eval(x, y, t), b.eval(x, y, t));

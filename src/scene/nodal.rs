@@ -5,7 +5,7 @@
 //! (the same `f64` operations in the same order at each point).
 
 use crate::scene::SceneError;
-use crate::scene::expr::{BinOp, CmpOp, Expression, Func2, Node, pow, truth};
+use crate::scene::expr::{BinOp, Expression, Func2, Node, pow};
 
 /// `f(x_i, t)` at fixed nodes `x_i`, for any `t`.
 #[derive(Clone, Debug)]
@@ -65,19 +65,7 @@ fn eval_into(node: &Node, xs: &[f64], t: f64, out: &mut [f64], pool: &mut [Vec<f
             let (tmp, rest) = pool.split_first_mut().expect("pool sized by `scratch`");
             eval_into(b, xs, t, tmp, rest);
             for (o, &b) in out.iter_mut().zip(tmp.iter()) {
-                let a = *o;
-                *o = if a.is_nan() || b.is_nan() {
-                    f64::NAN
-                } else {
-                    truth(match op {
-                        CmpOp::Lt => a < b,
-                        CmpOp::Le => a <= b,
-                        CmpOp::Gt => a > b,
-                        CmpOp::Ge => a >= b,
-                        CmpOp::Eq => a == b,
-                        CmpOp::Ne => a != b,
-                    })
-                };
+                *o = op.apply(*o, b);
             }
         }
         Node::Call2(f, a, b) => {

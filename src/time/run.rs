@@ -40,26 +40,41 @@ pub fn run_to_dir(
     out: &Path,
     progress: bool,
 ) -> Result<Summary, RunError> {
-    let write_err = |path: &Path| {
-        let path = path.to_path_buf();
-        move |source| RunError::Write { path, source }
-    };
     let start = Instant::now();
     let sim = Simulation::new(scene)?;
+    write_whole(
+        out,
+        &RUN_FILES,
+        |path, source| RunError::Write { path, source },
+        |tmp| write_run(name, scene, sim, start, tmp, progress),
+    )
+}
+
+/// The files a run writes (bar or plane).
+pub(crate) const RUN_FILES: [&str; 3] = ["history.csv", "displacement.csv", "summary.json"];
+
+/// Writes `files` into `out` whole or not at all: `write` fills a temporary folder inside
+/// `out`, whose files are moved into place only when it succeeds, so a failed run leaves
+/// earlier results untouched; folders created for `out` are removed again on failure.
+pub(crate) fn write_whole<T, E>(
+    out: &Path,
+    files: &[&str],
+    write_err: impl Fn(PathBuf, std::io::Error) -> E,
+    write: impl FnOnce(&Path) -> Result<T, E>,
+) -> Result<T, E> {
     let created = missing_folders(out);
     let outcome = (|| {
-        std::fs::create_dir_all(out).map_err(write_err(out))?;
+        std::fs::create_dir_all(out).map_err(|e| write_err(out.to_path_buf(), e))?;
         remove_stale_partials(out);
         let tmp = out.join(format!(".viscobar-partial-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&tmp);
-        std::fs::create_dir_all(&tmp).map_err(write_err(&tmp))?;
-        let result = write_run(name, scene, sim, start, &tmp, progress);
-        let outcome = result.and_then(|summary| {
-            for file in ["history.csv", "displacement.csv", "summary.json"] {
+        std::fs::create_dir_all(&tmp).map_err(|e| write_err(tmp.clone(), e))?;
+        let outcome = write(&tmp).and_then(|value| {
+            for file in files {
                 std::fs::rename(tmp.join(file), out.join(file))
-                    .map_err(write_err(&out.join(file)))?;
+                    .map_err(|e| write_err(out.join(file), e))?;
             }
-            Ok(summary)
+            Ok(value)
         });
         let _ = std::fs::remove_dir_all(&tmp);
         outcome
