@@ -308,16 +308,27 @@ mod tests {
         }
     }
 
-    #[test]
-    fn step_matrices_match_dense_from_mass_dominated_to_stiff() {
+    /// The step matrices `C` of a 21-node bar from mass-dominated (`Δt = 1e-3 Δx`, κ ≈ 4) to
+    /// stiff (`α = 1e6`, `Δt = 1e4 Δx`, κ ≈ 4e11).
+    fn step_matrices() -> Vec<(f64, f64, SymTridiag)> {
         use crate::bar::matrices::{MatrixVariant, mass, stiffness};
         let nodes = 21;
         let dx = 1.0 / 20.0;
         let m = mass(MatrixVariant::Consistent, nodes, dx);
         let r = stiffness(MatrixVariant::Consistent, nodes, dx);
-        for (alpha, ratio) in [(0.0, 1e-3), (0.0, 1.0), (1e3, 100.0), (1e6, 1e4)] {
-            let dt = ratio * dx;
-            let c = SymTridiag::combine(1.0 / (dt * dt), &m, 0.5 + alpha / (2.0 * dt), &r);
+        [(0.0, 1e-3), (0.0, 1.0), (1e3, 100.0), (1e6, 1e4)]
+            .into_iter()
+            .map(|(alpha, ratio)| {
+                let dt = ratio * dx;
+                let c = SymTridiag::combine(1.0 / (dt * dt), &m, 0.5 + alpha / (2.0 * dt), &r);
+                (alpha, ratio, c)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn step_matrices_match_dense_from_mass_dominated_to_stiff() {
+        for (_, _, c) in step_matrices() {
             check_against_dense(&c);
             // κ: against the double-double reference, below (the dense QR values are
             // themselves only within a few ε‖C‖).
@@ -382,15 +393,8 @@ mod tests {
     /// κ off by 7.7e-6 relative at 4e11 (`viscobar verify --tolerances` prints both ratios).
     #[test]
     fn condition_numbers_match_the_double_double_reference() {
-        use crate::bar::matrices::{MatrixVariant, mass, stiffness};
-        let nodes = 21;
-        let dx = 1.0 / 20.0;
-        let m = mass(MatrixVariant::Consistent, nodes, dx);
-        let r = stiffness(MatrixVariant::Consistent, nodes, dx);
-        for (alpha, ratio) in [(0.0, 1e-3), (0.0, 1.0), (1e3, 100.0), (1e6, 1e4)] {
-            let dt = ratio * dx;
-            let c = SymTridiag::combine(1.0 / (dt * dt), &m, 0.5 + alpha / (2.0 * dt), &r);
-            let (lo, hi) = (eigenvalue_dd(&c, 0), eigenvalue_dd(&c, nodes - 1));
+        for (alpha, ratio, c) in step_matrices() {
+            let (lo, hi) = (eigenvalue_dd(&c, 0), eigenvalue_dd(&c, c.diag.len() - 1));
             let tol = STURM_ERROR_ULPS * f64::EPSILON * c.inf_norm();
             let (l, h) = extreme_eigenvalues(&c);
             for (got, reference) in [(l, lo), (smallest_eigenvalue_spd(&c), lo), (h, hi)] {

@@ -6,8 +6,8 @@
 
 use crate::scene::expr::Expression;
 use crate::scene::schema::{
-    GIB, MAX_STEPS, Scene, Time, apply_override, available_memory_bytes, check_time_grid, invalid,
-    number_or_expression, number_text, positive,
+    GIB, MAX_STEPS, Scene, Time, available_memory_bytes, check_time_grid, invalid,
+    number_or_expression, number_text, positive, toml_syntax, with_overrides,
 };
 /// The built-in plane scenes (kept beside the bar's list in [`crate::scene::schema`]).
 pub use crate::scene::schema::{PLANE_BUILTIN, plane_builtin_text};
@@ -259,12 +259,8 @@ pub fn any_from_toml(text: &str, overrides: &[String]) -> Result<AnyScene, Scene
 impl PlaneScene {
     /// Parses TOML text, applies `key=value` overrides (as for the bar) and validates.
     pub fn from_toml(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
-        let syntax = |e: toml::de::Error| SceneError::Syntax(e.to_string().trim_end().to_string());
-        let mut table: toml::Table = toml::from_str(text).map_err(syntax)?;
-        for assignment in overrides {
-            apply_override(&mut table, assignment)?;
-        }
-        let scene: PlaneScene = table.try_into().map_err(syntax)?;
+        let table: toml::Table = toml::from_str(text).map_err(toml_syntax)?;
+        let scene: PlaneScene = with_overrides(table, overrides)?;
         scene.validate()?;
         Ok(scene)
     }

@@ -575,15 +575,11 @@ impl Scene {
     /// is accepted wherever an expression is (`initial.displacement = 0.1`, in the file or
     /// through `--set`), kept as its text ([`number_text`]).
     pub fn from_toml(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
-        let syntax = |e: toml::de::Error| SceneError::Syntax(e.to_string().trim_end().to_string());
-        let mut table: toml::Table = toml::from_str(text).map_err(syntax)?;
+        let table: toml::Table = toml::from_str(text).map_err(toml_syntax)?;
         if table.contains_key("plane") && !table.contains_key("bar") {
             return Err(plane_not_here("this scene"));
         }
-        for assignment in overrides {
-            apply_override(&mut table, assignment)?;
-        }
-        let scene: Scene = table.try_into().map_err(syntax)?;
+        let scene: Scene = with_overrides(table, overrides)?;
         scene.validate()?;
         Ok(scene)
     }
@@ -914,6 +910,23 @@ pub(crate) fn positive(field: &str, value: f64) -> Result<(), SceneError> {
     } else {
         Err(invalid(field, value, "must be a finite number > 0"))
     }
+}
+
+/// A TOML error as the scene's syntax error.
+pub(crate) fn toml_syntax(e: toml::de::Error) -> SceneError {
+    SceneError::Syntax(e.to_string().trim_end().to_string())
+}
+
+/// `table` with the `key=value` overrides applied, read as a scene of type `T` (not yet
+/// validated): the bar's and the plane's parsing share it.
+pub(crate) fn with_overrides<T: serde::de::DeserializeOwned>(
+    mut table: toml::Table,
+    overrides: &[String],
+) -> Result<T, SceneError> {
+    for assignment in overrides {
+        apply_override(&mut table, assignment)?;
+    }
+    table.try_into().map_err(toml_syntax)
 }
 
 pub(crate) fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), SceneError> {
