@@ -182,9 +182,7 @@ impl Manufactured {
     pub fn scene(&self, nx: u64, ny: u64, y_grading: f64, dt: f64, end: f64) -> PlaneScene {
         let [k1x, k1y, k2x, k2y] = self.k();
         let [a1, a2] = self.amplitude;
-        let clamped = EdgeSpec {
-            condition: EdgeCondition::Clamped,
-        };
+        let clamped = EdgeSpec::plain(EdgeCondition::Clamped);
         let field = |a: f64| {
             [
                 format!("{a:?}*{a1:?}*sin({k1x:?}*x)*sin({k1y:?}*y)"),
@@ -202,9 +200,9 @@ impl Manufactured {
                 viscosity: self.viscosity,
             },
             edges: Edges {
-                left: clamped,
-                right: clamped,
-                bottom: clamped,
+                left: clamped.clone(),
+                right: clamped.clone(),
+                bottom: clamped.clone(),
                 top: clamped,
             },
             initial: PlaneInitial {

@@ -450,6 +450,8 @@ struct Parser<'a> {
     depth: usize,
     allow_t: bool,
     allow_y: bool,
+    /// An edge's gap: the only variable is `s`, read as `x` (the edge's coordinate).
+    edge: bool,
     field: &'a str,
     uses_x: bool,
     uses_y: bool,
@@ -652,7 +654,11 @@ impl Parser<'_> {
 
     fn name(&mut self, name: &str, col: usize) -> Result<Node, String> {
         match name {
-            "x" => {
+            "s" if self.edge => {
+                self.uses_x = true;
+                return Ok(Node::X);
+            }
+            "x" if !self.edge => {
                 self.uses_x = true;
                 return Ok(Node::X);
             }
@@ -675,6 +681,7 @@ impl Parser<'_> {
             ));
         }
         let vars = match (self.allow_y, self.allow_t) {
+            _ if self.edge => "s",
             (false, false) => "x",
             (false, true) => "x, t",
             (true, false) => "x, y",
@@ -784,11 +791,28 @@ impl Expression {
         Self::parse_with(field, text, allow_t, true)
     }
 
+    /// An edge's gap of a plane scene: an expression in the edge's coordinate `s` only (`x`
+    /// along the bottom and top, `y` along the left and right edge), evaluated by
+    /// [`Expression::eval`] with `s` in place of `x`.
+    pub fn parse_edge(field: &str, text: &str) -> Result<Self, SceneError> {
+        Self::parse_full(field, text, false, false, true)
+    }
+
     fn parse_with(
         field: &str,
         text: &str,
         allow_t: bool,
         allow_y: bool,
+    ) -> Result<Self, SceneError> {
+        Self::parse_full(field, text, allow_t, allow_y, false)
+    }
+
+    fn parse_full(
+        field: &str,
+        text: &str,
+        allow_t: bool,
+        allow_y: bool,
+        edge: bool,
     ) -> Result<Self, SceneError> {
         let bad = |reason: String| SceneError::Expression {
             field: field.to_string(),
@@ -802,6 +826,7 @@ impl Expression {
             depth: 0,
             allow_t,
             allow_y,
+            edge,
             field,
             uses_x: false,
             uses_y: false,

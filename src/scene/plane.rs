@@ -58,7 +58,7 @@ fn one_f64() -> f64 {
     1.0
 }
 
-/// The condition on an edge (contact comes with the next issue).
+/// The condition on an edge.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum EdgeCondition {
@@ -67,16 +67,59 @@ pub enum EdgeCondition {
     Free,
     /// `u = 0` (both components).
     Clamped,
+    /// A rigid flat obstacle parallel to the edge at distance `gap(s)` outside the body: at
+    /// every node of the edge `u·n <= g(s)`, `n` the outward normal, with a reaction `r >= 0`
+    /// along `−n` and `r (g − u·n) = 0` (the physical convention; the bar keeps the talk's
+    /// lower bounds). Zero traction where there is no contact.
+    Signorini,
 }
 
-#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+/// One edge: its condition and, for `signorini`, the gap (a number or an expression in the
+/// edge's coordinate `s`: `x` along bottom and top, `y` along left and right).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EdgeSpec {
     pub condition: EdgeCondition,
+    #[serde(
+        default,
+        deserialize_with = "optional_expression",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub gap: Option<String>,
 }
 
+impl EdgeSpec {
+    /// A free (`Free`) or clamped edge.
+    pub fn plain(condition: EdgeCondition) -> Self {
+        Self {
+            condition,
+            gap: None,
+        }
+    }
+
+    /// A Signorini edge with gap `gap` (number or expression in `s`).
+    pub fn signorini(gap: &str) -> Self {
+        Self {
+            condition: EdgeCondition::Signorini,
+            gap: Some(gap.to_string()),
+        }
+    }
+}
+
+fn optional_expression<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
+    number_or_expression(d).map(Some)
+}
+
+/// The edges in the order `left, right, bottom, top` ([`Edges::all`]).
+pub const EDGE_NAMES: [&str; 4] = ["left", "right", "bottom", "top"];
+
+/// Largest number of contact normals `m` of a plane scene: the condensed matrix `S` and the
+/// factor of its active block are two dense `m × m` arrays, 2 · 8 · m² bytes = 256 MiB at
+/// this limit; beyond, the exact step's memory is no longer O(nnz(L)) dominated.
+pub const MAX_CONTACT_NORMALS: u64 = 4096;
+
 /// `[edges]`: `left` (x = 0), `right` (x = W), `bottom` (y = 0), `top` (y = H); free when absent.
-#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Edges {
     #[serde(default)]
@@ -90,10 +133,48 @@ pub struct Edges {
 }
 
 impl Edges {
+    /// `[left, right, bottom, top]`.
+    pub fn all(&self) -> [&EdgeSpec; 4] {
+        [&self.left, &self.right, &self.bottom, &self.top]
+    }
+
     /// `[left, right, bottom, top]` clamped.
     pub fn clamped(&self) -> [bool; 4] {
-        [self.left, self.right, self.bottom, self.top]
-            .map(|e| e.condition == EdgeCondition::Clamped)
+        self.all().map(|e| e.condition == EdgeCondition::Clamped)
+    }
+
+    /// The parsed gap of each Signorini edge (`None` for the others), `[left, right, bottom,
+    /// top]`; an error names `edges.<edge>.gap`.
+    pub fn gaps(&self) -> Result<[Option<Expression>; 4], SceneError> {
+        let mut out: [Option<Expression>; 4] = Default::default();
+        for (k, e) in self.all().into_iter().enumerate() {
+            let field = format!("edges.{}.gap", EDGE_NAMES[k]);
+            match (e.condition, &e.gap) {
+                (EdgeCondition::Signorini, Some(text)) => {
+                    out[k] = Some(Expression::parse_edge(&field, text)?);
+                }
+                (EdgeCondition::Signorini, None) => {
+                    return Err(SceneError::Invalid {
+                        field,
+                        value: "absent".into(),
+                        allowed: "a Signorini edge needs its gap: a number or an expression in s"
+                            .into(),
+                    });
+                }
+                (c, Some(text)) => {
+                    return Err(SceneError::Invalid {
+                        field,
+                        value: text.clone(),
+                        allowed: format!(
+                            "a gap belongs to a Signorini edge only (this edge is {})",
+                            format!("{c:?}").to_lowercase()
+                        ),
+                    });
+                }
+                (_, None) => {}
+            }
+        }
+        Ok(out)
     }
 }
 
@@ -355,7 +436,36 @@ impl PlaneScene {
             ));
         }
         self.expressions()?;
+        self.edges.gaps()?;
+        let m = self.contact_normals();
+        if m > MAX_CONTACT_NORMALS {
+            return Err(SceneError::Invalid {
+                field: "edges".into(),
+                value: format!("{m} contact normals"),
+                allowed: format!(
+                    "at most {MAX_CONTACT_NORMALS} contact normals m (the dense m x m matrix of \
+                     the exact step and its factor take 16 m^2 bytes): coarsen the Signorini \
+                     edges' mesh"
+                ),
+            });
+        }
         Ok(())
+    }
+
+    /// Contact normals `m`: one per node of each Signorini edge, the nodes of a clamped edge
+    /// excepted (a corner shared by two Signorini edges has two, one per component).
+    pub fn contact_normals(&self) -> u64 {
+        let [l, r, b, t] = self.edges.clamped();
+        let (nx, ny) = (self.mesh.nx + 1, self.mesh.ny + 1);
+        let along_y = ny.saturating_sub(u64::from(b) + u64::from(t));
+        let along_x = nx.saturating_sub(u64::from(l) + u64::from(r));
+        self.edges
+            .all()
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| e.condition == EdgeCondition::Signorini)
+            .map(|(k, _)| if k < 2 { along_y } else { along_x })
+            .sum()
     }
 
     /// The parsed expressions: initial displacement and velocity, and the load (if any).

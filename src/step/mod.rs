@@ -7,6 +7,7 @@
 pub mod audit;
 pub mod block_pivot;
 pub mod exact;
+pub mod lcp;
 pub mod oracle;
 pub mod osqp;
 pub mod penalty;

@@ -127,9 +127,7 @@ pub fn identity_scenes() -> Vec<(String, PlaneScene)> {
 pub fn plane_of_bar(bar: &Scene, height: f64, ny: u64, y_grading: f64) -> Option<PlaneScene> {
     let edge = |c: Condition| match c {
         Condition::Free => Some(EdgeSpec::default()),
-        Condition::Clamped => Some(EdgeSpec {
-            condition: EdgeCondition::Clamped,
-        }),
+        Condition::Clamped => Some(EdgeSpec::plain(EdgeCondition::Clamped)),
         Condition::Signorini => None,
     };
     if bar.obstacle.is_some() {
