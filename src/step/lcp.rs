@@ -121,7 +121,7 @@ impl DenseLcp {
                     v -= l[i * a + k] * l[j * a + k];
                 }
                 if i == j {
-                    if !(v > 0.0) {
+                    if v.is_nan() || v <= 0.0 {
                         return Err(LcpError::NotPositiveDefinite {
                             index: self.index[i],
                         });
