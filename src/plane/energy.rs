@@ -1,11 +1,12 @@
 //! The discrete energy balance of a plane step, the bar's with `K` for `R`:
 //!
 //! ```text
-//!   E^{n+1/2} − E^{n−1/2} = ½ F^n·δ − α/(4Δt) |δ|²_K,   δ = u^{n+1} − u^{n−1},
+//!   E^{n+1/2} − E^{n−1/2} = ½ F^n·δ − α/(4Δt) |δ|²_K − ½ r^{n+1}·Eδ,   δ = u^{n+1} − u^{n−1},
 //!   E^{n+1/2} = ½ |(u^{n+1} − u^n)/Δt|²_M + ¼ (|u^{n+1}|²_K + |u^n|²_K),
 //! ```
 //!
-//! exact algebra (multiply the scheme by `δ/2`), so its residual is round-off only. The
+//! exact algebra (multiply the scheme by `δ/2`; the contact force is `−Eᵀr`,
+//! [`crate::plane::contact`]), so its residual is round-off only. The
 //! `K`-forms are evaluated cell by cell from the strains at the Gauss points, with nodal
 //! differences ([`StrainForms`]): the same sums as `uᵀKu` in exact arithmetic, but a rigid
 //! motion (a bending beam is locally one) adds no round-off, where `u·(Ku)` loses digits in
@@ -170,30 +171,34 @@ pub struct Balance {
     pub work: f64,
     /// `α/(4Δt) |δ|²_K`.
     pub viscous: f64,
-    /// `|E^{n+1/2} − E^{n−1/2} − work + viscous|` over the largest of those four terms.
+    /// `D = ½ r^{n+1}·Eδ >= 0`, the contact term.
+    pub contact: f64,
+    /// `|E^{n+1/2} − E^{n−1/2} − work + viscous + D|` over the largest of those five terms.
     pub residual: f64,
 }
 
 /// The balance of a step: `sums` of the step, `energy_before = E^{n−1/2}`,
-/// `potential_before = |u^n|²_K`.
+/// `potential_before = |u^n|²_K`, `contact` the contact term `D` (0 without contact).
 pub fn balance(
     sums: &StepSums,
     energy_before: f64,
     potential_before: f64,
     dt: f64,
     alpha: f64,
+    contact: f64,
 ) -> Balance {
     let energy = 0.5 * sums.kinetic / (dt * dt) + 0.25 * (sums.potential + potential_before);
     let viscous = alpha / (4.0 * dt) * sums.viscous;
     let work = 0.5 * sums.work;
-    let residual = energy - energy_before - work + viscous;
-    let scale = [energy, energy_before, work.abs(), viscous]
+    let residual = energy - energy_before - work + viscous + contact;
+    let scale = [energy, energy_before, work.abs(), viscous, contact.abs()]
         .into_iter()
         .fold(0.0, f64::max);
     Balance {
         energy,
         work,
         viscous,
+        contact,
         residual: if scale > 0.0 {
             residual.abs() / scale
         } else {

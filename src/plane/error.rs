@@ -11,6 +11,8 @@ pub enum PlaneError {
     Scene(#[from] SceneError),
     #[error("cannot factorise: {0}")]
     Factor(#[from] FactorError),
+    #[error("step {step}: the contact problem failed: {reason}")]
+    Contact { step: usize, reason: String },
     #[error("step {step} (t = {time}): the state is not finite")]
     NonFinite { step: usize, time: f64 },
     #[error("cannot write {path}: {source}")]

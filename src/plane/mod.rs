@@ -1,7 +1,8 @@
 //! The plane body: a Kelvin–Voigt body in plane strain on `(0, W) × (0, H)`, Q1 elements on a
 //! tensor grid graded in `y`, stepped by the bar's scheme with the consistent Q1 mass `M` and
 //! stiffness `K`; the step matrix is factorised once per run by a sparse Cholesky (faer, AMD).
-//! No contact yet (issue 20). With `λ = 0`, `μ = ½`, `ρ = 1` and data `(f(x), 0)` it reduces
+//! Edges may be Signorini (issue 21): each step's contact problem is condensed onto the
+//! contact normals and solved exactly ([`contact`]). With `λ = 0`, `μ = ½`, `ρ = 1` and data `(f(x), 0)` it reduces
 //! to the bar exactly (VERIFICATION.md, "Plane body").
 //!
 //! Imports [`crate::scene`] and [`crate::time`] (output helpers); placed above `time` because
@@ -24,6 +25,7 @@
 //! ```
 
 pub mod closed_form;
+pub mod contact;
 pub mod energy;
 pub mod error;
 pub mod factor;

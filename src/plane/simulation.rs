@@ -10,6 +10,7 @@
 //! ([`crate::plane::rhs`]), `C = M/Δt² + (½ + α/(2Δt)) K` factorised once per run
 //! ([`SparseCholesky`]), and measures the energy balance ([`crate::plane::energy`]).
 
+use crate::plane::contact::{Contact, ContactStep, normals};
 use crate::plane::energy::{Balance, StrainForms, balance, measure};
 use crate::plane::error::PlaneError;
 use crate::plane::factor::SparseCholesky;
@@ -153,12 +154,17 @@ pub struct PlaneRecord {
     pub viscous_dissipation: f64,
     /// The identity's relative residual (0 for the start-up step, which has no `E^{−1/2}`).
     pub identity_residual: f64,
+    /// The contact figures (all 0 without Signorini edges; the start-up step's dissipation
+    /// is 0, it has no `u^{−1}`).
+    pub contact: ContactStep,
 }
 
 /// A running plane simulation; [`PlaneSimulation::step`] allocates nothing.
 pub struct PlaneSimulation {
     disc: PlaneDiscretisation,
     chol: SparseCholesky,
+    /// The Signorini edges' exact contact solver (`None` without contact normals).
+    contact: Option<Contact>,
     load: LoadTerm,
     n: usize,
     /// `u^n`, `w = u^n − u^{n−1}` on the unknowns.
@@ -182,6 +188,7 @@ impl PlaneSimulation {
     pub fn new(scene: &PlaneScene) -> Result<Self, PlaneError> {
         scene.validate()?;
         let exprs = scene.expressions()?;
+        let gaps = scene.edges.gaps()?;
         let disc = PlaneDiscretisation::new(scene);
         let grid = &disc.grid;
         let nodal = |e: &[Expression; 2], t: f64, out: &mut [f64]| -> Result<(), PlaneError> {
@@ -202,6 +209,7 @@ impl PlaneSimulation {
                 (u0_full[d], v0_full[d]) = (0.0, 0.0);
             }
         }
+        let normals = normals(&disc, &gaps, &u0_full)?;
         let n = disc.unknowns();
         let mut force = vec![0.0; n];
         let load = match exprs.load {
@@ -238,10 +246,33 @@ impl PlaneSimulation {
         let mut acc: Vec<f64> = (0..n).map(|i| force[i] - ku[i] - alpha * kv[i]).collect();
         let mut chol = SparseCholesky::new(&disc.pattern, &disc.mass, "M")?;
         chol.solve_in_place(&mut acc);
-        chol.factor(&disc.pattern, &disc.step_matrix(), "C")?;
-        let z: Vec<f64> = (0..n)
+        let c = disc.step_matrix();
+        chol.factor(&disc.pattern, &c, "C")?;
+        let mut z: Vec<f64> = (0..n)
             .map(|i| dt * v0[i] + 0.5 * dt * dt * acc[i])
             .collect();
+        // With contact, the Taylor step is projected onto the admissible set in the C-norm
+        // (the step problem with b = C z_T), as the bar's start-up does.
+        let mut contact_step = ContactStep::default();
+        let contact = if normals.is_empty() {
+            None
+        } else {
+            let mut contact = Contact::new(normals, &mut chol)?;
+            let (iterations, touching) = contact.solve(&u0, &z, 1)?;
+            if touching {
+                let mut b = vec![0.0; n];
+                disc.pattern.mul_into(&c, &z, &mut b);
+                contact.subtract_reactions(&mut b);
+                chol.solve_in_place(&mut b);
+                z = b;
+            }
+            let u1: Vec<f64> = u0.iter().zip(&z).map(|(a, b)| a + b).collect();
+            contact_step = ContactStep {
+                dissipation: 0.0,
+                ..contact.measure(&u1, &z, &vec![0.0; n], iterations)
+            };
+            Some(contact)
+        };
         let u: Vec<f64> = u0.iter().zip(&z).map(|(a, b)| a + b).collect();
         let potential0 = disc.forms.quad(&u0);
         let potential = disc.forms.quad(&u);
@@ -254,10 +285,12 @@ impl PlaneSimulation {
             step: 1,
             time: dt,
             energy,
+            contact: contact_step,
             ..Default::default()
         };
         Ok(Self {
             chol,
+            contact,
             load,
             n: 1,
             u,
@@ -305,9 +338,25 @@ impl PlaneSimulation {
         rhs_into(&terms, &self.u, &self.w, &self.force, &mut self.rhs);
         self.z.copy_from_slice(&self.rhs);
         self.chol.solve_in_place(&mut self.z);
+        let mut iterations = 0;
+        if let Some(contact) = &mut self.contact {
+            let touching;
+            (iterations, touching) = contact.solve(&self.u, &self.z, n + 1)?;
+            if touching {
+                // z from C z = b − Eᵀ r directly (backward stable).
+                self.z.copy_from_slice(&self.rhs);
+                contact.subtract_reactions(&mut self.z);
+                self.chol.solve_in_place(&mut self.z);
+            }
+        }
         for (u, z) in self.u.iter_mut().zip(&self.z) {
             *u += z;
         }
+        let contact = self
+            .contact
+            .as_ref()
+            .map(|c| c.measure(&self.u, &self.z, &self.w, iterations))
+            .unwrap_or_default();
         let sums = measure(
             &d.pattern,
             &d.mass,
@@ -322,7 +371,15 @@ impl PlaneSimulation {
             work,
             viscous,
             residual,
-        } = balance(&sums, self.energy, self.potential, d.dt, d.alpha);
+            ..
+        } = balance(
+            &sums,
+            self.energy,
+            self.potential,
+            d.dt,
+            d.alpha,
+            contact.dissipation,
+        );
         let time = (n + 1) as f64 * d.dt;
         if !(energy.is_finite() && residual.is_finite()) {
             return Err(PlaneError::NonFinite { step: n + 1, time });
@@ -338,7 +395,13 @@ impl PlaneSimulation {
             work,
             viscous_dissipation: viscous,
             identity_residual: residual,
+            contact,
         })
+    }
+
+    /// The contact solver (`None` without Signorini edges): normals, `S`, last reactions.
+    pub fn contact(&self) -> Option<&Contact> {
+        self.contact.as_ref()
     }
 
     /// The record of the start-up step.

@@ -14,6 +14,7 @@ use crate::scene::plane::{
     Body, EdgeCondition, EdgeSpec, Edges, PLANE_BUILTIN, PlaneInitial, PlaneLoad, PlaneMesh,
     PlaneOutput, PlaneScene, Vector, plane_builtin_text,
 };
+use crate::scene::schema::number_text;
 use crate::scene::{Condition, Scene};
 use crate::study::converge::ConvergeError;
 use crate::time::{RunError, Simulation};
@@ -122,12 +123,15 @@ pub fn identity_scenes() -> Vec<(String, PlaneScene)> {
 
 /// The plane scene of a bar scene: `λ = 0`, `μ = ½`, `ρ = 1`, data `(f, 0)`, the bar's end
 /// conditions on the left and right edges (free or clamped), free top and bottom, `ny` rows
-/// graded by `y_grading`. `None` for a bar with a Signorini end or an obstacle (no contact on
-/// the plane yet).
+/// graded by `y_grading`; a Signorini left end `u(0) >= −a` becomes the left edge's
+/// `−ux <= a` (outward normal `−x`: the same bound). `None` for a bar whose right end is
+/// Signorini (the bar's lower bound there is not an edge obstacle of the plane) or with an
+/// obstacle under every node.
 pub fn plane_of_bar(bar: &Scene, height: f64, ny: u64, y_grading: f64) -> Option<PlaneScene> {
-    let edge = |c: Condition| match c {
+    let edge = |c: Condition, gap: Option<f64>, left: bool| match c {
         Condition::Free => Some(EdgeSpec::default()),
         Condition::Clamped => Some(EdgeSpec::plain(EdgeCondition::Clamped)),
+        Condition::Signorini if left => Some(EdgeSpec::signorini(&number_text(gap?))),
         Condition::Signorini => None,
     };
     if bar.obstacle.is_some() {
@@ -145,8 +149,8 @@ pub fn plane_of_bar(bar: &Scene, height: f64, ny: u64, y_grading: f64) -> Option
             viscosity: bar.bar.viscosity,
         },
         edges: Edges {
-            left: edge(bar.left.condition)?,
-            right: edge(bar.right.condition)?,
+            left: edge(bar.left.condition, bar.left.gap, true)?,
+            right: edge(bar.right.condition, bar.right.gap, false)?,
             bottom: EdgeSpec::default(),
             top: EdgeSpec::default(),
         },
@@ -193,13 +197,18 @@ end = 3.0
 pub const BAR_CASE_BODY: (f64, u64, f64) = (0.3, 3, 4.0);
 
 /// The bar special case: over every step, `max |ux(x_i, y_j) − u_i|`, `max |uy|` and the bar's
-/// `max |u|`.
+/// `max |u|`; with a Signorini left end, `max_k |r_k − ω_k r_bar|` over the left edge's nodes
+/// (`ω_k` the node's trapezoid share of the edge) and the bar's `max r`.
 #[derive(Clone, Copy, Debug)]
 pub struct BarCase {
     pub steps: usize,
     pub max_ux_deviation: f64,
     pub max_uy: f64,
     pub max_u: f64,
+    pub max_reaction_deviation: f64,
+    pub max_reaction: f64,
+    /// Steps with the bar in contact (`r > 0`).
+    pub contact_steps: usize,
 }
 
 /// Runs `bar` and its plane counterpart ([`plane_of_bar`], [`BAR_CASE_BODY`]) step by step.
@@ -215,8 +224,20 @@ pub fn bar_case(bar: &Scene) -> Result<BarCase, ConvergeError> {
         max_ux_deviation: 0.0,
         max_uy: 0.0,
         max_u: 0.0,
+        max_reaction_deviation: 0.0,
+        max_reaction: 0.0,
+        contact_steps: 0,
     };
     let compare = |b: &Simulation, p: &PlaneSimulation, out: &mut BarCase| {
+        if let Some(c) = p.contact() {
+            let rb = b.reactions()[0];
+            out.max_reaction = out.max_reaction.max(rb);
+            out.contact_steps += usize::from(rb > 0.0);
+            for (nk, r) in c.normals.iter().zip(c.reactions()) {
+                let d = (r - nk.weight * rb).abs();
+                out.max_reaction_deviation = out.max_reaction_deviation.max(d);
+            }
+        }
         let (ub, up) = (b.displacement(), p.displacement());
         assert_eq!(ub.len(), grid.nx + 1, "one plane column per bar node");
         for node in 0..grid.nodes() {
@@ -240,6 +261,38 @@ pub fn bar_case_scenes() -> Vec<(&'static str, Scene)> {
     let (_, modal) = crate::scene::load("modal", &[]).expect("built-in");
     let clamped = Scene::from_toml(CLAMPED_BAR, &[]).expect("valid");
     vec![("modal", modal), ("clamped", clamped)]
+}
+
+/// A viscous bar pushed by a load onto an obstacle at its left end, free at its right: the
+/// contact bar of the special case beside the built-in `impact` (elastic, no load). It
+/// arrives with speed 0.5 at the obstacle 0.05 away, is held there by the load and leaves
+/// when the load turns.
+pub const CONTACT_BAR: &str = r#"
+[bar]
+length = 1.0
+viscosity = 0.05
+[left]
+condition = "signorini"
+gap = 0.05
+[right]
+condition = "free"
+[initial]
+displacement = "0"
+velocity = "-0.5"
+[load]
+density = "-0.6*cos(1.5*t)*(1 - x/2)"
+[mesh]
+elements = 50
+[time]
+step = 0.01
+end = 4.0
+"#;
+
+/// The bars with contact of the special case: `impact` and [`CONTACT_BAR`].
+pub fn bar_contact_case_scenes() -> Vec<(&'static str, Scene)> {
+    let (_, impact) = crate::scene::load("impact", &[]).expect("built-in");
+    let loaded = Scene::from_toml(CONTACT_BAR, &[]).expect("valid");
+    vec![("impact", impact), ("loaded-contact", loaded)]
 }
 
 /// Cells along x of the manufactured levels (`nx × nx/2` cells, `Δt = h/2`).

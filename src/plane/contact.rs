@@ -1,0 +1,269 @@
+//! Signorini contact on the plane body's edges, solved exactly by condensation.
+//!
+//! Each node of a Signorini edge that is not clamped carries one contact normal `k`: the
+//! unknown `i_k` of the component normal to the edge and the sign `σ_k` of the outward normal
+//! (`n = σ_k e_c`), so `u·n = σ_k u_{i_k}` and `E` (`m × n`, row `k` = `σ_k e_{i_k}ᵀ`) selects
+//! components with sign. A corner shared by two Signorini edges has two normals, one per
+//! component (each wall holds its own component; they never compete). A clamped node carries
+//! none (`u = 0` there, admissible when `g >= 0`, checked at set-up).
+//!
+//! The step problem, in the increment `z = u^{n+1} − u^n`:
+//!
+//! ```text
+//!   C z = b − Eᵀ r,   h − E z >= 0,   r >= 0,   rᵀ(h − E z) = 0,   h = g − E u^n.
+//! ```
+//!
+//! With `z⁰ = C⁻¹ b`, `z = z⁰ − C⁻¹ Eᵀ r` and the gap `w = h − E z = S r + q`, `S = E C⁻¹ Eᵀ`
+//! (SPD: `E` has full row rank), `q = h − E z⁰`: the LCP of [`crate::step::lcp`]. `S` is formed
+//! once per run by solves with the factor of `C` on blocks of unit columns
+//! ([`SparseCholesky::solve_columns_in_place`]). Each step: `z⁰` (one solve), the LCP, and,
+//! when some `r_k > 0`, `z` again from `C z = b − Eᵀ r` (a second solve: backward stable,
+//! where `z⁰ − C⁻¹Eᵀr` would cancel digits when contact stops a fast body).
+//!
+//! Energy: the scheme times `δ/2`, `δ = u^{n+1} − u^{n−1}`, gains the contact term
+//! `−½ r·Eδ = −D`, and `D = ½ Σ_k r_k (g_k − σ_k u^{n−1}_{i_k}) >= 0` by complementarity and
+//! the admissibility of `u^{n−1}`: contact only dissipates.
+
+use crate::plane::error::PlaneError;
+use crate::plane::factor::SparseCholesky;
+use crate::plane::simulation::PlaneDiscretisation;
+use crate::scene::SceneError;
+use crate::scene::expr::Expression;
+use crate::scene::plane::EDGE_NAMES;
+use crate::step::lcp::DenseLcp;
+
+/// Largest block of unit columns solved at once when forming `S`, in doubles (`n · block`):
+/// 32 MiB of right-hand sides, so that the set-up stays within the run's memory budget.
+const S_BLOCK_DOUBLES: usize = 1 << 22;
+
+/// One contact normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Normal {
+    /// 0 left, 1 right, 2 bottom, 3 top ([`EDGE_NAMES`]).
+    pub edge: usize,
+    /// The mesh node.
+    pub node: usize,
+    /// The unknown of the normal component.
+    pub unknown: usize,
+    /// `σ = ±1`: `n = σ e_c`.
+    pub sign: f64,
+    /// The edge coordinate `s` of the node.
+    pub s: f64,
+    /// `g(s)`.
+    pub gap: f64,
+    /// The node's trapezoid share of the edge, `∫ ψ ds` (half of each adjacent segment).
+    pub weight: f64,
+}
+
+/// The contact normals of a discretisation and gaps; `u0_full` the initial displacement at
+/// every degree of freedom. Errors: a non-finite gap, a negative gap at a clamped node, an
+/// initial displacement beyond the obstacle (bad input, naming the field).
+pub fn normals(
+    disc: &PlaneDiscretisation,
+    gaps: &[Option<Expression>; 4],
+    u0_full: &[f64],
+) -> Result<Vec<Normal>, SceneError> {
+    let g = &disc.grid;
+    let mut out = Vec::new();
+    for (edge, expr) in gaps.iter().enumerate() {
+        let Some(expr) = expr else { continue };
+        let along_y = edge < 2;
+        let count = if along_y { g.ny + 1 } else { g.nx + 1 };
+        let coords: &[f64] = if along_y { &g.ys } else { &g.xs };
+        for k in 0..count {
+            let node = match edge {
+                0 => g.node(0, k),
+                1 => g.node(g.nx, k),
+                2 => g.node(k, 0),
+                _ => g.node(k, g.ny),
+            };
+            let c = usize::from(!along_y);
+            let sign = if edge % 2 == 0 { -1.0 } else { 1.0 };
+            let s = coords[k];
+            let gap = expr.eval(s, 0.0)?;
+            let field = format!("edges.{}.gap", EDGE_NAMES[edge]);
+            let Some(unknown) = disc.index[2 * node + c] else {
+                if gap < 0.0 {
+                    return Err(SceneError::Invalid {
+                        field,
+                        value: format!("{gap} at s = {s}"),
+                        allowed: "a clamped node (u = 0) of a Signorini edge needs a gap >= 0"
+                            .into(),
+                    });
+                }
+                continue;
+            };
+            let un = sign * u0_full[2 * node + c];
+            if un > gap {
+                return Err(SceneError::Invalid {
+                    field: "initial.displacement".into(),
+                    value: format!("u·n = {un} at node {node} (s = {s})"),
+                    allowed: format!(
+                        "the initial state must be admissible: u·n <= {gap} (`{field}`)"
+                    ),
+                });
+            }
+            let lo = if k > 0 { coords[k] - coords[k - 1] } else { 0.0 };
+            let hi = if k + 1 < count {
+                coords[k + 1] - coords[k]
+            } else {
+                0.0
+            };
+            out.push(Normal {
+                edge,
+                node,
+                unknown,
+                sign,
+                s,
+                gap,
+                weight: 0.5 * (lo + hi),
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// `S = E C⁻¹ Eᵀ` (row-major, symmetrised bitwise), from blocks of unit columns solved with
+/// the factor of `C`.
+pub fn condensed_matrix(normals: &[Normal], chol: &mut SparseCholesky) -> Vec<f64> {
+    let (m, n) = (normals.len(), chol.dim());
+    let mut s = vec![0.0; m * m];
+    let block = (S_BLOCK_DOUBLES / n.max(1)).clamp(1, m.max(1));
+    let mut x = vec![0.0; n * block];
+    for start in (0..m).step_by(block) {
+        let cols = block.min(m - start);
+        let x = &mut x[..n * cols];
+        x.fill(0.0);
+        for c in 0..cols {
+            let nk = &normals[start + c];
+            x[c * n + nk.unknown] = nk.sign;
+        }
+        chol.solve_columns_in_place(x, cols);
+        for c in 0..cols {
+            for (j, nj) in normals.iter().enumerate() {
+                s[j * m + start + c] = nj.sign * x[c * n + nj.unknown];
+            }
+        }
+    }
+    for j in 0..m {
+        for k in 0..j {
+            let v = 0.5 * (s[j * m + k] + s[k * m + j]);
+            s[j * m + k] = v;
+            s[k * m + j] = v;
+        }
+    }
+    s
+}
+
+/// The contact state of one step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactStep {
+    /// `D = ½ r·E(u^{n+1} − u^{n−1})`.
+    pub dissipation: f64,
+    /// Normals with `r_k > 0`.
+    pub active: usize,
+    /// `Σ_k r_k`.
+    pub total_reaction: f64,
+    /// `max_k max(0, −gap_k)`, `gap_k = g_k − σ_k u^{n+1}_{i_k}`.
+    pub penetration: f64,
+    /// `max_k |r_k gap_k|`.
+    pub complementarity: f64,
+    /// `max_k max(|g_k|, |u^{n+1}·n|)`: the scale of the gaps' round-off.
+    pub gap_scale: f64,
+    /// Active sets tried by the LCP solver.
+    pub iterations: u32,
+}
+
+/// The exact contact solver of a run: the normals, `S` with its LCP solver, and work space.
+pub struct Contact {
+    pub normals: Vec<Normal>,
+    lcp: DenseLcp,
+    q: Vec<f64>,
+    r: Vec<f64>,
+    w: Vec<f64>,
+}
+
+impl Contact {
+    /// Forms `S` and its LCP solver.
+    pub fn new(normals: Vec<Normal>, chol: &mut SparseCholesky) -> Result<Self, PlaneError> {
+        let m = normals.len();
+        let s = condensed_matrix(&normals, chol);
+        let lcp = DenseLcp::new(s, m).map_err(|e| PlaneError::Contact {
+            step: 0,
+            reason: e.to_string(),
+        })?;
+        Ok(Self {
+            normals,
+            lcp,
+            q: vec![0.0; m],
+            r: vec![0.0; m],
+            w: vec![0.0; m],
+        })
+    }
+
+    /// `m`.
+    pub fn len(&self) -> usize {
+        self.normals.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.normals.is_empty()
+    }
+
+    /// `S_jk`.
+    pub fn s(&self, j: usize, k: usize) -> f64 {
+        self.lcp.entry(j, k)
+    }
+
+    /// The reactions `r_k` of the last step.
+    pub fn reactions(&self) -> &[f64] {
+        &self.r
+    }
+
+    /// Solves the step's LCP for the unconstrained increment `z0` at the state `u = u^n`;
+    /// writes the reactions and, when any is positive, returns true (the caller then solves
+    /// `C z = b − Eᵀ r`, see [`Contact::subtract_reactions`]). Allocates nothing.
+    pub fn solve(&mut self, u: &[f64], z0: &[f64], step: usize) -> Result<(u32, bool), PlaneError> {
+        for (q, nk) in self.q.iter_mut().zip(&self.normals) {
+            *q = nk.gap - nk.sign * (u[nk.unknown] + z0[nk.unknown]);
+        }
+        let iterations = self
+            .lcp
+            .solve(&self.q, &mut self.r, &mut self.w)
+            .map_err(|e| PlaneError::Contact {
+                step,
+                reason: e.to_string(),
+            })?;
+        Ok((iterations, self.r.iter().any(|&r| r > 0.0)))
+    }
+
+    /// `b ← b − Eᵀ r`.
+    pub fn subtract_reactions(&self, b: &mut [f64]) {
+        for (nk, r) in self.normals.iter().zip(&self.r) {
+            b[nk.unknown] -= nk.sign * r;
+        }
+    }
+
+    /// The step's contact figures, after `u = u^{n+1}`, with `delta = u^{n+1} − u^{n−1}`
+    /// given as `z + w` (the two increments).
+    pub fn measure(&self, u: &[f64], z: &[f64], w: &[f64], iterations: u32) -> ContactStep {
+        let mut out = ContactStep {
+            iterations,
+            ..Default::default()
+        };
+        let mut dissipation = 0.0;
+        for (nk, &r) in self.normals.iter().zip(&self.r) {
+            let i = nk.unknown;
+            let un = nk.sign * u[i];
+            let gap = nk.gap - un;
+            dissipation += r * nk.sign * (z[i] + w[i]);
+            out.penetration = out.penetration.max(-gap);
+            out.complementarity = out.complementarity.max((r * gap).abs());
+            out.gap_scale = out.gap_scale.max(nk.gap.abs()).max(un.abs());
+            out.total_reaction += r;
+            out.active += usize::from(r > 0.0);
+        }
+        out.dissipation = 0.5 * dissipation;
+        out
+    }
+}
