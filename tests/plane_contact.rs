@@ -2,7 +2,8 @@
 //! special case, and the contact conditions and energy identity at every node and step of
 //! every built-in plane scene. Run in release.
 
-use viscobar::study::plane_checks::{bar_case, bar_contact_case_scenes};
+use viscobar::plane::run::run_plane_in_memory;
+use viscobar::study::plane_checks::{bar_case, bar_contact_case_scenes, identity_scenes};
 
 /// The bar with contact as a special case: the same equations and the same complementarity
 /// problem (the plane's LCP on the edge's `ny + 1` normals has the bar's solution times the
@@ -27,4 +28,50 @@ fn the_bar_with_contact_is_an_exact_special_case_of_the_plane_body() {
             c.max_reaction_deviation
         );
     }
+}
+
+/// The bar's `IDENTITY_TOL`: the identity with the contact term is exact algebra (the scheme
+/// times `δ/2`), only round-off remains, relative to the largest of its terms.
+const IDENTITY_TOL: f64 = 1e-12;
+/// No penetration and complementarity beyond round-off: a gap `g − u·n` at an active node is
+/// the rounding of `u` from a backward-stable solve, a few ulps of the gaps' scale times the
+/// growth of the solve; 1e-12 of that scale leaves a margin over the measured values
+/// (VERIFICATION.md, "Plane contact").
+const GAP_TOL: f64 = 1e-12;
+
+#[test]
+fn contact_conditions_and_energy_identity_hold_at_every_node_and_step_of_every_plane_scene() {
+    let mut with_contact = 0;
+    for (name, scene) in identity_scenes() {
+        let (records, summary, sim) = run_plane_in_memory(&name, &scene).unwrap();
+        if sim.contact().is_none() {
+            continue;
+        }
+        with_contact += 1;
+        assert!(records.iter().any(|r| r.contact.active > 0), "{name}: no contact");
+        assert!(
+            records.iter().any(|r| r.contact.active > 0)
+                && records.last().unwrap().contact.active < records.iter().map(|r| r.contact.active).max().unwrap(),
+            "{name}: the contact set never shrinks"
+        );
+        for r in &records {
+            let c = &r.contact;
+            assert!(c.penetration <= GAP_TOL * c.gap_scale, "{name} step {}: penetration {:e}", r.step, c.penetration);
+            assert!(
+                c.complementarity <= GAP_TOL * c.gap_scale * c.total_reaction,
+                "{name} step {}: r·gap {:e}",
+                r.step,
+                c.complementarity
+            );
+            assert!(r.contact.dissipation >= -GAP_TOL * r.energy, "{name} step {}", r.step);
+        }
+        for r in &records[1..] {
+            assert!(r.identity_residual <= IDENTITY_TOL, "{name} step {}: {:e}", r.step, r.identity_residual);
+        }
+        assert!(summary.max_identity_residual <= IDENTITY_TOL);
+        // The contact term is part of the balance: dropping it breaks the identity.
+        let big = records.iter().map(|r| r.contact.dissipation).fold(0.0, f64::max);
+        assert!(big > 1e3 * IDENTITY_TOL * records[0].energy, "{name}: contact dissipates nothing");
+    }
+    assert!(with_contact >= 2);
 }

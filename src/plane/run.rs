@@ -41,6 +41,29 @@ pub struct PlaneSummary {
     /// Largest `E^{n+1/2} − E^{n−1/2}` over `E^{1/2}`; `null` with a load.
     pub max_energy_rise: Option<f64>,
     pub max_identity_residual: f64,
+    /// With Signorini edges only: the contact figures over all steps.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact: Option<ContactSummary>,
+}
+
+/// The contact figures of a plane run with Signorini edges.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct ContactSummary {
+    /// `m`, the contact normals.
+    pub normals: usize,
+    /// Largest number of normals in contact (`r > 0`) at one step.
+    pub max_active: usize,
+    /// Steps with some normal in contact.
+    pub contact_steps: usize,
+    /// `Σ_n D^n`, the energy the contact took.
+    pub dissipation: f64,
+    /// Largest `max(0, −gap)` and `|r · gap|`, each over its step's gap scale
+    /// (`max(|g|, |u·n|)`): round-off.
+    pub max_penetration: f64,
+    pub max_complementarity: f64,
+    /// `mean` and `max` of the LCP solver's active sets tried per step.
+    pub iterations_mean: f64,
+    pub iterations_max: u32,
 }
 
 /// Collects the summary's figures over the records.
@@ -50,6 +73,9 @@ struct Tracker {
     max_rise: f64,
     max_residual: f64,
     forced: bool,
+    contact: Option<ContactSummary>,
+    iterations: u64,
+    records: u64,
 }
 
 impl Tracker {
@@ -60,10 +86,43 @@ impl Tracker {
             max_rise: f64::NEG_INFINITY,
             max_residual: 0.0,
             forced,
+            contact: None,
+            iterations: 0,
+            records: 0,
+        }
+    }
+
+    fn with_contact(mut self, sim: &PlaneSimulation) -> Self {
+        if let Some(c) = sim.contact() {
+            self.contact = Some(ContactSummary {
+                normals: c.len(),
+                ..Default::default()
+            });
+            self.observe_contact(&sim.first_record());
+        }
+        self
+    }
+
+    fn observe_contact(&mut self, r: &PlaneRecord) {
+        if let Some(s) = &mut self.contact {
+            let c = &r.contact;
+            s.max_active = s.max_active.max(c.active);
+            s.contact_steps += usize::from(c.active > 0);
+            s.dissipation += c.dissipation;
+            if c.gap_scale > 0.0 {
+                s.max_penetration = s.max_penetration.max(c.penetration / c.gap_scale);
+                s.max_complementarity = s
+                    .max_complementarity
+                    .max(c.complementarity / c.gap_scale);
+            }
+            s.iterations_max = s.iterations_max.max(c.iterations);
+            self.iterations += u64::from(c.iterations);
+            self.records += 1;
         }
     }
 
     fn observe(&mut self, r: &PlaneRecord) {
+        self.observe_contact(r);
         self.max_rise = self.max_rise.max(r.energy - self.last_energy);
         self.max_residual = self.max_residual.max(r.identity_residual);
         self.last_energy = r.energy;
@@ -93,6 +152,10 @@ impl Tracker {
             energy_final: self.last_energy,
             max_energy_rise: (!self.forced).then_some(rise),
             max_identity_residual: self.max_residual,
+            contact: self.contact.map(|mut c| {
+                c.iterations_mean = self.iterations as f64 / self.records.max(1) as f64;
+                c
+            }),
         }
     }
 }
@@ -113,7 +176,7 @@ pub fn run_plane_in_memory(
 ) -> Result<(Vec<PlaneRecord>, PlaneSummary, PlaneSimulation), PlaneError> {
     let start = Instant::now();
     let mut sim = PlaneSimulation::new(scene)?;
-    let mut tracker = Tracker::new(&sim.first_record(), forced(scene));
+    let mut tracker = Tracker::new(&sim.first_record(), forced(scene)).with_contact(&sim);
     let mut records = vec![sim.first_record()];
     for _ in 1..scene.steps() {
         let r = sim.step()?;
@@ -163,14 +226,16 @@ fn write_run(
     };
     let (hist_path, mut hist) = open("history.csv")?;
     let (disp_path, mut disp) = open("displacement.csv")?;
+    let contact = sim.contact().is_some();
     writeln!(
         hist,
-        "step,t,energy,work,viscous_dissipation,identity_residual"
+        "step,t,energy,work,viscous_dissipation,identity_residual{}",
+        if contact { CONTACT_COLUMNS } else { "" }
     )
     .map_err(io(&hist_path))?;
     let first = sim.first_record();
-    write_history_row(&mut hist, &first).map_err(io(&hist_path))?;
-    let mut tracker = Tracker::new(&first, forced(scene));
+    write_history_row(&mut hist, &first, contact).map_err(io(&hist_path))?;
+    let mut tracker = Tracker::new(&first, forced(scene)).with_contact(&sim);
 
     let grid = sim.discretisation().grid.clone();
     // Coordinates rounded once per run, as the bar's x.
@@ -196,7 +261,7 @@ fn write_run(
     for _ in 1..steps {
         let r = sim.step()?;
         tracker.observe(&r);
-        write_history_row(&mut hist, &r).map_err(io(&hist_path))?;
+        write_history_row(&mut hist, &r, contact).map_err(io(&hist_path))?;
         if keep(r.step) {
             sim.displacement_into(&mut u);
             sim.velocity_into(&mut v);
@@ -212,8 +277,13 @@ fn write_run(
     Ok(summary)
 }
 
-fn write_history_row(w: &mut impl Write, r: &PlaneRecord) -> std::io::Result<()> {
-    writeln!(
+/// The history's columns of a run with Signorini edges: the contact term `D` of the energy
+/// identity, normals in contact, `Σ r`, the largest penetration, the LCP's active sets tried.
+pub const CONTACT_COLUMNS: &str =
+    ",contact_dissipation,contact_normals,total_reaction,max_penetration,iterations";
+
+fn write_history_row(w: &mut impl Write, r: &PlaneRecord, contact: bool) -> std::io::Result<()> {
+    write!(
         w,
         "{},{},{},{},{},{}",
         r.step,
@@ -222,7 +292,16 @@ fn write_history_row(w: &mut impl Write, r: &PlaneRecord) -> std::io::Result<()>
         r.work,
         r.viscous_dissipation,
         r.identity_residual
-    )
+    )?;
+    if contact {
+        let c = &r.contact;
+        write!(
+            w,
+            ",{},{},{},{},{}",
+            c.dissipation, c.active, c.total_reaction, c.penetration, c.iterations
+        )?;
+    }
+    writeln!(w)
 }
 
 /// One row a node: `t,x,y,ux,uy,vx,vy`.

@@ -157,7 +157,8 @@ impl Edges {
                     return Err(SceneError::Invalid {
                         field,
                         value: "absent".into(),
-                        allowed: "a Signorini edge needs its gap: a number or an expression in s"
+                        allowed: "an edge with condition = \"signorini\" needs its gap: a number or \
+                                  an expression in s"
                             .into(),
                     });
                 }

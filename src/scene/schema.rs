@@ -507,6 +507,14 @@ pub const PLANE_BUILTIN: &[(&str, &str)] = &[
         "plane-cantilever",
         include_str!("../../scenes/plane-cantilever.toml"),
     ),
+    (
+        "plane-tilted-drop",
+        include_str!("../../scenes/plane-tilted-drop.toml"),
+    ),
+    (
+        "plane-curved-obstacle",
+        include_str!("../../scenes/plane-curved-obstacle.toml"),
+    ),
 ];
 
 /// The TOML text of a built-in plane scene.
