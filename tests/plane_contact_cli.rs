@@ -58,7 +58,7 @@ const CASES: &[(&str, &[&str], &str)] = &[
     ),
     (
         "gap not finite on the edge",
-        &["edges.bottom={condition=\"signorini\", gap=\"1/(s-1)\"}"],
+        &["edges.bottom={condition=\"signorini\", gap=\"1/(s-1)^2\"}"],
         "edges.bottom.gap",
     ),
     (

@@ -30,7 +30,35 @@ use crate::plane::simulation::PlaneDiscretisation;
 use crate::scene::SceneError;
 use crate::scene::expr::Expression;
 use crate::scene::plane::EDGE_NAMES;
+use crate::plane::matrices::Pattern;
+use crate::plane::osqp::PlaneOsqp;
 use crate::step::lcp::DenseLcp;
+use crate::step::osqp::OsqpSettings;
+use crate::step::report::AuditReport;
+
+/// How the contact problem of a step is solved.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum ContactMethod {
+    /// Condensation and the exact LCP solver (this module).
+    #[default]
+    Exact,
+    /// Normal compliance `ε r_k = max(0, u·n − g)`: the LCP on `S + εI` (`w + ε r >= 0 ⊥
+    /// r >= 0` is that law), solved exactly.
+    Penalty { epsilon: f64 },
+    /// OSQP on the full sparse QP, audited ([`crate::plane::osqp`]).
+    Osqp(OsqpSettings),
+}
+
+impl ContactMethod {
+    /// `exact`, `penalty`, `osqp`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            ContactMethod::Exact => "exact",
+            ContactMethod::Penalty { .. } => "penalty",
+            ContactMethod::Osqp(_) => "osqp",
+        }
+    }
+}
 
 /// Largest block of unit columns solved at once when forming `S`, in doubles (`n · block`):
 /// 32 MiB of right-hand sides, so that the set-up stays within the run's memory budget.
@@ -174,27 +202,55 @@ pub struct ContactStep {
     pub iterations: u32,
 }
 
-/// The exact contact solver of a run: the normals, `S` with its LCP solver, and work space.
+/// The contact solver of a run: the normals, `S` with its LCP solver (exact, penalty) or OSQP,
+/// and work space.
 pub struct Contact {
     pub normals: Vec<Normal>,
-    lcp: DenseLcp,
+    method: ContactMethod,
+    lcp: Option<DenseLcp>,
+    osqp: Option<Box<PlaneOsqp>>,
     q: Vec<f64>,
     r: Vec<f64>,
     w: Vec<f64>,
 }
 
 impl Contact {
-    /// Forms `S` and its LCP solver.
-    pub fn new(normals: Vec<Normal>, chol: &mut SparseCholesky) -> Result<Self, PlaneError> {
+    /// Forms `S` and its LCP solver (exact, penalty: `S + εI`) or sets OSQP up (`c` the values
+    /// of `C` on `pattern`, factorised in `chol`).
+    pub fn new(
+        normals: Vec<Normal>,
+        chol: &mut SparseCholesky,
+        method: ContactMethod,
+        pattern: &Pattern,
+        c: &[f64],
+    ) -> Result<Self, PlaneError> {
         let m = normals.len();
-        let s = condensed_matrix(&normals, chol);
-        let lcp = DenseLcp::new(s, m).map_err(|e| PlaneError::Contact {
-            step: 0,
-            reason: e.to_string(),
-        })?;
+        let setup = |reason: String| PlaneError::Contact { step: 0, reason };
+        let (mut lcp, mut osqp) = (None, None);
+        match method {
+            ContactMethod::Exact | ContactMethod::Penalty { .. } => {
+                let mut s = condensed_matrix(&normals, chol);
+                if let ContactMethod::Penalty { epsilon } = method {
+                    if !(epsilon.is_finite() && epsilon > 0.0) {
+                        return Err(setup(format!("penalty epsilon {epsilon} must be > 0")));
+                    }
+                    for k in 0..m {
+                        s[k * m + k] += epsilon;
+                    }
+                }
+                lcp = Some(DenseLcp::new(s, m).map_err(|e| setup(e.to_string()))?);
+            }
+            ContactMethod::Osqp(settings) => {
+                osqp = Some(Box::new(
+                    PlaneOsqp::new(pattern, c, &normals, chol, settings).map_err(setup)?,
+                ));
+            }
+        }
         Ok(Self {
             normals,
+            method,
             lcp,
+            osqp,
             q: vec![0.0; m],
             r: vec![0.0; m],
             w: vec![0.0; m],
@@ -210,9 +266,50 @@ impl Contact {
         self.normals.is_empty()
     }
 
-    /// `S_jk`.
-    pub fn s(&self, j: usize, k: usize) -> f64 {
-        self.lcp.entry(j, k)
+    pub fn method(&self) -> ContactMethod {
+        self.method
+    }
+
+    /// `S_jk` (`S + εI` for the penalty; `None` with OSQP, which does not form it).
+    pub fn s(&self, j: usize, k: usize) -> Option<f64> {
+        self.lcp.as_ref().map(|l| l.entry(j, k))
+    }
+
+    /// OSQP's audit so far (OSQP only).
+    pub fn audit(&self) -> Option<&AuditReport> {
+        self.osqp.as_ref().map(|o| o.report())
+    }
+
+    /// The increment `z` of a step with right-hand side `b` at the state `u = u^n`, the
+    /// reactions kept: exact and penalty by the unconstrained solve, the LCP and, when some
+    /// `r_k > 0`, the solve of `C z = b − Eᵀ r`; OSQP by its own iteration, audited. Returns
+    /// the iterations. Allocates nothing.
+    pub fn step(
+        &mut self,
+        chol: &mut SparseCholesky,
+        b: &[f64],
+        u: &[f64],
+        z: &mut [f64],
+        step: usize,
+    ) -> Result<u32, PlaneError> {
+        if let Some(osqp) = &mut self.osqp {
+            return osqp
+                .solve(&self.normals, b, u, chol, z, &mut self.r)
+                .map_err(|e| PlaneError::Contact {
+                    step,
+                    reason: format!("osqp: {e}"),
+                });
+        }
+        z.copy_from_slice(b);
+        chol.solve_in_place(z);
+        let (iterations, touching) = self.solve(u, z, step)?;
+        if touching {
+            // z from C z = b − Eᵀ r directly (backward stable).
+            z.copy_from_slice(b);
+            self.subtract_reactions(z);
+            chol.solve_in_place(z);
+        }
+        Ok(iterations)
     }
 
     /// The reactions `r_k` of the last step.
@@ -221,14 +318,16 @@ impl Contact {
     }
 
     /// Solves the step's LCP for the unconstrained increment `z0` at the state `u = u^n`;
-    /// writes the reactions and, when any is positive, returns true (the caller then solves
-    /// `C z = b − Eᵀ r`, see [`Contact::subtract_reactions`]). Allocates nothing.
-    pub fn solve(&mut self, u: &[f64], z0: &[f64], step: usize) -> Result<(u32, bool), PlaneError> {
+    /// writes the reactions and, when any is positive, returns true (then `C z = b − Eᵀ r`,
+    /// see [`Contact::subtract_reactions`]). Allocates nothing.
+    fn solve(&mut self, u: &[f64], z0: &[f64], step: usize) -> Result<(u32, bool), PlaneError> {
         for (q, nk) in self.q.iter_mut().zip(&self.normals) {
             *q = nk.gap - nk.sign * (u[nk.unknown] + z0[nk.unknown]);
         }
         let iterations = self
             .lcp
+            .as_mut()
+            .expect("exact and penalty methods form S")
             .solve(&self.q, &mut self.r, &mut self.w)
             .map_err(|e| PlaneError::Contact {
                 step,

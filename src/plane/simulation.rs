@@ -10,7 +10,7 @@
 //! ([`crate::plane::rhs`]), `C = M/Δt² + (½ + α/(2Δt)) K` factorised once per run
 //! ([`SparseCholesky`]), and measures the energy balance ([`crate::plane::energy`]).
 
-use crate::plane::contact::{Contact, ContactStep, normals};
+use crate::plane::contact::{Contact, ContactMethod, ContactStep, normals};
 use crate::plane::energy::{Balance, StrainForms, balance, measure};
 use crate::plane::error::PlaneError;
 use crate::plane::factor::SparseCholesky;
@@ -186,6 +186,12 @@ impl PlaneSimulation {
     /// `u^1 = u^0 + Δt u_1 + Δt²/2 M⁻¹(F^0 − K u^0 − α K u_1)` (Taylor, second order for
     /// smooth data; the bar's start-up without its projection, which has no constraint here).
     pub fn new(scene: &PlaneScene) -> Result<Self, PlaneError> {
+        Self::with_method(scene, ContactMethod::Exact)
+    }
+
+    /// [`PlaneSimulation::new`] with the contact problems solved by `method` (ignored without
+    /// Signorini edges).
+    pub fn with_method(scene: &PlaneScene, method: ContactMethod) -> Result<Self, PlaneError> {
         scene.validate()?;
         let exprs = scene.expressions()?;
         let gaps = scene.edges.gaps()?;
@@ -257,15 +263,10 @@ impl PlaneSimulation {
         let contact = if normals.is_empty() {
             None
         } else {
-            let mut contact = Contact::new(normals, &mut chol)?;
-            let (iterations, touching) = contact.solve(&u0, &z, 1)?;
-            if touching {
-                let mut b = vec![0.0; n];
-                disc.pattern.mul_into(&c, &z, &mut b);
-                contact.subtract_reactions(&mut b);
-                chol.solve_in_place(&mut b);
-                z = b;
-            }
+            let mut contact = Contact::new(normals, &mut chol, method, &disc.pattern, &c)?;
+            let mut b = vec![0.0; n];
+            disc.pattern.mul_into(&c, &z, &mut b);
+            let iterations = contact.step(&mut chol, &b, &u0, &mut z, 1)?;
             let u1: Vec<f64> = u0.iter().zip(&z).map(|(a, b)| a + b).collect();
             contact_step = ContactStep {
                 dissipation: 0.0,
@@ -336,18 +337,12 @@ impl PlaneSimulation {
             c_w: 0.5 - d.alpha / (2.0 * d.dt),
         };
         rhs_into(&terms, &self.u, &self.w, &self.force, &mut self.rhs);
-        self.z.copy_from_slice(&self.rhs);
-        self.chol.solve_in_place(&mut self.z);
         let mut iterations = 0;
         if let Some(contact) = &mut self.contact {
-            let touching;
-            (iterations, touching) = contact.solve(&self.u, &self.z, n + 1)?;
-            if touching {
-                // z from C z = b − Eᵀ r directly (backward stable).
-                self.z.copy_from_slice(&self.rhs);
-                contact.subtract_reactions(&mut self.z);
-                self.chol.solve_in_place(&mut self.z);
-            }
+            iterations = contact.step(&mut self.chol, &self.rhs, &self.u, &mut self.z, n + 1)?;
+        } else {
+            self.z.copy_from_slice(&self.rhs);
+            self.chol.solve_in_place(&mut self.z);
         }
         for (u, z) in self.u.iter_mut().zip(&self.z) {
             *u += z;
