@@ -67,10 +67,11 @@ impl PlaneOsqp {
         // P: upper triangle in CSC.
         let (mut indptr, mut indices, mut data) = (vec![0], Vec::new(), Vec::new());
         for r in 0..n {
-            for k in pattern.row_ptr[r]..pattern.row_ptr[r + 1] {
-                if pattern.cols[k] <= r {
-                    indices.push(pattern.cols[k]);
-                    data.push(c[k]);
+            let range = pattern.row_ptr[r]..pattern.row_ptr[r + 1];
+            for (&col, &v) in pattern.cols[range.clone()].iter().zip(&c[range]) {
+                if col <= r {
+                    indices.push(col);
+                    data.push(v);
                 }
             }
             indptr.push(indices.len());
