@@ -113,3 +113,212 @@ pub fn agreement(scene: &PlaneScene, method: ContactMethod) -> Result<Agreement,
     });
     Ok(a)
 }
+
+/// One level of the tilted drop's refinement study against a finer exact run.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactLevel {
+    pub level: u32,
+    pub nx: u64,
+    pub dt: f64,
+    /// Over every step of this level, the largest nodal `|u − u_ref|` (the reference at the
+    /// same node and time), over the reference's `max |u|`.
+    pub max_error: f64,
+}
+
+/// The tilted drop's convergence study: its end time (the fall, the contact spreading and the
+/// rocking; the runs at the reference level stay within seconds).
+pub const CONVERGENCE_END: f64 = 0.6;
+/// Levels compared and the reference level (2x finer in space and time than the finest: a
+/// level-4 reference, 66k unknowns and 3840 steps, takes minutes, too long for the tests).
+pub const CONVERGENCE_LEVELS: [u32; 3] = [0, 1, 2];
+pub const CONVERGENCE_REFERENCE: u32 = 3;
+
+/// Runs `scene` refined to each of `levels` and to `reference`, and measures each level at its
+/// nodes and steps against the reference (whose grid holds every coarser node: uniform rows,
+/// or the same grading, doubled).
+pub fn convergence(
+    scene: &PlaneScene,
+    levels: &[u32],
+    reference: u32,
+) -> Result<Vec<ContactLevel>, ConvergeError> {
+    // The reference's displacement at the steps that are multiples of 2^(reference − 0).
+    let fine = scene.refined(reference);
+    let mut sim = PlaneSimulation::new(&fine).map_err(plane_error)?;
+    let stride = 1usize << reference;
+    let mut kept = vec![sim.displacement()];
+    for n in 1..fine.steps() {
+        sim.step().map_err(plane_error)?;
+        if (n + 1).is_multiple_of(stride) {
+            kept.push(sim.displacement());
+        }
+    }
+    let fine_grid = sim.discretisation().grid.clone();
+    let scale = kept
+        .iter()
+        .flat_map(|u| u.iter())
+        .fold(0.0f64, |a, v| a.max(v.abs()));
+    let mut out = Vec::new();
+    for &level in levels {
+        let s = scene.refined(level);
+        let mut sim = PlaneSimulation::new(&s).map_err(plane_error)?;
+        let grid = sim.discretisation().grid.clone();
+        let (f, every) = (1usize << (reference - level), 1usize << level);
+        let mut max_error = 0.0f64;
+        let mut measure = |sim: &PlaneSimulation, n: usize| {
+            if !n.is_multiple_of(every) {
+                return;
+            }
+            let u = sim.displacement();
+            let r = &kept[n / every];
+            for node in 0..grid.nodes() {
+                let (i, j) = grid.position(node);
+                let fnode = fine_grid.node(i * f, j * f);
+                for c in 0..2 {
+                    max_error = max_error.max((u[2 * node + c] - r[2 * fnode + c]).abs());
+                }
+            }
+        };
+        measure(&sim, 0);
+        for n in 1..s.steps() {
+            sim.step().map_err(plane_error)?;
+            measure(&sim, n + 1);
+        }
+        out.push(ContactLevel {
+            level,
+            nx: s.mesh.nx,
+            dt: s.time.step,
+            max_error: max_error / scale,
+        });
+    }
+    Ok(out)
+}
+
+/// The observed orders between consecutive levels, `log2(e_l / e_{l+1})`.
+pub fn orders(levels: &[ContactLevel]) -> Vec<f64> {
+    levels
+        .windows(2)
+        .map(|w| (w[0].max_error / w[1].max_error).log2())
+        .collect()
+}
+
+/// The penalty parameters of the comparison with the exact solver.
+pub const PENALTY_EPSILONS: [f64; 2] = [1e-4, 1e-6];
+
+/// The figures of one contact scene's exact run.
+#[derive(Clone, Debug)]
+pub struct SceneCheck {
+    pub name: String,
+    pub summary: crate::plane::run::PlaneSummary,
+}
+
+/// The exact runs of the built-in contact scenes.
+pub fn scene_checks() -> Result<Vec<SceneCheck>, ConvergeError> {
+    CONTACT_SCENES
+        .iter()
+        .map(|name| {
+            let scene = plane_scene(name, &[])?;
+            let (_, summary, _) =
+                crate::plane::run::run_plane_in_memory(name, &scene).map_err(plane_error)?;
+            Ok(SceneCheck {
+                name: name.to_string(),
+                summary,
+            })
+        })
+        .collect()
+}
+
+/// The generated block of VERIFICATION.md's "Plane contact" section (id `plane-contact`).
+pub fn markdown() -> Result<String, ConvergeError> {
+    use crate::study::plane_checks::{BAR_CASE_BODY, bar_case, bar_contact_case_scenes};
+    use std::fmt::Write;
+    let mut md = String::from(
+        "| bar scene | steps | steps in contact | plane rows (y_grading) | max abs(ux − u) / max abs(u) | max abs(uy) / max abs(u) | max abs(r_k − ω_k r) / max r |\n|---|---|---|---|---|---|---|\n",
+    );
+    for (name, bar) in bar_contact_case_scenes() {
+        let c = bar_case(&bar)?;
+        let _ = writeln!(
+            md,
+            "| {name} | {} | {} | {} ({}) | {:.1e} | {:.1e} | {:.1e} |",
+            c.steps,
+            c.contact_steps,
+            BAR_CASE_BODY.1,
+            BAR_CASE_BODY.2,
+            c.max_ux_deviation / c.max_u,
+            c.max_uy / c.max_u,
+            c.max_reaction_deviation / c.max_reaction
+        );
+    }
+    md.push_str(
+        "\n| scene | unknowns | normals m | steps | steps in contact | max in contact | max identity residual | max penetration / scale | max abs(r·gap) / scale | contact dissipation | LCP sets tried (mean, max) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for s in scene_checks()? {
+        let (p, c) = (&s.summary, s.summary.contact.clone().unwrap_or_default());
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} | {:.1e} | {:.1e} | {:.1e} | {:.4e} | {:.2}, {} |",
+            s.name,
+            p.unknowns,
+            c.normals,
+            p.steps,
+            c.contact_steps,
+            c.max_active,
+            p.max_identity_residual,
+            c.max_penetration,
+            c.max_complementarity,
+            c.dissipation,
+            c.iterations_mean,
+            c.iterations_max
+        );
+    }
+    md.push_str(
+        "\n| scene | method | max abs(u − u_exact) / max abs(u) | max abs(r − r_exact) / max r | iterations per step (mean) | audit: worst residual / tolerance |\n|---|---|---|---|---|---|\n",
+    );
+    for name in CONTACT_SCENES {
+        let scene = plane_scene(name, &[])?;
+        let mut methods = vec![(osqp_method(), "osqp, eps = 1e-10".to_string())];
+        for e in PENALTY_EPSILONS {
+            methods.push((ContactMethod::Penalty { epsilon: e }, format!("penalty, ε = {e:e}")));
+        }
+        for (method, label) in methods {
+            let a = agreement(&scene, method)?;
+            let audit = a
+                .audit_worst_ratio
+                .map_or_else(|| "–".to_string(), |r| format!("{r:.1e}"));
+            let _ = writeln!(
+                md,
+                "| {name} | {label} | {:.1e} | {:.1e} | {:.1} | {audit} |",
+                a.max_u_deviation / a.max_u,
+                a.max_reaction_deviation / a.max_reaction,
+                a.mean_iterations
+            );
+        }
+    }
+    let scene = plane_scene(
+        "plane-tilted-drop",
+        &[format!("time.end={CONVERGENCE_END}")],
+    )?;
+    let levels = convergence(&scene, &CONVERGENCE_LEVELS, CONVERGENCE_REFERENCE)?;
+    let orders = orders(&levels);
+    md.push_str("\n| level | nx × ny | Δt | max nodal error / max abs(u_ref) | order |\n|---|---|---|---|---|\n");
+    for (k, l) in levels.iter().enumerate() {
+        let order = if k == 0 {
+            "–".to_string()
+        } else {
+            format!("{:.2}", orders[k - 1])
+        };
+        let _ = writeln!(
+            md,
+            "| {} | {} × {} | {} | {:.3e} | {order} |",
+            l.level,
+            l.nx,
+            l.nx / 2,
+            l.dt,
+            l.max_error
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\nReference: level {CONVERGENCE_REFERENCE} (exact solver), T = {CONVERGENCE_END}."
+    );
+    Ok(md)
+}

@@ -54,6 +54,10 @@ pub fn sections() -> Result<Vec<Section>, crate::study::converge::ConvergeError>
             id: "plane",
             markdown: crate::study::plane_checks::markdown()?,
         },
+        Section {
+            id: "plane-contact",
+            markdown: crate::study::plane_contact::markdown()?,
+        },
     ])
 }
 
