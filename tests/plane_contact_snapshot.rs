@@ -1,0 +1,109 @@
+//! Snapshot regression of `plane-tilted-drop`: statistics of the run at 11 steps (`n = 1`, the
+//! start-up step, and `N/10, …, N`), rounded, in the reviewed YAML file `snapshots/plane/plane-tilted-drop.snap`
+//! (never raw matrices or fields). A change that moves the drop's numbers fails this test; the
+//! README ("Snapshots") says how to review and accept it.
+//!
+//! Rounding: each quantity to [`SIGNIFICANT_DIGITS`] digits of its largest magnitude over the
+//! run (as `tests/snapshots.rs`): the run's round-off (1e-13 relative) is far below that
+//! quantum, its discretisation error (1e-2, VERIFICATION.md "Plane contact") far above.
+
+use insta::with_settings;
+use serde::Serialize;
+use viscobar::plane::PlaneSimulation;
+use viscobar::study::plane_contact::plane_scene;
+
+/// Significant digits kept, relative to the largest magnitude of each quantity.
+const SIGNIFICANT_DIGITS: i32 = 7;
+/// Rows of the snapshot (10 intervals).
+const T_POINTS: usize = 11;
+
+fn round_sig(x: f64, scale: f64) -> f64 {
+    if x == 0.0 || scale == 0.0 {
+        return x;
+    }
+    let exponent = scale.abs().log10().floor() as i32 - (SIGNIFICANT_DIGITS - 1);
+    let q = 10f64.powi(exponent);
+    let digits = (-exponent).max(0) as usize;
+    let r: f64 = format!("{:.*}", digits, (x / q).round() * q).parse().unwrap();
+    r + 0.0
+}
+
+#[derive(Serialize)]
+struct Row {
+    step: usize,
+    t: f64,
+    energy: f64,
+    /// Normals in contact, and the extent `[s_min, s_max]` of the touching nodes.
+    in_contact: usize,
+    contact_s: Option<[f64; 2]>,
+    /// `Σ r_k` and the largest contact pressure `r_k / ω_k`.
+    total_reaction: f64,
+    max_pressure: f64,
+    /// The mean displacement of the nodes (x, y), and the bottom edge's lowest `uy`.
+    mean_u: [f64; 2],
+    min_bottom_uy: f64,
+}
+
+#[test]
+fn the_tilted_drop_matches_its_reviewed_snapshot() {
+    let scene = plane_scene("plane-tilted-drop", &[]).unwrap();
+    let steps = scene.steps();
+    let mut sim = PlaneSimulation::new(&scene).unwrap();
+    let mut rows = Vec::new();
+    let mut energy = sim.first_record().energy;
+    for n in 1..=steps {
+        if n > 1 {
+            energy = sim.step().unwrap().energy;
+        }
+        if n > 1 && !(n * (T_POINTS - 1)).is_multiple_of(steps) {
+            continue;
+        }
+        let c = sim.contact().unwrap();
+        let u = sim.displacement();
+        let grid = &sim.discretisation().grid;
+        let nodes = grid.nodes() as f64;
+        let mean_u = [0, 1].map(|k| u.iter().skip(k).step_by(2).sum::<f64>() / nodes);
+        let min_bottom_uy = (0..=grid.nx)
+            .map(|i| u[2 * grid.node(i, 0) + 1])
+            .fold(f64::INFINITY, f64::min);
+        let touching: Vec<_> = c
+            .normals
+            .iter()
+            .zip(c.reactions())
+            .filter(|(_, r)| **r > 0.0)
+            .collect();
+        rows.push(Row {
+            step: n,
+            t: n as f64 * scene.time.step,
+            energy,
+            in_contact: touching.len(),
+            contact_s: (!touching.is_empty()).then(|| {
+                [touching[0].0.s, touching[touching.len() - 1].0.s]
+            }),
+            total_reaction: touching.iter().map(|(_, r)| **r).sum::<f64>() + 0.0,
+            max_pressure: touching.iter().map(|(k, r)| **r / k.weight).fold(0.0, f64::max),
+            mean_u,
+            min_bottom_uy,
+        });
+    }
+    // Round each quantity relative to its largest magnitude.
+    let scale = |f: &dyn Fn(&Row) -> f64| rows.iter().map(|r| f(r).abs()).fold(0.0, f64::max);
+    let (se, sr, sp) = (
+        scale(&|r| r.energy),
+        scale(&|r| r.total_reaction),
+        scale(&|r| r.max_pressure),
+    );
+    let su = scale(&|r| r.mean_u[0].abs().max(r.mean_u[1].abs()).max(r.min_bottom_uy.abs()));
+    for r in &mut rows {
+        r.t = round_sig(r.t, 1.0);
+        r.energy = round_sig(r.energy, se);
+        r.total_reaction = round_sig(r.total_reaction, sr);
+        r.max_pressure = round_sig(r.max_pressure, sp);
+        r.mean_u = r.mean_u.map(|v| round_sig(v, su));
+        r.min_bottom_uy = round_sig(r.min_bottom_uy, su);
+    }
+    assert_eq!(rows.len(), T_POINTS);
+    with_settings!({snapshot_path => "../snapshots/plane", prepend_module_to_snapshot => false}, {
+        insta::assert_yaml_snapshot!("plane-tilted-drop", &rows);
+    });
+}
