@@ -116,3 +116,29 @@ fn bad_contact_input_exits_2_naming_the_field_and_writes_nothing() {
         assert!(!Path::new(&out).exists(), "{what}: wrote {}", out.display());
     }
 }
+
+/// A drawn figure is more than its headers: the smallest plausible PNG or SVG of a map.
+const MIN_FIGURE_BYTES: u64 = 1000;
+
+#[test]
+fn run_figure_draws_the_contact_pressure_beside_the_deformed_mesh() {
+    let out = fresh_dir("figure");
+    let o = viscobar(&[
+        "run",
+        "plane-curved-obstacle",
+        "--out",
+        out.to_str().unwrap(),
+        "--figure",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in [
+        "deformed.png",
+        "deformed.svg",
+        "contact-pressure.png",
+        "contact-pressure.svg",
+    ] {
+        let len = std::fs::metadata(out.join(f)).unwrap().len();
+        assert!(len > MIN_FIGURE_BYTES, "{f}: {len} bytes");
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -14,6 +14,7 @@ pub mod mass_figure;
 pub mod mass_variants;
 pub mod plane_checks;
 pub mod plane_contact;
+pub mod plane_contact_figure;
 pub mod plane_figure;
 pub mod sampled_run;
 pub mod stiff;

@@ -287,7 +287,9 @@ impl Drawing for PlaneFigure {
     }
 }
 
-/// Runs `scene` and writes `deformed.png` and `deformed.svg` into `out`; returns their paths.
+/// Runs `scene` and writes `deformed.png` and `deformed.svg` into `out`, and with Signorini
+/// edges `contact-pressure.png`/`.svg` ([`crate::study::plane_contact_figure`]); returns their
+/// paths.
 pub fn write(name: &str, scene: &PlaneScene, out: &Path) -> Result<Vec<PathBuf>, PlaneFigureError> {
     register_font()?;
     let figure = PlaneFigure::run(name, scene)?;
@@ -301,5 +303,6 @@ pub fn write(name: &str, scene: &PlaneScene, out: &Path) -> Result<Vec<PathBuf>,
         write_figure(&path, &figure)?;
         files.push(path);
     }
+    files.extend(crate::study::plane_contact_figure::write(name, scene, out)?);
     Ok(files)
 }
