@@ -6,6 +6,12 @@
 //! in `../shared/notes/faer-sparse-cholesky.md`). `plane-step/N` is a whole step (right-hand
 //! side, solve, energy balance), `plane-solve/N` one solve; after criterion's groups the bench
 //! prints the ratio step / solve from medians of its own timings.
+//!
+//! `plane-contact`: a block resting on a Signorini floor (every bottom node in contact), the
+//! exact step against the unconstrained step of the same body with a free bottom, at 1e4 …
+//! 2e5 unknowns with up to 200 contact normals and at 1e5 with 500; it prints the ratio, the
+//! set-up cost of `S` (the contact run's set-up minus the free one's) and OSQP's step over the
+//! exact one (up to 1e5 unknowns).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use std::time::Instant;
@@ -80,10 +86,102 @@ fn bench(c: &mut Criterion) {
     }
 }
 
+/// A block `2 × H` (square cells, `nx × ny`) resting under gravity on a floor at its bottom
+/// edge (Signorini, gap 0, the `nx + 1` bottom nodes in contact every step), `λ = 1`, `μ = ½`,
+/// `α = 0.02`, `Δt = h`; `contact = false` gives the same body with a free bottom (the
+/// unconstrained step the exact step is measured against).
+fn resting(nx: u64, ny: u64, contact: bool) -> PlaneScene {
+    let h = 2.0 / nx as f64;
+    let bottom = if contact {
+        "{ condition = \"signorini\", gap = 0 }"
+    } else {
+        "{ condition = \"free\" }"
+    };
+    let text = format!(
+        "[plane]\nwidth = 2.0\nheight = {height}\nlambda = 1.0\nmu = 0.5\nviscosity = 0.02\n\
+         [edges]\nbottom = {bottom}\n[load]\ndensity = [\"0\", \"-1\"]\n\
+         [mesh]\nnx = {nx}\nny = {ny}\n[time]\nstep = {h}\nend = {end}\n",
+        height = h * ny as f64,
+        end = 1000.0 * h
+    );
+    PlaneScene::from_toml(&text, &[]).unwrap()
+}
+
+/// `(nx, ny)` of the contact bench: about 1e4, 4e4 and 2e5 unknowns with up to 200 contact
+/// normals, and 500 normals at 1e5 unknowns.
+const CONTACT_SIZES: [(u64, u64); 4] = [(99, 50), (199, 100), (199, 500), (499, 100)];
+
+/// The exact step with contact against the unconstrained step of the same body, the set-up of
+/// `S` (m solves, blocked), and OSQP's step where it is affordable (at most 1e5 unknowns).
+fn bench_contact(c: &mut Criterion) {
+    use viscobar::plane::contact::ContactMethod;
+    use viscobar::step::osqp::OsqpSettings;
+    let mut group = c.benchmark_group("plane-contact");
+    group.sample_size(10);
+    let mut rows = Vec::new();
+    for (nx, ny) in CONTACT_SIZES {
+        let t = Instant::now();
+        let mut free = PlaneSimulation::new(&resting(nx, ny, false)).unwrap();
+        let setup_free = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let mut sim = PlaneSimulation::new(&resting(nx, ny, true)).unwrap();
+        let setup_contact = t.elapsed().as_secs_f64();
+        let n = sim.discretisation().unknowns();
+        let m = sim.contact().map_or(0, |c| c.len());
+        // Settle into contact before timing.
+        for _ in 0..20 {
+            sim.step().unwrap();
+        }
+        let id = format!("{n}-m{m}");
+        group.bench_function(BenchmarkId::new("exact-step", &id), |b| {
+            b.iter(|| sim.step().unwrap())
+        });
+        group.bench_function(BenchmarkId::new("free-step", &id), |b| {
+            b.iter(|| free.step().unwrap())
+        });
+        let runs = if n > 100_000 { 5 } else { 21 };
+        let exact = median(runs, || {
+            sim.step().unwrap();
+        });
+        let unconstrained = median(runs, || {
+            free.step().unwrap();
+        });
+        let active = sim.step().unwrap().contact.active;
+        let osqp = (n <= 100_000).then(|| {
+            let mut o = PlaneSimulation::with_method(
+                &resting(nx, ny, true),
+                ContactMethod::Osqp(OsqpSettings::default()),
+            )
+            .unwrap();
+            for _ in 0..20 {
+                o.step().unwrap();
+            }
+            median(5, || {
+                o.step().unwrap();
+            })
+        });
+        rows.push((n, m, active, exact, unconstrained, setup_contact - setup_free, osqp));
+    }
+    group.finish();
+    println!(
+        "\n| unknowns | m | in contact | exact step ms | free step ms | exact / free | S set-up s | OSQP step / exact |\n|---|---|---|---|---|---|---|---|"
+    );
+    for (n, m, active, exact, free, setup, osqp) in rows {
+        println!(
+            "| {n} | {m} | {active} | {:.3} | {:.3} | {:.2} | {:.3} | {} |",
+            exact * 1e3,
+            free * 1e3,
+            exact / free,
+            setup,
+            osqp.map_or("–".to_string(), |o| format!("{:.1}", o / exact))
+        );
+    }
+}
+
 // No HTML plots, as in benches/step.rs (criterion's plotters backend would need a font).
 criterion_group! {
     name = benches;
     config = Criterion::default().without_plots();
-    targets = bench
+    targets = bench, bench_contact
 }
 criterion_main!(benches);
