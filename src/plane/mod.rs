@@ -31,6 +31,7 @@ pub mod error;
 pub mod factor;
 pub mod matrices;
 pub mod mesh;
+pub mod normals;
 pub mod osqp;
 pub mod rhs;
 pub mod run;

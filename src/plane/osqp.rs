@@ -16,7 +16,7 @@
 //! complementarity `|r_k (h − E z)_k| <= tol_z |r_k| + tol_f |(h − Ez)_k|`, stationarity
 //! `‖C z − b + Eᵀ r‖∞` and the same mapped to displacement by a solve with the factor of `C`.
 
-use crate::plane::contact::Normal;
+use crate::plane::normals::Normal;
 use crate::plane::factor::SparseCholesky;
 use crate::plane::matrices::Pattern;
 use crate::step::audit::{AUDIT_MARGIN, dual_tolerance};

@@ -10,7 +10,8 @@
 //! ([`crate::plane::rhs`]), `C = M/Δt² + (½ + α/(2Δt)) K` factorised once per run
 //! ([`SparseCholesky`]), and measures the energy balance ([`crate::plane::energy`]).
 
-use crate::plane::contact::{Contact, ContactMethod, ContactStep, normals};
+use crate::plane::contact::{Contact, ContactMethod, ContactStep};
+use crate::plane::normals::normals;
 use crate::plane::energy::{Balance, StrainForms, balance, measure};
 use crate::plane::error::PlaneError;
 use crate::plane::factor::SparseCholesky;
@@ -215,7 +216,7 @@ impl PlaneSimulation {
                 (u0_full[d], v0_full[d]) = (0.0, 0.0);
             }
         }
-        let normals = normals(&disc, &gaps, &u0_full)?;
+        let normals = normals(&disc.grid, &disc.index, &gaps, &u0_full)?;
         let n = disc.unknowns();
         let mut force = vec![0.0; n];
         let load = match exprs.load {

@@ -9,7 +9,7 @@
 use crate::plane::PlaneError;
 use crate::plane::simulation::PlaneSimulation;
 use crate::scene::plane::{EDGE_NAMES, PlaneScene};
-use crate::study::figure_writer::{DrawResult, Drawing, write_figure};
+use crate::study::figure_writer::{DrawResult, Drawing, FigureError, write_figure};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
@@ -186,20 +186,15 @@ impl Drawing for ContactPressureFigure {
     }
 }
 
-/// Writes `contact-pressure.png`/`.svg` into `out` when `scene` has Signorini edges.
-pub fn write(
-    name: &str,
-    scene: &PlaneScene,
-    out: &Path,
-) -> Result<Vec<PathBuf>, crate::study::plane_figure::PlaneFigureError> {
-    let Some(figure) = ContactPressureFigure::run(name, scene)? else {
-        return Ok(Vec::new());
-    };
-    let mut files = Vec::new();
-    for ext in ["png", "svg"] {
-        let path = out.join(format!("contact-pressure.{ext}"));
-        write_figure(&path, &figure)?;
-        files.push(path);
+impl ContactPressureFigure {
+    /// Writes `contact-pressure.png`/`.svg` into `out`; returns their paths.
+    pub fn write(&self, out: &Path) -> Result<Vec<PathBuf>, FigureError> {
+        let mut files = Vec::new();
+        for ext in ["png", "svg"] {
+            let path = out.join(format!("contact-pressure.{ext}"));
+            write_figure(&path, self)?;
+            files.push(path);
+        }
+        Ok(files)
     }
-    Ok(files)
 }

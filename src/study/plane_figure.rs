@@ -303,6 +303,10 @@ pub fn write(name: &str, scene: &PlaneScene, out: &Path) -> Result<Vec<PathBuf>,
         write_figure(&path, &figure)?;
         files.push(path);
     }
-    files.extend(crate::study::plane_contact_figure::write(name, scene, out)?);
+    if let Some(contact) =
+        crate::study::plane_contact_figure::ContactPressureFigure::run(name, scene)?
+    {
+        files.extend(contact.write(out)?);
+    }
     Ok(files)
 }
