@@ -94,6 +94,8 @@ pub struct BlockPivotSolver {
     /// Constrained nodes (strictly increasing) and, per node, its constraint index or `NONE`.
     nodes: Vec<usize>,
     slot: Vec<usize>,
+    /// Every node is constrained (`nodes = 0..n`).
+    all_constrained: bool,
     /// Per node: active (`z_i = lo_i`), kept from the previous step (warm start); always
     /// false at unconstrained nodes.
     active: Vec<bool>,
@@ -104,9 +106,8 @@ pub struct BlockPivotSolver {
     d: Vec<f64>,
     inv_d: Vec<f64>,
     l: Vec<f64>,
-    /// Forward chain `t_j` and `w_j = t_j / d_j` of the last solve.
+    /// Forward chain `t_j` of the last solve (the backward chain reads `t_j / d_j`).
     t: Vec<f64>,
-    w: Vec<f64>,
     /// `max|z|` per block of [`MAX_BLOCK`] nodes.
     block_max: Vec<f64>,
     /// Per node: the margin of the last evaluation ([`BlockPivotSolver::margin_at`]).
@@ -146,6 +147,7 @@ impl BlockPivotSolver {
             factor,
             nodes: nodes.to_vec(),
             slot,
+            all_constrained: nodes.len() == n,
             active: vec![false; n],
             active_count: 0,
             lo: vec![0.0; n],
@@ -153,7 +155,6 @@ impl BlockPivotSolver {
             inv_d: vec![0.0; n],
             l: vec![0.0; n.saturating_sub(1)],
             t: vec![0.0; n],
-            w: vec![0.0; n],
             block_max: vec![0.0; n.div_ceil(MAX_BLOCK)],
             margin: vec![0.0; n],
             negative: Vec::with_capacity(nodes.len()),
@@ -232,37 +233,51 @@ impl BlockPivotSolver {
         same
     }
 
-    /// Forward chain at `j`; whether `t_j` kept its bits. It restarts at every active node
+    /// Forward chain value at `j` from `t_{j−1}`. It restarts at every active node
     /// (`t_j = lo_j`, `d_j = 1`) and at the free node after it (`l_{j−1} = 0`), so that a run
     /// of free nodes is solved without reading the rest of the bar.
     #[inline(always)]
-    fn forward_at(&mut self, j: usize, rhs: &[f64]) -> bool {
-        let tj = if self.active[j] {
+    fn forward_value(&self, j: usize, rhs: &[f64], t_prev: f64) -> f64 {
+        if self.active[j] {
             self.lo[j]
         } else {
             let r = self.rhs_r(j, rhs);
             if j == 0 || self.active[j - 1] {
                 r
             } else {
-                r - self.l[j - 1] * self.t[j - 1]
+                r - self.l[j - 1] * t_prev
             }
-        };
+        }
+    }
+
+    /// Forward chain at `j`; whether `t_j` kept its bits.
+    #[inline(always)]
+    fn forward_at(&mut self, j: usize, rhs: &[f64]) -> bool {
+        let t_prev = if j == 0 { 0.0 } else { self.t[j - 1] };
+        let tj = self.forward_value(j, rhs, t_prev);
         let same = tj.to_bits() == self.t[j].to_bits();
         self.t[j] = tj;
-        self.w[j] = tj * self.inv_d[j];
         same
     }
 
-    /// Backward chain at `j`; whether `z_j` kept its bits (`z_j = w_j` where `l_j = 0`: at
-    /// an active node and before one).
+    /// Backward chain value at `j` from `z_{j+1}` (`z_j = w_j` where `l_j = 0`: at an active
+    /// node and before one).
+    #[inline(always)]
+    fn backward_value(&self, j: usize, n: usize, z_next: f64) -> f64 {
+        let w = self.t[j] * self.inv_d[j];
+        if j + 1 == n || self.active[j] || self.active[j + 1] {
+            w
+        } else {
+            w - self.l[j] * z_next
+        }
+    }
+
+    /// Backward chain at `j`; whether `z_j` kept its bits.
     #[inline(always)]
     fn backward_at(&self, j: usize, z: &mut [f64]) -> bool {
         let n = z.len();
-        let zj = if j + 1 == n || self.active[j] || self.active[j + 1] {
-            self.w[j]
-        } else {
-            self.w[j] - self.l[j] * z[j + 1]
-        };
+        let z_next = if j + 1 == n { 0.0 } else { z[j + 1] };
+        let zj = self.backward_value(j, n, z_next);
         let same = zj.to_bits() == z[j].to_bits();
         z[j] = zj;
         same
@@ -293,18 +308,76 @@ impl BlockPivotSolver {
         self.factor_valid = true;
     }
 
-    fn solve_all(&mut self, rhs: &[f64], z: &mut [f64]) {
+    /// The whole-bar solve with the current factor, with every margin and the block maxima
+    /// of `|z|` evaluated inside the backward sweep (off its dependency chain).
+    /// Returns `(max|b|, max|lo|)`, taken in the forward sweep.
+    fn solve_all(&mut self, rhs: &[f64], z: &mut [f64]) -> (f64, f64) {
         let n = z.len();
-        for j in 0..n {
-            self.forward_at(j, rhs);
+        let (mut b_max, mut lo_max) = (0.0f64, 0.0f64);
+        {
+            // The arithmetic of `forward_value`, on local slices (no reloads through `self`)
+            // with the carried value in a register; the tests compare the two bit for bit.
+            let (active, lo, off, l) = (&self.active[..n], &self.lo[..n], &self.c.off, &self.l);
+            let ts = &mut self.t[..n];
+            let mut t = 0.0;
+            for j in 0..n {
+                b_max = max_of(b_max, rhs[j].abs());
+                lo_max = max_of(lo_max, lo[j].abs());
+                t = if active[j] {
+                    lo[j]
+                } else {
+                    let mut r = rhs[j];
+                    if j > 0 && active[j - 1] {
+                        r -= off[j - 1] * lo[j - 1];
+                    }
+                    if j + 1 < n && active[j + 1] {
+                        r -= off[j] * lo[j + 1];
+                    }
+                    if j == 0 || active[j - 1] {
+                        r
+                    } else {
+                        r - l[j - 1] * t
+                    }
+                };
+                ts[j] = t;
+            }
         }
+        self.negative.clear();
+        let mut block = 0.0f64;
+        let mut z_next = 0.0;
         for j in (0..n).rev() {
-            self.backward_at(j, z);
+            z_next = self.backward_value(j, n, z_next);
+            z[j] = z_next;
+            block = max_of(block, z_next.abs());
+            if j % MAX_BLOCK == 0 {
+                self.block_max[j / MAX_BLOCK] = block;
+                block = 0.0;
+            }
+            if j + 1 < n {
+                self.margin_into_negative(j + 1, rhs, z);
+            }
         }
-        for (b, chunk) in self.block_max.iter_mut().zip(z.chunks(MAX_BLOCK)) {
-            *b = max_abs(chunk);
+        if n > 0 {
+            self.margin_into_negative(0, rhs, z);
         }
+        self.negative.reverse();
         self.work.full_solves += 1;
+        (b_max, lo_max)
+    }
+
+    /// Evaluates the margin of node `i` if it is constrained, and lists it when negative.
+    #[inline(always)]
+    fn margin_into_negative(&mut self, i: usize, rhs: &[f64], z: &[f64]) {
+        if self.all_constrained || self.slot[i] != NONE {
+            let m = self.margin_at(i, rhs, z);
+            // Read back only for active nodes (reactions) and negative margins.
+            if m < 0.0 {
+                self.margin[i] = m;
+                self.negative.push(i);
+            } else if self.active[i] {
+                self.margin[i] = m;
+            }
+        }
     }
 
     // ---- incremental re-solve after `flips` --------------------------------------------
@@ -504,6 +577,28 @@ fn sweep_down(
     out.truncate(w);
 }
 
+/// `m.max(x)` for a running maximum `m` that is not NaN (it starts at 0): the same value (a
+/// NaN `x` is ignored either way) in one `maxsd`, without `f64::max`'s NaN blend on the
+/// dependency chain.
+#[inline(always)]
+fn max_of(m: f64, x: f64) -> f64 {
+    if x > m { x } else { m }
+}
+
+/// [`max_abs`] with four accumulators (the same value: a maximum does not depend on the order;
+/// NaNs are ignored either way), off the single chain of dependent comparisons.
+fn max_abs_4(v: &[f64]) -> f64 {
+    let mut m = [0.0f64; 4];
+    let chunks = v.chunks_exact(4);
+    let rest = max_abs(chunks.remainder());
+    for c in chunks {
+        for k in 0..4 {
+            m[k] = m[k].max(c[k].abs());
+        }
+    }
+    m[0].max(m[1]).max(m[2].max(m[3])).max(rest)
+}
+
 /// Appends `r` to sorted ranges, merging it with the last one when they overlap or touch.
 fn push_merged(out: &mut Vec<(usize, usize)>, r: (usize, usize)) {
     match out.last_mut() {
@@ -526,14 +621,20 @@ impl StepSolver for BlockPivotSolver {
     ) -> Result<SolveInfo, StepFailure> {
         let eps = f64::EPSILON;
         let n = z.len();
-        let b_max = max_abs(rhs);
-        let lo_max = max_abs(lower);
-        for (&i, &v) in self.nodes.iter().zip(lower) {
-            self.lo[i] = v;
+        // `(max|b|, max|lo|)`, taken by the step's first solve.
+        let mut maxima = None;
+        if self.all_constrained {
+            // Every node constrained (nodes = 0..n).
+            self.lo.copy_from_slice(lower);
+        } else {
+            let lo = &mut self.lo[..];
+            for (&i, &v) in self.nodes.iter().zip(lower) {
+                lo[i] = v;
+            }
         }
         let mut best_count = usize::MAX;
         let mut patience = BLOCK_PATIENCE;
-        // Whether `t`, `w`, `z` hold this step's sweep with `active` before `flips`.
+        // Whether `t` and `z` hold this step's sweep with `active` before `flips`.
         let mut swept = false;
         if !self.flips.is_empty() {
             // A failed solve left flips unsolved: the factor no longer matches.
@@ -553,15 +654,18 @@ impl StepSolver for BlockPivotSolver {
                 for (b, chunk) in self.block_max.iter_mut().zip(z.chunks(MAX_BLOCK)) {
                     *b = max_abs(chunk);
                 }
+                maxima.get_or_insert_with(|| (max_abs_4(rhs), max_abs_4(lower)));
             } else if local {
                 self.solve_local(rhs, z);
             } else {
                 if !self.incremental || !self.factor_valid || !self.flips.is_empty() {
                     self.factor_all();
                 }
-                self.solve_all(rhs, z);
+                let m = self.solve_all(rhs, z);
+                maxima.get_or_insert(m);
                 swept = true;
             }
+            let (b_max, lo_max) = maxima.expect("the first iteration is not local");
             let z_max = max_abs(&self.block_max);
             if !z_max.is_finite() {
                 return Err(StepFailure::NonFinite);
@@ -570,18 +674,15 @@ impl StepSolver for BlockPivotSolver {
             let tol_l = TIE_ULPS * eps * (self.c_norm * z_max + b_max);
             if local {
                 self.margins_changed(rhs, z);
-            } else {
+            } else if !swept {
                 self.margins_all(rhs, z);
             }
             self.select_infeasible(tol_z, tol_l);
             self.flips.clear();
             if self.infeasible.is_empty() {
-                for (k, &i) in self.nodes.iter().enumerate() {
-                    reactions[k] = if self.active[i] {
-                        self.margin[i].max(0.0)
-                    } else {
-                        0.0
-                    };
+                let (active, margin) = (&self.active[..], &self.margin[..]);
+                for (r, &i) in reactions.iter_mut().zip(&self.nodes) {
+                    *r = if active[i] { margin[i].max(0.0) } else { 0.0 };
                 }
                 return Ok(SolveInfo {
                     iterations: iteration,
