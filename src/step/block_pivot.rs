@@ -681,8 +681,15 @@ impl StepSolver for BlockPivotSolver {
             self.flips.clear();
             if self.infeasible.is_empty() {
                 let (active, margin) = (&self.active[..], &self.margin[..]);
-                for (r, &i) in reactions.iter_mut().zip(&self.nodes) {
-                    *r = if active[i] { margin[i].max(0.0) } else { 0.0 };
+                let reaction = |i: usize| if active[i] { margin[i].max(0.0) } else { 0.0 };
+                if self.all_constrained {
+                    for (i, r) in reactions[..n].iter_mut().enumerate() {
+                        *r = reaction(i);
+                    }
+                } else {
+                    for (r, &i) in reactions.iter_mut().zip(&self.nodes) {
+                        *r = reaction(i);
+                    }
                 }
                 return Ok(SolveInfo {
                     iterations: iteration,
