@@ -315,46 +315,68 @@ impl BlockPivotSolver {
         let n = z.len();
         let (mut b_max, mut lo_max) = (0.0f64, 0.0f64);
         {
-            // The arithmetic of `forward_value`, on local slices (no reloads through `self`)
-            // with the carried value in a register; the tests compare the two bit for bit.
+            // The arithmetic of `forward_value`, on local slices (no reloads through `self`),
+            // one loop per run of active or free nodes so that the chain runs through the free
+            // runs only (a select on `active` would chain every node); the tests compare the
+            // two bit for bit.
             let (active, lo, off, l) = (&self.active[..n], &self.lo[..n], &self.c.off, &self.l);
             let ts = &mut self.t[..n];
-            let mut t = 0.0;
-            for j in 0..n {
-                b_max = max_of(b_max, rhs[j].abs());
-                lo_max = max_of(lo_max, lo[j].abs());
-                t = if active[j] {
-                    lo[j]
+            let reduced_rhs = |j: usize| {
+                let mut r = rhs[j];
+                if j > 0 && active[j - 1] {
+                    r -= off[j - 1] * lo[j - 1];
+                }
+                if j + 1 < n && active[j + 1] {
+                    r -= off[j] * lo[j + 1];
+                }
+                r
+            };
+            let mut j = 0;
+            while j < n {
+                if active[j] {
+                    while j < n && active[j] {
+                        b_max = max_of(b_max, rhs[j].abs());
+                        lo_max = max_of(lo_max, lo[j].abs());
+                        ts[j] = lo[j];
+                        j += 1;
+                    }
                 } else {
-                    let mut r = rhs[j];
-                    if j > 0 && active[j - 1] {
-                        r -= off[j - 1] * lo[j - 1];
+                    b_max = max_of(b_max, rhs[j].abs());
+                    lo_max = max_of(lo_max, lo[j].abs());
+                    let mut t = reduced_rhs(j);
+                    ts[j] = t;
+                    j += 1;
+                    while j < n && !active[j] {
+                        b_max = max_of(b_max, rhs[j].abs());
+                        lo_max = max_of(lo_max, lo[j].abs());
+                        t = reduced_rhs(j) - l[j - 1] * t;
+                        ts[j] = t;
+                        j += 1;
                     }
-                    if j + 1 < n && active[j + 1] {
-                        r -= off[j] * lo[j + 1];
-                    }
-                    if j == 0 || active[j - 1] {
-                        r
-                    } else {
-                        r - l[j - 1] * t
-                    }
-                };
-                ts[j] = t;
+                }
             }
         }
         self.negative.clear();
+        // `backward_value` run by run, downwards (same remark).
         let mut block = 0.0f64;
-        let mut z_next = 0.0;
-        for j in (0..n).rev() {
-            z_next = self.backward_value(j, n, z_next);
-            z[j] = z_next;
-            block = max_of(block, z_next.abs());
-            if j % MAX_BLOCK == 0 {
-                self.block_max[j / MAX_BLOCK] = block;
-                block = 0.0;
-            }
-            if j + 1 < n {
-                self.margin_into_negative(j + 1, rhs, z);
+        let mut j = n;
+        while j > 0 {
+            let top = j - 1;
+            let free = !self.active[top];
+            let mut z_next = 0.0;
+            while j > 0 && self.active[j - 1] != free {
+                j -= 1;
+                let w = self.t[j] * self.inv_d[j];
+                z_next = if !free || j == top { w } else { w - self.l[j] * z_next };
+                z[j] = z_next;
+                block = max_of(block, z_next.abs());
+                if j.is_multiple_of(MAX_BLOCK) {
+                    self.block_max[j / MAX_BLOCK] = block;
+                    block = 0.0;
+                }
+                if j + 1 < n {
+                    self.margin_into_negative(j + 1, rhs, z);
+                }
             }
         }
         if n > 0 {
