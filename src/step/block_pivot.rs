@@ -10,13 +10,40 @@
 //! `C` is a P-matrix, so the solution is unique.
 //!
 //! Method: block principal pivoting (Júdice & Pires, Comput. Oper. Res. 21, 1994) safeguarded
-//! by Murty's single pivoting rule, finite on every P-matrix LCP
-//! ([docs/step-solvers.md](../docs/step-solvers.md#block-principal-pivoting)).
+//! by Murty's single pivoting rule. It terminates after finitely many iterations: a block
+//! iteration (flip every infeasible index) is taken only while the number of infeasible
+//! indices has reached a new minimum within the last [`BLOCK_PATIENCE`] iterations, and that
+//! minimum can fall at most `|B|` times, so after finitely many block iterations only Murty's
+//! rule is applied (flip the infeasible index of largest node number), which visits no
+//! active set twice and ends on every P-matrix LCP (Murty 1974)
+//! ([docs/step-solvers.md](../docs/step-solvers.md#block-principal-pivoting)). Should round-off
+//! defeat that argument, the iteration stops at a hard limit with an error, never with an
+//! unverified point.
 //!
-//! Each iteration solves `C_FF z_F = b_F − C_FA lo_A` on the free set `F` with `z_A = lo_A`: one
-//! tridiagonal factorisation and solve of size `n` (active rows replaced by identity rows), O(n).
-//! The active set is warm-started from the previous step; when it is empty, the factorisation
-//! of `C` computed once per run is used.
+//! Each iteration solves `C_FF z_F = b_F − C_FA lo_A` on the free set `F` with `z_A = lo_A`:
+//! the tridiagonal matrix with the active rows and columns replaced by identity ones, by the
+//! plain `L D Lᵀ` sweep (pivots `d_j`, multipliers `l_j`), a forward chain `t_j` and a backward
+//! chain `z_j`. An active node cuts the sweep into independent runs of free nodes.
+//!
+//! *Incremental re-solves.* The right-hand side changes every step, so the first iteration of a
+//! step sweeps the whole bar; its factor is the one kept from the previous step's final active
+//! set (a contact set that persists costs no factorisation). A later iteration of the same step
+//! changes only a few rows (the flipped indices), and recomputes each of the three recurrences
+//! (pivots, forward chain, backward chain) only from the first changed row until its carried
+//! value is bitwise the one stored from the previous iteration, past the last changed row:
+//! from there on every later value is the same function of the same bits. The answer of every
+//! iteration is therefore bitwise the full sweep's ([`BlockPivotSolver::with_full_solves`] is
+//! that reference, and the tests compare the two bit for bit). The recurrences forget their
+//! start geometrically (the pivots at the rate `(e/d)²`, the chains at `|e/d|` per node, where
+//! columns of `C⁻¹` decay), so a flip costs a few hundred to a few thousand nodes instead of
+//! the whole bar; the pivots of a uniform mesh provably meet (the rounded pivot map is monotone:
+//! two orbits from above end at the same largest fixed point), the chains in practice, and a
+//! recurrence that never meets ends at its run's end, still exact. The margins of the indices
+//! (`λ_i = (C z − b)_i` if active, `z_i − lo_i` if free) are re-evaluated only where `z`
+//! changed and next to it; the round-off thresholds, which scale with `max|z|` (kept per block
+//! of nodes), are applied to the negative margins only.
+//!
+//! When no index is active, the factorisation of `C` computed once per run is used.
 
 use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite};
 use crate::linalg::norms::max_abs;
@@ -27,9 +54,35 @@ use crate::step::{SolveInfo, StepFailure, StepSolver};
 /// single-pivot safeguard takes over (Júdice & Pires use a small constant; 10 keeps the fast
 /// block steps through transient increases).
 pub const BLOCK_PATIENCE: u32 = 10;
-/// An index counts as infeasible only beyond this many ulps of the quantities compared: below
-/// it, the sign of `z_i − lo_i` or `λ_i` is round-off and either choice satisfies KKT.
-pub const TIE_ULPS: f64 = 64.0;
+/// An index counts as infeasible only beyond this many ulps of the quantities compared
+/// (`max(max|z|, max|lo|)` for `z_i − lo_i`, `‖C‖∞ max|z| + max|b|` for `λ_i`): below it, the
+/// sign is round-off and either choice satisfies KKT. Half the audit's floor
+/// ([`crate::step::audit::ROUNDOFF_ULPS`] = 32, on the same scales), so that an accepted answer
+/// also passes the audit with room for the rounding of its recomputed residuals (64 on
+/// `max|z| + max|lo|`, as before, let the talk's distributed scene end a step 1.4 times over
+/// the audit's primal floor).
+pub const TIE_ULPS: f64 = 16.0;
+/// Nodes per block of the running `max|z|` (a changed window recomputes its blocks, then the
+/// maximum is taken over the blocks: `n / 256` comparisons).
+const MAX_BLOCK: usize = 256;
+/// An iteration flipping more than `n / FULL_SOLVE_FLIPS` indices sweeps the whole bar instead
+/// of re-solving locally (same bits either way; the local bookkeeping does not pay then).
+const FULL_SOLVE_FLIPS: usize = 64;
+
+/// Work done by the solver so far, for profiles and for the tests that check the re-solves
+/// stay local.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PivotWork {
+    /// Solves of the whole bar (the first iteration of a step, or a reference solve).
+    pub full_solves: u64,
+    /// Iterations solved incrementally.
+    pub local_solves: u64,
+    /// Rows recomputed by the incremental iterations, summed over the pivot, forward and
+    /// backward recurrences (a full solve counts `3 n`).
+    pub local_rows: u64,
+    /// Iterations that used the factorisation of `C` (no index active).
+    pub unconstrained_solves: u64,
+}
 
 /// Exact solver for bounds at many nodes.
 #[derive(Clone, Debug)]
@@ -41,14 +94,36 @@ pub struct BlockPivotSolver {
     /// Constrained nodes (strictly increasing) and, per node, its constraint index or `NONE`.
     nodes: Vec<usize>,
     slot: Vec<usize>,
-    /// Active flags per constraint, kept from the previous step (warm start).
+    /// Every node is constrained (`nodes = 0..n`).
+    all_constrained: bool,
+    /// Per node: active (`z_i = lo_i`), kept from the previous step (warm start); always
+    /// false at unconstrained nodes.
     active: Vec<bool>,
-    diag: Vec<f64>,
-    off: Vec<f64>,
-    l: Vec<f64>,
+    active_count: usize,
+    /// Per node: the bound (0 at unconstrained nodes).
+    lo: Vec<f64>,
+    /// The reduced `L D Lᵀ`: `d_j`, `1/d_j`, `l_j = e_j / d_j` (the reduced off-diagonal).
+    d: Vec<f64>,
     inv_d: Vec<f64>,
-    cz: Vec<f64>,
+    l: Vec<f64>,
+    /// Forward chain `t_j` of the last solve (the backward chain reads `t_j / d_j`).
+    t: Vec<f64>,
+    /// `max|z|` per block of [`MAX_BLOCK`] nodes.
+    block_max: Vec<f64>,
+    /// Per node: the margin of the last evaluation ([`BlockPivotSolver::margin_at`]).
+    margin: Vec<f64>,
+    /// Nodes with a negative margin, increasing; those beyond the round-off threshold
+    /// (infeasible), increasing; scratch for their update; the flipped nodes.
+    negative: Vec<usize>,
     infeasible: Vec<usize>,
+    scratch: Vec<usize>,
+    flips: Vec<usize>,
+    /// Row ranges (inclusive) changed by the recurrences of an incremental iteration.
+    ranges: [Vec<(usize, usize)>; 3],
+    /// The factor `d, l, inv_d` matches `active` before the pending `flips`.
+    factor_valid: bool,
+    incremental: bool,
+    work: PivotWork,
     max_iterations: u32,
 }
 
@@ -65,77 +140,492 @@ impl BlockPivotSolver {
             slot[i] = k;
         }
         let c_norm = c.inf_norm();
+        let ranges = || Vec::with_capacity(n + 1);
         Ok(Self {
             c: c.clone(),
             c_norm,
             factor,
             nodes: nodes.to_vec(),
             slot,
-            active: vec![false; nodes.len()],
-            diag: vec![0.0; n],
-            off: vec![0.0; n.saturating_sub(1)],
-            l: vec![0.0; n.saturating_sub(1)],
+            all_constrained: nodes.len() == n,
+            active: vec![false; n],
+            active_count: 0,
+            lo: vec![0.0; n],
+            d: vec![0.0; n],
             inv_d: vec![0.0; n],
-            cz: vec![0.0; n],
+            l: vec![0.0; n.saturating_sub(1)],
+            t: vec![0.0; n],
+            block_max: vec![0.0; n.div_ceil(MAX_BLOCK)],
+            margin: vec![0.0; n],
+            negative: Vec::with_capacity(nodes.len()),
             infeasible: Vec::with_capacity(nodes.len()),
+            scratch: Vec::with_capacity(nodes.len()),
+            flips: Vec::with_capacity(nodes.len()),
+            ranges: [ranges(), ranges(), ranges()],
+            factor_valid: false,
+            incremental: true,
+            work: PivotWork::default(),
             // Murty's rule is finite but may in theory need many pivots; beyond this the step
             // fails with an error instead of returning an unverified point.
             max_iterations: 50 * (nodes.len() as u32).max(1) + 100,
         })
     }
 
-    fn is_active(&self, i: usize) -> bool {
-        let k = self.slot[i];
-        k != NONE && self.active[k]
+    /// The same solver sweeping the whole bar at every iteration (factorisation included):
+    /// the reference the incremental re-solves must reproduce bit for bit.
+    pub fn with_full_solves(mut self) -> Self {
+        self.incremental = false;
+        self
     }
 
-    /// Solves with the current active set: `z_A = lo_A`, `C_FF z_F = b_F − C_FA lo_A`.
-    fn solve_reduced(&mut self, rhs: &[f64], lower: &[f64], z: &mut [f64]) {
-        let n = z.len();
-        if !self.active.iter().any(|&a| a) {
-            self.factor.solve_into(rhs, z);
-            return;
+    /// Work done so far.
+    pub fn work(&self) -> PivotWork {
+        self.work
+    }
+
+    // ---- the reduced system, row by row --------------------------------------------------
+
+    #[inline(always)]
+    fn diag_r(&self, i: usize) -> f64 {
+        if self.active[i] { 1.0 } else { self.c.diag[i] }
+    }
+
+    /// The reduced off-diagonal between `i` and `i + 1`.
+    #[inline(always)]
+    fn off_r(&self, i: usize) -> f64 {
+        if self.active[i] || self.active[i + 1] {
+            0.0
+        } else {
+            self.c.off[i]
         }
-        for i in 0..n {
-            if self.is_active(i) {
-                self.diag[i] = 1.0;
-                z[i] = lower[self.slot[i]];
+    }
+
+    /// The reduced right-hand side: `lo_i` on an active row, else `b_i − C_{i,A} lo_A`.
+    #[inline(always)]
+    fn rhs_r(&self, i: usize, rhs: &[f64]) -> f64 {
+        if self.active[i] {
+            return self.lo[i];
+        }
+        let mut r = rhs[i];
+        if i > 0 && self.active[i - 1] {
+            r -= self.c.off[i - 1] * self.lo[i - 1];
+        }
+        if i + 1 < rhs.len() && self.active[i + 1] {
+            r -= self.c.off[i] * self.lo[i + 1];
+        }
+        r
+    }
+
+    /// Pivot `j` from pivot `j − 1`; whether it kept its bits.
+    #[inline(always)]
+    fn pivot_at(&mut self, j: usize) -> bool {
+        let dj = if j == 0 {
+            self.diag_r(0)
+        } else {
+            let o = self.off_r(j - 1);
+            let lj = o / self.d[j - 1];
+            self.l[j - 1] = lj;
+            self.diag_r(j) - lj * o
+        };
+        let same = dj.to_bits() == self.d[j].to_bits();
+        self.d[j] = dj;
+        self.inv_d[j] = 1.0 / dj;
+        same
+    }
+
+    /// Forward chain value at `j` from `t_{j−1}`. It restarts at every active node
+    /// (`t_j = lo_j`, `d_j = 1`) and at the free node after it (`l_{j−1} = 0`), so that a run
+    /// of free nodes is solved without reading the rest of the bar.
+    #[inline(always)]
+    fn forward_value(&self, j: usize, rhs: &[f64], t_prev: f64) -> f64 {
+        if self.active[j] {
+            self.lo[j]
+        } else {
+            let r = self.rhs_r(j, rhs);
+            if j == 0 || self.active[j - 1] {
+                r
             } else {
-                self.diag[i] = self.c.diag[i];
-                let mut r = rhs[i];
-                if i > 0 && self.is_active(i - 1) {
-                    r -= self.c.off[i - 1] * lower[self.slot[i - 1]];
-                }
-                if i + 1 < n && self.is_active(i + 1) {
-                    r -= self.c.off[i] * lower[self.slot[i + 1]];
-                }
-                z[i] = r;
-            }
-            if i + 1 < n {
-                let coupled = !self.is_active(i) && !self.is_active(i + 1);
-                self.off[i] = if coupled { self.c.off[i] } else { 0.0 };
+                r - self.l[j - 1] * t_prev
             }
         }
-        // LDLᵀ of the reduced matrix (a principal submatrix of C with identity rows: SPD).
-        let mut d_prev = self.diag[0];
-        self.inv_d[0] = 1.0 / d_prev;
-        for i in 1..n {
-            let li = self.off[i - 1] / d_prev;
-            self.l[i - 1] = li;
-            d_prev = self.diag[i] - li * self.off[i - 1];
-            self.inv_d[i] = 1.0 / d_prev;
+    }
+
+    /// Forward chain at `j`; whether `t_j` kept its bits.
+    #[inline(always)]
+    fn forward_at(&mut self, j: usize, rhs: &[f64]) -> bool {
+        let t_prev = if j == 0 { 0.0 } else { self.t[j - 1] };
+        let tj = self.forward_value(j, rhs, t_prev);
+        let same = tj.to_bits() == self.t[j].to_bits();
+        self.t[j] = tj;
+        same
+    }
+
+    /// Backward chain value at `j` from `z_{j+1}` (`z_j = w_j` where `l_j = 0`: at an active
+    /// node and before one).
+    #[inline(always)]
+    fn backward_value(&self, j: usize, n: usize, z_next: f64) -> f64 {
+        let w = self.t[j] * self.inv_d[j];
+        if j + 1 == n || self.active[j] || self.active[j + 1] {
+            w
+        } else {
+            w - self.l[j] * z_next
         }
-        let mut t = z[0];
-        z[0] = t * self.inv_d[0];
-        for ((zi, li), inv_d) in z[1..n].iter_mut().zip(&self.l).zip(&self.inv_d[1..]) {
-            t = *zi - li * t;
-            *zi = t * inv_d;
+    }
+
+    /// Backward chain at `j`; whether `z_j` kept its bits.
+    #[inline(always)]
+    fn backward_at(&self, j: usize, z: &mut [f64]) -> bool {
+        let n = z.len();
+        let z_next = if j + 1 == n { 0.0 } else { z[j + 1] };
+        let zj = self.backward_value(j, n, z_next);
+        let same = zj.to_bits() == z[j].to_bits();
+        z[j] = zj;
+        same
+    }
+
+    /// `(C z)_i`, with the bits of [`SymTridiag::mul_into`] (difference form).
+    #[inline(always)]
+    fn row_product(&self, i: usize, z: &[f64]) -> f64 {
+        let n = z.len();
+        let (s, e) = (self.c.row_sums(), &self.c.off);
+        if n == 1 {
+            self.c.diag[0] * z[0]
+        } else if i == 0 {
+            s[0] * z[0] + e[0] * (z[1] - z[0])
+        } else if i + 1 == n {
+            s[i] * z[i] + e[i - 1] * (z[i - 1] - z[i])
+        } else {
+            s[i] * z[i] + e[i - 1] * (z[i - 1] - z[i]) + e[i] * (z[i + 1] - z[i])
         }
-        let mut next = z[n - 1];
-        for i in (0..n - 1).rev() {
-            next = z[i] - self.l[i] * next;
-            z[i] = next;
+    }
+
+    // ---- whole-bar solves ---------------------------------------------------------------
+
+    fn factor_all(&mut self) {
+        for j in 0..self.d.len() {
+            self.pivot_at(j);
         }
+        self.factor_valid = true;
+    }
+
+    /// The whole-bar solve with the current factor, with every margin and the block maxima
+    /// of `|z|` evaluated inside the backward sweep (off its dependency chain).
+    /// Returns `(max|b|, max|lo|)`, taken in the forward sweep.
+    fn solve_all(&mut self, rhs: &[f64], z: &mut [f64]) -> (f64, f64) {
+        let n = z.len();
+        let (mut b_max, mut lo_max) = (0.0f64, 0.0f64);
+        {
+            // The arithmetic of `forward_value`, on local slices (no reloads through `self`),
+            // one loop per run of active or free nodes so that the chain runs through the free
+            // runs only (a select on `active` would chain every node); the tests compare the
+            // two bit for bit.
+            let (active, lo, off, l) = (&self.active[..n], &self.lo[..n], &self.c.off, &self.l);
+            let ts = &mut self.t[..n];
+            let reduced_rhs = |j: usize| {
+                let mut r = rhs[j];
+                if j > 0 && active[j - 1] {
+                    r -= off[j - 1] * lo[j - 1];
+                }
+                if j + 1 < n && active[j + 1] {
+                    r -= off[j] * lo[j + 1];
+                }
+                r
+            };
+            let mut j = 0;
+            while j < n {
+                if active[j] {
+                    while j < n && active[j] {
+                        b_max = max_of(b_max, rhs[j].abs());
+                        lo_max = max_of(lo_max, lo[j].abs());
+                        ts[j] = lo[j];
+                        j += 1;
+                    }
+                } else {
+                    b_max = max_of(b_max, rhs[j].abs());
+                    lo_max = max_of(lo_max, lo[j].abs());
+                    let mut t = reduced_rhs(j);
+                    ts[j] = t;
+                    j += 1;
+                    while j < n && !active[j] {
+                        b_max = max_of(b_max, rhs[j].abs());
+                        lo_max = max_of(lo_max, lo[j].abs());
+                        t = reduced_rhs(j) - l[j - 1] * t;
+                        ts[j] = t;
+                        j += 1;
+                    }
+                }
+            }
+        }
+        self.negative.clear();
+        // `backward_value` run by run, downwards (same remark).
+        let mut block = 0.0f64;
+        let mut j = n;
+        while j > 0 {
+            let top = j - 1;
+            let free = !self.active[top];
+            let mut z_next = 0.0;
+            while j > 0 && self.active[j - 1] != free {
+                j -= 1;
+                let w = self.t[j] * self.inv_d[j];
+                z_next = if !free || j == top { w } else { w - self.l[j] * z_next };
+                z[j] = z_next;
+                block = max_of(block, z_next.abs());
+                if j.is_multiple_of(MAX_BLOCK) {
+                    self.block_max[j / MAX_BLOCK] = block;
+                    block = 0.0;
+                }
+                if j + 1 < n {
+                    self.margin_into_negative(j + 1, rhs, z);
+                }
+            }
+        }
+        if n > 0 {
+            self.margin_into_negative(0, rhs, z);
+        }
+        self.negative.reverse();
+        self.work.full_solves += 1;
+        (b_max, lo_max)
+    }
+
+    /// Evaluates the margin of node `i` if it is constrained, and lists it when negative.
+    #[inline(always)]
+    fn margin_into_negative(&mut self, i: usize, rhs: &[f64], z: &[f64]) {
+        if self.all_constrained || self.slot[i] != NONE {
+            let m = self.margin_at(i, rhs, z);
+            // Read back only for active nodes (reactions) and negative margins.
+            if m < 0.0 {
+                self.margin[i] = m;
+                self.negative.push(i);
+            } else if self.active[i] {
+                self.margin[i] = m;
+            }
+        }
+    }
+
+    // ---- incremental re-solve after `flips` --------------------------------------------
+
+    /// Re-solves after the active flags of `self.flips` changed; leaves the rows where `z`
+    /// changed in `self.ranges[2]`.
+    fn solve_local(&mut self, rhs: &[f64], z: &mut [f64]) {
+        let n = z.len();
+        let [mut pivots, mut forward, mut backward] = std::mem::take(&mut self.ranges);
+        // Pivots: row k's diagonal and left coupling, row k + 1's left coupling.
+        backward.clear();
+        for &k in &self.flips {
+            backward.push((k, (k + 1).min(n - 1)));
+        }
+        let mut rows = 0;
+        sweep_up(n, &backward, &mut pivots, &mut rows, |j| self.pivot_at(j));
+        // Forward chain: the right-hand sides of rows k − 1..=k + 1, and the rows whose
+        // pivot or multiplier changed.
+        backward.clear();
+        let (mut p, mut f) = (0, 0);
+        while p < pivots.len() || f < self.flips.len() {
+            let from_flip = f < self.flips.len()
+                && (p == pivots.len() || self.flips[f].saturating_sub(1) <= pivots[p].0);
+            let r = if from_flip {
+                let k = self.flips[f];
+                f += 1;
+                (k.saturating_sub(1), (k + 1).min(n - 1))
+            } else {
+                p += 1;
+                pivots[p - 1]
+            };
+            push_merged(&mut backward, r);
+        }
+        sweep_up(n, &backward, &mut forward, &mut rows, |j| self.forward_at(j, rhs));
+        // Backward chain: every row whose w_j or l_j changed lies in `forward`.
+        sweep_down(n, &forward, &mut backward, &mut rows, |j| {
+            self.backward_at(j, z)
+        });
+        for &(a, b) in &backward {
+            for blk in a / MAX_BLOCK..=b / MAX_BLOCK {
+                let end = ((blk + 1) * MAX_BLOCK).min(n);
+                self.block_max[blk] = max_abs(&z[blk * MAX_BLOCK..end]);
+            }
+        }
+        self.ranges = [pivots, forward, backward];
+        self.work.local_solves += 1;
+        self.work.local_rows += rows as u64;
+    }
+
+    // ---- feasibility ------------------------------------------------------------------
+
+    /// The margin of index `i`: `λ_i = (C z − b)_i` when active, `z_i − lo_i` when free; the
+    /// index is infeasible when its margin is below minus the round-off threshold.
+    #[inline(always)]
+    fn margin_at(&self, i: usize, rhs: &[f64], z: &[f64]) -> f64 {
+        if self.active[i] {
+            self.row_product(i, z) - rhs[i]
+        } else {
+            z[i] - self.lo[i]
+        }
+    }
+
+    /// Re-evaluates every margin.
+    fn margins_all(&mut self, rhs: &[f64], z: &[f64]) {
+        self.negative.clear();
+        for k in 0..self.nodes.len() {
+            let i = self.nodes[k];
+            let m = self.margin_at(i, rhs, z);
+            self.margin[i] = m;
+            if m < 0.0 {
+                self.negative.push(i);
+            }
+        }
+    }
+
+    /// Re-evaluates the margins within one node of the rows where `z` changed
+    /// (`self.ranges[2]`, which include the flipped nodes).
+    fn margins_changed(&mut self, rhs: &[f64], z: &[f64]) {
+        let n = z.len();
+        let ranges = std::mem::take(&mut self.ranges);
+        let old = std::mem::take(&mut self.negative);
+        let mut merged = std::mem::take(&mut self.scratch);
+        merged.clear();
+        let mut o = 0;
+        let mut last = None::<usize>;
+        for &(a, b) in &ranges[2] {
+            let (a, b) = (a.saturating_sub(1), (b + 1).min(n - 1));
+            // Windows may touch: never evaluate a node twice.
+            let a = last.map_or(a, |l| a.max(l + 1));
+            while o < old.len() && old[o] < a {
+                merged.push(old[o]);
+                o += 1;
+            }
+            while o < old.len() && old[o] <= b {
+                o += 1;
+            }
+            for i in a..=b {
+                if self.slot[i] != NONE {
+                    let m = self.margin_at(i, rhs, z);
+                    self.margin[i] = m;
+                    if m < 0.0 {
+                        merged.push(i);
+                    }
+                }
+            }
+            last = Some(b);
+        }
+        merged.extend_from_slice(&old[o..]);
+        self.ranges = ranges;
+        self.scratch = old;
+        self.negative = merged;
+    }
+
+    /// The infeasible indices: negative margins beyond the thresholds.
+    fn select_infeasible(&mut self, tol_z: f64, tol_l: f64) {
+        self.infeasible.clear();
+        for &i in &self.negative {
+            let tol = if self.active[i] { tol_l } else { tol_z };
+            if self.margin[i] < -tol {
+                self.infeasible.push(i);
+            }
+        }
+    }
+}
+
+/// Runs the recurrence `step` upwards over the rows of the sorted, disjoint ranges `dirty`
+/// (rows whose inputs changed), continuing past a range until `step` reports the carried value
+/// unchanged; the recomputed rows go to `out` (sorted, disjoint), their count to `rows`.
+fn sweep_up(
+    n: usize,
+    dirty: &[(usize, usize)],
+    out: &mut Vec<(usize, usize)>,
+    rows: &mut usize,
+    mut step: impl FnMut(usize) -> bool,
+) {
+    out.clear();
+    let mut next = 0;
+    while next < dirty.len() {
+        let (start, mut must) = dirty[next];
+        let mut j = start;
+        loop {
+            while next < dirty.len() && dirty[next].0 <= j {
+                must = must.max(dirty[next].1);
+                next += 1;
+            }
+            let same = step(j);
+            *rows += 1;
+            if j + 1 == n || (same && j >= must) {
+                break;
+            }
+            j += 1;
+        }
+        push_merged(out, (start, j));
+    }
+}
+
+/// [`sweep_up`] downwards: the recurrence carries from row `j + 1` to row `j`.
+fn sweep_down(
+    n: usize,
+    dirty: &[(usize, usize)],
+    out: &mut Vec<(usize, usize)>,
+    rows: &mut usize,
+    mut step: impl FnMut(usize) -> bool,
+) {
+    debug_assert!(dirty.iter().all(|r| r.1 < n));
+    out.clear();
+    let mut next = dirty.len();
+    while next > 0 {
+        let (mut must, start) = dirty[next - 1];
+        let mut j = start;
+        loop {
+            while next > 0 && dirty[next - 1].1 >= j {
+                must = must.min(dirty[next - 1].0);
+                next -= 1;
+            }
+            let same = step(j);
+            *rows += 1;
+            if j == 0 || (same && j <= must) {
+                break;
+            }
+            j -= 1;
+        }
+        out.push((j, start));
+    }
+    out.reverse();
+    // Adjacent ranges found downwards are merged after the reversal.
+    let mut w = 0;
+    for r in 0..out.len() {
+        let cur = out[r];
+        if w > 0 && cur.0 <= out[w - 1].1 + 1 {
+            out[w - 1].1 = out[w - 1].1.max(cur.1);
+        } else {
+            out[w] = cur;
+            w += 1;
+        }
+    }
+    out.truncate(w);
+}
+
+/// `m.max(x)` for a running maximum `m` that is not NaN (it starts at 0): the same value (a
+/// NaN `x` is ignored either way) in one `maxsd`, without `f64::max`'s NaN blend on the
+/// dependency chain.
+#[inline(always)]
+fn max_of(m: f64, x: f64) -> f64 {
+    if x > m { x } else { m }
+}
+
+/// [`max_abs`] with four accumulators (the same value: a maximum does not depend on the order;
+/// NaNs are ignored either way), off the single chain of dependent comparisons.
+fn max_abs_4(v: &[f64]) -> f64 {
+    let mut m = [0.0f64; 4];
+    let chunks = v.chunks_exact(4);
+    let rest = max_abs(chunks.remainder());
+    for c in chunks {
+        for k in 0..4 {
+            m[k] = m[k].max(c[k].abs());
+        }
+    }
+    m[0].max(m[1]).max(m[2].max(m[3])).max(rest)
+}
+
+/// Appends `r` to sorted ranges, merging it with the last one when they overlap or touch.
+fn push_merged(out: &mut Vec<(usize, usize)>, r: (usize, usize)) {
+    match out.last_mut() {
+        Some(last) if r.0 <= last.1 + 1 => last.1 = last.1.max(r.1),
+        _ => out.push(r),
     }
 }
 
@@ -152,37 +642,76 @@ impl StepSolver for BlockPivotSolver {
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
         let eps = f64::EPSILON;
-        let b_max = max_abs(rhs);
-        let lo_max = max_abs(lower);
+        let n = z.len();
+        // `(max|b|, max|lo|)`, taken by the step's first solve.
+        let mut maxima = None;
+        if self.all_constrained {
+            // Every node constrained (nodes = 0..n).
+            self.lo.copy_from_slice(lower);
+        } else {
+            let lo = &mut self.lo[..];
+            for (&i, &v) in self.nodes.iter().zip(lower) {
+                lo[i] = v;
+            }
+        }
         let mut best_count = usize::MAX;
         let mut patience = BLOCK_PATIENCE;
+        // Whether `t` and `z` hold this step's sweep with `active` before `flips`.
+        let mut swept = false;
+        if !self.flips.is_empty() {
+            // A failed solve left flips unsolved: the factor no longer matches.
+            self.factor_valid = false;
+            self.flips.clear();
+        }
         for iteration in 1..=self.max_iterations {
-            self.solve_reduced(rhs, lower, z);
-            self.c.mul_into(z, &mut self.cz);
-            let z_max = max_abs(z.iter());
+            let local = self.incremental
+                && swept
+                && self.factor_valid
+                && self.flips.len() * FULL_SOLVE_FLIPS <= n;
+            if self.active_count == 0 {
+                self.factor.solve_into(rhs, z);
+                self.factor_valid = false;
+                swept = false;
+                self.work.unconstrained_solves += 1;
+                for (b, chunk) in self.block_max.iter_mut().zip(z.chunks(MAX_BLOCK)) {
+                    *b = max_abs(chunk);
+                }
+                maxima.get_or_insert_with(|| (max_abs_4(rhs), max_abs_4(lower)));
+            } else if local {
+                self.solve_local(rhs, z);
+            } else {
+                if !self.incremental || !self.factor_valid || !self.flips.is_empty() {
+                    self.factor_all();
+                }
+                let m = self.solve_all(rhs, z);
+                maxima.get_or_insert(m);
+                swept = true;
+            }
+            let (b_max, lo_max) = maxima.expect("the first iteration is not local");
+            let z_max = max_abs(&self.block_max);
             if !z_max.is_finite() {
                 return Err(StepFailure::NonFinite);
             }
-            let tol_z = TIE_ULPS * eps * (z_max + lo_max);
+            let tol_z = TIE_ULPS * eps * z_max.max(lo_max);
             let tol_l = TIE_ULPS * eps * (self.c_norm * z_max + b_max);
-            self.infeasible.clear();
-            for (k, &i) in self.nodes.iter().enumerate() {
-                let bad = if self.active[k] {
-                    self.cz[i] - rhs[i] < -tol_l
-                } else {
-                    z[i] < lower[k] - tol_z
-                };
-                if bad {
-                    self.infeasible.push(k);
-                }
+            if local {
+                self.margins_changed(rhs, z);
+            } else if !swept {
+                self.margins_all(rhs, z);
             }
+            self.select_infeasible(tol_z, tol_l);
+            self.flips.clear();
             if self.infeasible.is_empty() {
-                for (k, &i) in self.nodes.iter().enumerate() {
-                    reactions[k] = if self.active[k] {
-                        (self.cz[i] - rhs[i]).max(0.0)
-                    } else {
-                        0.0
-                    };
+                let (active, margin) = (&self.active[..], &self.margin[..]);
+                let reaction = |i: usize| if active[i] { margin[i].max(0.0) } else { 0.0 };
+                if self.all_constrained {
+                    for (i, r) in reactions[..n].iter_mut().enumerate() {
+                        *r = reaction(i);
+                    }
+                } else {
+                    for (r, &i) in reactions.iter_mut().zip(&self.nodes) {
+                        *r = reaction(i);
+                    }
                 }
                 return Ok(SolveInfo {
                     iterations: iteration,
@@ -195,13 +724,18 @@ impl StepSolver for BlockPivotSolver {
             } else {
                 patience = patience.saturating_sub(1);
             }
-            if patience > 0 || count < best_count {
-                for &k in &self.infeasible {
-                    self.active[k] = !self.active[k];
-                }
+            if patience > 0 {
+                self.flips.extend_from_slice(&self.infeasible);
             } else {
-                let k = *self.infeasible.last().expect("non-empty");
-                self.active[k] = !self.active[k];
+                self.flips.push(*self.infeasible.last().expect("non-empty"));
+            }
+            for &i in &self.flips {
+                self.active[i] = !self.active[i];
+                if self.active[i] {
+                    self.active_count += 1;
+                } else {
+                    self.active_count -= 1;
+                }
             }
         }
         Err(StepFailure::IterationLimit {
