@@ -1,7 +1,7 @@
 //! Prints the last criterion measurements of `benches/step.rs` and `benches/scenes.rs` as
 //! Markdown (median time per step or per run, ns per node-step, and for steps the ratio to the
-//! unconstrained step at equal J), read from `target/criterion/{step,scenes}/*/…/new/
-//! estimates.json`, followed by issue 7's targets, each marked met or not met. Run after
+//! unconstrained step at equal J), read from `target/criterion/{step,scenes,load,setup}/*/…/new/
+//! estimates.json`, followed by the targets of issues 7 and 17, each marked met or not met. Run after
 //! `cargo bench --bench step` and `cargo bench --bench scenes`:
 //!
 //!     cargo run --release --example bench_table
@@ -21,6 +21,14 @@ const EXACT_RATIO_TARGET: f64 = 1.15;
 /// does not separate (two transcendental calls), per node-step.
 const FORCED_RATIO_TARGET: f64 = 1.3;
 const MIXED_LOAD_NS_TARGET: f64 = 30.0;
+
+/// Issue 17's set-up and output targets: a one-step run of the 16384-element two-end bar (ms),
+/// the 400-step run against its steps alone, that run's ns per node-step, and the refined
+/// 1e5-element run end to end (ns per node-step).
+const ONE_STEP_MS_TARGET: f64 = 5.0;
+const SETUP_RATIO_TARGET: f64 = 1.3;
+const SETUP_NS_TARGET: f64 = 4.5;
+const REFINED_NS_TARGET: f64 = 3.0;
 
 /// Rows measured this long before the newest row of their group are stale.
 const STALE_AFTER_S: u64 = 3600;
@@ -81,7 +89,7 @@ fn verdict(ok: bool) -> &'static str {
 fn main() {
     let target = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/criterion");
     let (rows, stale) = fresh(step_rows(&target.join("step")));
-    if rows.is_empty() && !target.join("load").exists() {
+    if rows.is_empty() && !target.join("load").exists() && !target.join("setup").exists() {
         eprintln!("no measurements in target/criterion/step: run `cargo bench --bench step` first");
         std::process::exit(1);
     }
@@ -162,6 +170,63 @@ fn main() {
                     verdict(per <= MIXED_LOAD_NS_TARGET)
                 );
             }
+        }
+    }
+    let mut setup_runs = BTreeMap::new();
+    for entry in std::fs::read_dir(target.join("setup")).into_iter().flatten().flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if let Some(t) = median_ns(&entry.path().join("new/estimates.json")) {
+            setup_runs.insert(name, t);
+        }
+    }
+    let (setup, stale_setup) = fresh(setup_runs);
+    if !setup.is_empty() {
+        // Node-steps of each run (`benches/scenes.rs`, group `setup`).
+        let node_steps = |name: &str| match name {
+            "one-step" => 16_385.0,
+            "refined-1e5" => 100_001.0 * 1600.0,
+            _ => 16_385.0 * 400.0,
+        };
+        println!();
+        println!("| run (`setup` group, files written) | median | ns per node-step |");
+        println!("|---|---|---|");
+        for (name, t) in &setup {
+            println!(
+                "| {name} | {:.2} ms | {:.2} |",
+                t / 1e6,
+                t / node_steps(name)
+            );
+        }
+        for name in &stale_setup {
+            println!("| {name} (stale) | | |");
+        }
+        println!();
+        println!("Targets (issue 17, set-up and output):");
+        if let Some(t) = setup.get("one-step") {
+            println!(
+                "- one-step run, 16384 elements: {:.2} ms (target <= {ONE_STEP_MS_TARGET}): {}",
+                t / 1e6,
+                verdict(t / 1e6 <= ONE_STEP_MS_TARGET)
+            );
+        }
+        if let (Some(run), Some(steps)) = (setup.get("400-steps"), setup.get("400-steps-stepping")) {
+            println!(
+                "- 400-step run: {:.2}x its steps alone (target <= {SETUP_RATIO_TARGET}): {}",
+                run / steps,
+                verdict(run / steps <= SETUP_RATIO_TARGET)
+            );
+            let per = run / node_steps("400-steps");
+            println!(
+                "- 400-step run: {per:.2} ns per node-step (target <= {SETUP_NS_TARGET}): {}",
+                verdict(per <= SETUP_NS_TARGET)
+            );
+        }
+        if let Some(t) = setup.get("refined-1e5") {
+            let per = t / node_steps("refined-1e5");
+            println!(
+                "- refined run, 1e5 elements, 1600 steps, default output: {per:.2} ns per node-step (target <= {REFINED_NS_TARGET}): {}",
+                verdict(per <= REFINED_NS_TARGET)
+            );
         }
     }
     println!();

@@ -3,8 +3,8 @@
 
 use crate::scene::Scene;
 use crate::time::RunError;
-use crate::time::simulation::{Simulation, StepRecord};
-use crate::time::summary::{Summary, Tracker, output_time};
+use crate::time::simulation::{NodeValues, Simulation, StepRecord, Unstarted};
+use crate::time::summary::{Summary, Tracker, output_time, push_output_time};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -41,12 +41,12 @@ pub fn run_to_dir(
     progress: bool,
 ) -> Result<Summary, RunError> {
     let start = Instant::now();
-    let sim = Simulation::new(scene)?;
+    let prepared = Simulation::prepare(scene)?;
     write_whole(
         out,
         &RUN_FILES,
         |path, source| RunError::Write { path, source },
-        |tmp| write_run(name, scene, sim, start, tmp, progress),
+        |tmp| write_run(name, scene, prepared, start, tmp, progress),
     )
 }
 
@@ -149,34 +149,32 @@ impl Progress {
 fn write_run(
     name: &str,
     scene: &Scene,
-    mut sim: Simulation,
+    prepared: Unstarted,
     start: Instant,
     dir: &Path,
     progress: bool,
 ) -> Result<Summary, RunError> {
-    let open = |file: &str| -> Result<(PathBuf, std::io::BufWriter<std::fs::File>), RunError> {
-        let path = dir.join(file);
-        let f = std::fs::File::create(&path).map_err(|source| RunError::Write {
+    let path = |file: &str| dir.join(file);
+    let create = |path: &PathBuf| {
+        std::fs::File::create(path).map_err(|source| RunError::Write {
             path: path.clone(),
             source,
-        })?;
-        Ok((path, std::io::BufWriter::with_capacity(1 << 20, f)))
+        })
     };
-    let (hist_path, mut hist) = open("history.csv")?;
-    let (disp_path, mut disp) = open("displacement.csv")?;
+    let hist_path = path("history.csv");
+    let mut hist = std::io::BufWriter::with_capacity(HISTORY_BUFFER_BYTES, create(&hist_path)?);
     let io = |path: &PathBuf| {
         let path = path.clone();
         move |source| RunError::Write { path, source }
     };
 
-    let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
-    let sides: Vec<&str> = sim
-        .discretisation()
+    let disc = prepared.discretisation();
+    let sides: Vec<&str> = disc
         .constraints
         .iter()
         .filter_map(|c| c.side.map(|s| s.name()))
         .collect();
-    let obstacle = !sim.discretisation().ends_only();
+    let obstacle = !disc.ends_only();
     let mut header = String::from(
         "step,t,energy,work,viscous_dissipation,contact_dissipation,identity_residual",
     );
@@ -188,54 +186,218 @@ fn write_run(
     }
     header.push_str(",iterations");
     writeln!(hist, "{header}").map_err(io(&hist_path))?;
+
+    // `t = 0` is written before the start-up step moves `u^0` on.
+    let sampling = scene.output_sampling();
+    let disp_path = path("displacement.csv");
+    let mut disp = ProfileCsv::new(create(&disp_path)?, disc, sampling);
+    disp.write(0.0, prepared.node_values())
+        .map_err(io(&disp_path))?;
+    let mut sim = prepared.start()?;
+    let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
     write_history_row(&mut hist, &sim.first_record(), sides.len(), obstacle)
         .map_err(io(&hist_path))?;
-
-    let nodes = sim.discretisation().nodes;
-    let disc = sim.discretisation();
-    writeln!(disp, "t,x,u,v").map_err(io(&disp_path))?;
-    let mut u = vec![0.0; nodes];
-    let mut v = vec![0.0; nodes];
-    sim.initial_state_into(&mut u, &mut v);
-    // The written x, rounded once for the run rather than at every kept step.
-    let sampling = scene.output_sampling();
-    let written: Vec<usize> = (0..nodes)
-        .filter(|&i| sampling.writes_node(i, nodes))
-        .collect();
-    let xs: Vec<String> = written
-        .iter()
-        .map(|&i| output_time(disc.x(i)).to_string())
-        .collect();
-    write_profile(&mut disp, 0.0, &xs, &written, &u, &v).map_err(io(&disp_path))?;
     let steps = scene.steps();
     let every = scene.output.every as usize;
+    let nodes = sim.discretisation().nodes;
     let bar = Progress::new(progress, steps, nodes);
     let keep = |n: usize| n.is_multiple_of(every) || n == steps;
     if keep(1) {
-        sim.displacement_into(&mut u);
-        sim.velocity_into(&mut v);
-        write_profile(&mut disp, sim.time(), &xs, &written, &u, &v).map_err(io(&disp_path))?;
+        disp.write(sim.time(), sim.node_values())
+            .map_err(io(&disp_path))?;
     }
     for _ in 1..steps {
         let r = sim.step()?;
         tracker.observe(&r);
         write_history_row(&mut hist, &r, sides.len(), obstacle).map_err(io(&hist_path))?;
         if keep(r.step) {
-            sim.displacement_into(&mut u);
-            sim.velocity_into(&mut v);
-            write_profile(&mut disp, sim.time(), &xs, &written, &u, &v).map_err(io(&disp_path))?;
+            disp.write(sim.time(), sim.node_values())
+                .map_err(io(&disp_path))?;
         }
         bar.step(r.step);
     }
     bar.finish();
     hist.flush().map_err(io(&hist_path))?;
-    disp.flush().map_err(io(&disp_path))?;
+    disp.finish().map_err(io(&disp_path))?;
     let mut summary = tracker.finish(name, &sim, start.elapsed().as_secs_f64());
     summary.output = Some(sampling);
-    let json_path = dir.join("summary.json");
+    let json_path = path("summary.json");
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
     std::fs::write(&json_path, json + "\n").map_err(io(&json_path))?;
     Ok(summary)
+}
+
+/// Buffer of `history.csv` (a row a step, about 100 bytes).
+const HISTORY_BUFFER_BYTES: usize = 1 << 16;
+/// `displacement.csv` is written in chunks of about this size: large enough that the write
+/// calls cost little next to the formatting, small enough that a short run does not touch
+/// (and page-fault in) a buffer larger than its file.
+const PROFILE_CHUNK_BYTES: usize = 1 << 17;
+/// Room for a row `t,x,u,v\n` with padded fields: `t` and `x` in fields of [`FIELD_BYTES`]
+/// (the second written over the first's padding), `u` and `v` of at most 24 bytes each
+/// (`-1.2345678901234567e-308`), two separators.
+const PROFILE_ROW_MAX_BYTES: usize = 2 * FIELD_BYTES + 2 * 24 + 2;
+
+/// `displacement.csv`: one row `t,x,u,v` a written node at each kept step. `t` and `x` are
+/// rounded (see [`output_time`]) and written as `Display` would, `x` formatted once per run;
+/// `u` and `v` in the shortest form that reads back to the same `f64` (Żmij; `1.5e-7` rather
+/// than `0.00000015`), several times faster than `core::fmt`. Rows are built in a chunk that
+/// goes to the file when nearly full; `t` and `x` are copied as fixed-size fields (their
+/// text padded to [`FIELD_BYTES`]) and the next field overwrites the padding.
+struct ProfileCsv {
+    file: std::fs::File,
+    /// The chunk, `PROFILE_CHUNK_BYTES` long; `len` bytes of it are rows.
+    chunk: Vec<u8>,
+    len: usize,
+    /// The written nodes: every `stride`-th and the last of `nodes`.
+    stride: usize,
+    nodes: usize,
+    /// Each written node's `x,` padded to [`FIELD_BYTES`], and its length.
+    xs: Vec<([u8; FIELD_BYTES], u8)>,
+    /// Rows whose `t` or `x` text is longer than a field (a time or a bar beyond 1e22, written
+    /// in full by `Display`) go through this slow path instead.
+    long_fields: bool,
+    /// Each written node's `x,` text when `long_fields`.
+    long_xs: Vec<Vec<u8>>,
+}
+
+/// Room for the text of a rounded `t` or `x` and its comma: 12 digits, a point, up to 10
+/// leading zeros (`0.0000000000123456789012,`) and a sign fit.
+const FIELD_BYTES: usize = 32;
+
+impl ProfileCsv {
+    fn new(
+        file: std::fs::File,
+        disc: &crate::time::simulation::Discretisation,
+        sampling: crate::scene::OutputSampling,
+    ) -> Self {
+        let stride = usize::try_from(sampling.node_stride).unwrap_or(usize::MAX);
+        let nodes = disc.nodes;
+        let x_text = |i: usize, text: &mut Vec<u8>| {
+            text.clear();
+            push_output_time(disc.x(i), text);
+            text.push(b',');
+        };
+        let mut xs = Vec::with_capacity(usize::try_from(sampling.nodes_written).unwrap_or(0));
+        let mut long_fields = false;
+        let mut text = Vec::with_capacity(FIELD_BYTES);
+        for i in written_nodes(stride, nodes) {
+            x_text(i, &mut text);
+            long_fields |= text.len() > FIELD_BYTES;
+            xs.push(field(&text));
+        }
+        let long_xs = if long_fields {
+            (written_nodes(stride, nodes).map(|i| {
+                let mut text = Vec::new();
+                x_text(i, &mut text);
+                text
+            }))
+            .collect()
+        } else {
+            Vec::new()
+        };
+        let mut chunk = vec![0; PROFILE_CHUNK_BYTES];
+        let header = b"t,x,u,v\n";
+        chunk[..header.len()].copy_from_slice(header);
+        Self {
+            file,
+            chunk,
+            len: header.len(),
+            stride,
+            nodes,
+            xs,
+            long_fields,
+            long_xs,
+        }
+    }
+
+    /// The rows of one kept step at time `t`.
+    fn write(&mut self, t: f64, values: NodeValues<'_>) -> std::io::Result<()> {
+        let mut t_text = Vec::with_capacity(FIELD_BYTES);
+        push_output_time(t, &mut t_text);
+        t_text.push(b',');
+        if self.long_fields || t_text.len() > FIELD_BYTES {
+            return self.write_long(&t_text, values);
+        }
+        let (t_field, t_len) = field(&t_text);
+        let t_len = usize::from(t_len);
+        let (mut bu, mut bv) = (zmij::Buffer::new(), zmij::Buffer::new());
+        for (i, (x_field, x_len)) in written_nodes(self.stride, self.nodes).zip(&self.xs) {
+            let (u, v) = values.at(i);
+            if self.len > PROFILE_CHUNK_BYTES - PROFILE_ROW_MAX_BYTES {
+                self.file.write_all(&self.chunk[..self.len])?;
+                self.len = 0;
+            }
+            let row = &mut self.chunk[self.len..self.len + PROFILE_ROW_MAX_BYTES];
+            row[..FIELD_BYTES].copy_from_slice(&t_field);
+            let mut at = t_len;
+            row[at..at + FIELD_BYTES].copy_from_slice(x_field);
+            at += usize::from(*x_len);
+            let u = bu.format(u).as_bytes();
+            row[at..at + u.len()].copy_from_slice(u);
+            at += u.len();
+            row[at] = b',';
+            at += 1;
+            let v = bv.format(v).as_bytes();
+            row[at..at + v.len()].copy_from_slice(v);
+            at += v.len();
+            row[at] = b'\n';
+            self.len += at + 1;
+        }
+        Ok(())
+    }
+
+    /// [`ProfileCsv::write`] for texts longer than a field.
+    fn write_long(&mut self, t_text: &[u8], values: NodeValues<'_>) -> std::io::Result<()> {
+        if self.long_xs.is_empty() {
+            // Only `t` is long: the short `x` texts, unpadded.
+            self.long_xs = self
+                .xs
+                .iter()
+                .map(|(f, len)| f[..usize::from(*len)].to_vec())
+                .collect();
+            self.long_fields = true;
+        }
+        self.file.write_all(&self.chunk[..self.len])?;
+        self.len = 0;
+        let mut rows = Vec::new();
+        let (mut bu, mut bv) = (zmij::Buffer::new(), zmij::Buffer::new());
+        for (i, x) in written_nodes(self.stride, self.nodes).zip(&self.long_xs) {
+            let (u, v) = values.at(i);
+            rows.extend_from_slice(t_text);
+            rows.extend_from_slice(x);
+            rows.extend_from_slice(bu.format(u).as_bytes());
+            rows.push(b',');
+            rows.extend_from_slice(bv.format(v).as_bytes());
+            rows.push(b'\n');
+            if rows.len() > PROFILE_CHUNK_BYTES {
+                self.file.write_all(&rows)?;
+                rows.clear();
+            }
+        }
+        self.file.write_all(&rows)
+    }
+
+    fn finish(self) -> std::io::Result<()> {
+        let mut file = self.file;
+        file.write_all(&self.chunk[..self.len])
+    }
+}
+
+/// `text` padded to a field, with its length (`text` no longer than a field).
+fn field(text: &[u8]) -> ([u8; FIELD_BYTES], u8) {
+    let mut f = [0; FIELD_BYTES];
+    let len = text.len().min(FIELD_BYTES);
+    f[..len].copy_from_slice(&text[..len]);
+    (f, len as u8)
+}
+
+/// Every `stride`-th of `nodes` nodes and the last ([`crate::scene::OutputSampling::writes_node`]).
+fn written_nodes(stride: usize, nodes: usize) -> impl Iterator<Item = usize> {
+    let last = nodes.checked_sub(1);
+    (0..nodes)
+        .step_by(stride.max(1))
+        .chain(last.filter(|&l| !l.is_multiple_of(stride.max(1))))
 }
 
 fn write_history_row(
@@ -275,33 +437,6 @@ fn write_history_row(
         write!(w, ",{},{},{},{}", r.contact_nodes, x(lo), x(hi), r.min_gap)?;
     }
     writeln!(w, ",{}", r.iterations)
-}
-
-/// One row a written node (`nodes`, with their `xs`), `t,x,u,v`: `t` and `x` rounded (see [`output_time`]), `x` from the run's
-/// `xs` (formatted once per run), `u` and `v` in the shortest form that reads back to the same
-/// `f64` (Żmij; `1.5e-7` rather than `0.00000015`), several times faster than `core::fmt`.
-fn write_profile(
-    w: &mut impl Write,
-    t: f64,
-    xs: &[String],
-    nodes: &[usize],
-    u: &[f64],
-    v: &[f64],
-) -> std::io::Result<()> {
-    let t = output_time(t).to_string();
-    let (mut bu, mut bv) = (zmij::Buffer::new(), zmij::Buffer::new());
-    for (x, &i) in xs.iter().zip(nodes) {
-        let (u, v) = (u[i], v[i]);
-        w.write_all(t.as_bytes())?;
-        w.write_all(b",")?;
-        w.write_all(x.as_bytes())?;
-        w.write_all(b",")?;
-        w.write_all(bu.format(u).as_bytes())?;
-        w.write_all(b",")?;
-        w.write_all(bv.format(v).as_bytes())?;
-        w.write_all(b"\n")?;
-    }
-    Ok(())
 }
 
 /// Writes `bytes` to `path` whole or not at all: a temporary file in the same folder, then a

@@ -184,14 +184,20 @@ struct GeneralLoad {
     eval: NodalEvaluator,
     mass_full: SymTridiag,
     nodal: Vec<f64>,
+    /// `M l` on all nodes, when a clamped end makes the unknowns fewer than the nodes (empty
+    /// otherwise: the product goes straight into `force`).
     full: Vec<f64>,
 }
 
 impl GeneralLoad {
     fn force_into(&mut self, t: f64, first: usize, force: &mut [f64]) -> Result<(), SceneError> {
         self.eval.eval_into(t, &mut self.nodal)?;
-        self.mass_full.mul_into(&self.nodal, &mut self.full);
-        force.copy_from_slice(&self.full[first..first + force.len()]);
+        if force.len() == self.nodal.len() {
+            self.mass_full.mul_into(&self.nodal, force);
+        } else {
+            self.mass_full.mul_into(&self.nodal, &mut self.full);
+            force.copy_from_slice(&self.full[first..first + force.len()]);
+        }
         Ok(())
     }
 }
@@ -241,6 +247,14 @@ impl Simulation {
         Self::with_solver(scene, disc, solver)
     }
 
+    /// Sets `scene` up as [`Simulation::new`] does, short of the start-up step: for a run
+    /// that writes `u^0` and `u_1` first and starts afterwards (without a copy of `u^0`).
+    pub fn prepare(scene: &Scene) -> Result<Unstarted, RunError> {
+        let disc = Discretisation::new(scene)?;
+        let solver = make_solver(scene, &disc)?;
+        Self::prepare_with_solver(scene, disc, solver)
+    }
+
     /// Sets up a run with a given step solver (built for `disc.step_matrix` and
     /// `disc.constrained_locals()`), and takes the start-up step to `u^1`.
     ///
@@ -255,6 +269,15 @@ impl Simulation {
         disc: Discretisation,
         solver: Box<dyn StepSolver>,
     ) -> Result<Self, RunError> {
+        Self::prepare_with_solver(scene, disc, solver)?.start()
+    }
+
+    /// [`Simulation::with_solver`] short of the start-up step.
+    fn prepare_with_solver(
+        scene: &Scene,
+        disc: Discretisation,
+        solver: Box<dyn StepSolver>,
+    ) -> Result<Unstarted, RunError> {
         scene.validate()?;
         let nodes = disc.nodes;
         let n = disc.unknowns();
@@ -288,8 +311,13 @@ impl Simulation {
             }
         }
         let range = disc.first..disc.first + n;
-        // `force` holds F^n; a time-independent load fills it once, here.
-        let mut force = vec![0.0; n];
+        // `force` holds F^n; a time-independent load fills it once, here. Without a load it
+        // stays empty (the kernels do not read it; `load_vector` gives zeros).
+        let mut force = if scene.load.density.is_some() {
+            vec![0.0; n]
+        } else {
+            Vec::new()
+        };
         let load = match &scene.load.density {
             None => LoadTerm::None,
             Some(text) => {
@@ -313,7 +341,11 @@ impl Simulation {
                             ),
                             mass_full: matrices::mass(disc.variant, nodes, disc.dx),
                             nodal: vec![0.0; nodes],
-                            full: vec![0.0; nodes],
+                            full: if n == nodes {
+                                Vec::new()
+                            } else {
+                                vec![0.0; nodes]
+                            },
                         }),
                         Some(parts) => {
                             let mut terms = Vec::with_capacity(parts.len());
@@ -340,7 +372,7 @@ impl Simulation {
             v
         };
         let (u, v0) = (restrict(u0_full), restrict(v0_full));
-        let mut sim = Self {
+        let sim = Self {
             solver,
             load,
             n: 0,
@@ -366,8 +398,7 @@ impl Simulation {
             first_record: StepRecord::default(),
             disc,
         };
-        sim.start_up(&v0)?;
-        Ok(sim)
+        Ok(Unstarted { sim, v0 })
     }
 
     /// The start-up step; `z`, `w` and `rhs` serve as its work space (no J-sized temporaries).
@@ -379,7 +410,9 @@ impl Simulation {
         self.disc.stiffness.mul_into(&self.u, acc);
         self.disc.stiffness.mul_into(v0, rv);
         for i in 0..acc.len() {
-            acc[i] = self.force[i] - acc[i] - self.disc.alpha * rv[i];
+            // `0.0 − …` without a load: the bits of a zero force vector.
+            let f = self.force.get(i).copied().unwrap_or(0.0);
+            acc[i] = f - acc[i] - self.disc.alpha * rv[i];
         }
         solve_on_massive_nodes(&self.disc, acc)?;
         // The Taylor increment, in w (w becomes the increment z after the step).
@@ -437,6 +470,9 @@ impl Simulation {
     /// the load path; the next step recomputes its own).
     pub fn load_vector(&mut self, n: usize) -> Result<&[f64], SceneError> {
         self.update_force(n)?;
+        if matches!(self.load, LoadTerm::None) {
+            self.force.resize(self.u.len(), 0.0);
+        }
         Ok(&self.force)
     }
 
@@ -691,6 +727,17 @@ impl Simulation {
         out[self.disc.first..self.disc.first + self.u.len()].copy_from_slice(&self.u);
     }
 
+    /// `u^n` and `(u^n − u^{n−1})/Δt` node by node, with the bits of
+    /// [`Simulation::displacement_into`] and [`Simulation::velocity_into`], read in place.
+    pub fn node_values(&self) -> NodeValues<'_> {
+        NodeValues {
+            first: self.disc.first,
+            u: &self.u,
+            w: &self.w,
+            scale: 1.0 / self.disc.dt,
+        }
+    }
+
     /// `(u^n − u^{n−1})/Δt` on all nodes: the velocity at `t_{n−1/2}`.
     pub fn velocity_into(&self, out: &mut [f64]) {
         out.fill(0.0);
@@ -719,5 +766,60 @@ impl Simulation {
         self.initial
             .eval_into(&self.disc, u, v)
             .expect("the same evaluation succeeded at set-up");
+    }
+}
+
+/// A simulation set up, `u^0` and `u_1` evaluated, the start-up step not taken yet
+/// ([`Simulation::prepare`]).
+pub struct Unstarted {
+    /// Holds `u^0` in `u`.
+    sim: Simulation,
+    /// `u_1` on the unknowns.
+    v0: Vec<f64>,
+}
+
+impl Unstarted {
+    /// `u_0` and `u_1` node by node (0 at a clamped node, as
+    /// [`Simulation::initial_state_into`] gives them).
+    pub fn node_values(&self) -> NodeValues<'_> {
+        NodeValues {
+            first: self.sim.disc.first,
+            u: &self.sim.u,
+            w: &self.v0,
+            scale: 1.0,
+        }
+    }
+
+    pub fn discretisation(&self) -> &Discretisation {
+        &self.sim.disc
+    }
+
+    /// Takes the start-up step to `u^1` (see [`Simulation::with_solver`]).
+    pub fn start(self) -> Result<Simulation, RunError> {
+        let Self { mut sim, v0 } = self;
+        sim.start_up(&v0)?;
+        Ok(sim)
+    }
+}
+
+/// A displacement and a velocity at each node, read from a state on the unknowns (a clamped
+/// node reads 0, 0).
+#[derive(Clone, Copy, Debug)]
+pub struct NodeValues<'a> {
+    first: usize,
+    u: &'a [f64],
+    /// The velocity is `w · scale`.
+    w: &'a [f64],
+    scale: f64,
+}
+
+impl NodeValues<'_> {
+    /// Displacement and velocity at global node `node`.
+    #[inline]
+    pub fn at(&self, node: usize) -> (f64, f64) {
+        match node.checked_sub(self.first) {
+            Some(i) if i < self.u.len() => (self.u[i], self.w[i] * self.scale),
+            _ => (0.0, 0.0),
+        }
     }
 }

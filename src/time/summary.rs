@@ -12,22 +12,56 @@ pub const TIME_DIGITS: usize = 12;
 /// `t` rounded to [`TIME_DIGITS`] significant digits (see there): the double nearest to the
 /// decimal `t` rounds to, as parsing its 12-digit text would give.
 pub fn output_time(t: f64) -> f64 {
+    if let Some((digits, k)) = rounded_digits(t) {
+        return digits as f64 / POWERS_OF_TEN[k as usize];
+    }
     if t == 0.0 || !t.is_finite() {
         return t;
-    }
-    // Fast path: `round(t·10^k) / 10^k` with `10^k` exact (k <= 22) and the integer below
-    // 2^53 is one correctly rounded division, the parse of the 12-digit text.
-    let k = TIME_DIGITS as i32 - 1 - t.abs().log10().floor() as i32;
-    if (0..=22).contains(&k) {
-        let scale = 10f64.powi(k);
-        let digits = (t * scale).round();
-        if digits.abs() < 1e15 {
-            return digits / scale;
-        }
     }
     format!("{:.*e}", TIME_DIGITS - 1, t)
         .parse()
         .expect("a formatted float parses")
+}
+
+/// `10^k` for `k = 0..=22`, each exact (the values `10f64.powi(k)` gives).
+const POWERS_OF_TEN: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// The fast path of [`output_time`]: `t ≈ digits / 10^k` with `digits = round(t·10^k)` and
+/// `k` such that `digits` has [`TIME_DIGITS`] digits, when `10^k` is exact (`0 <= k <= 22`)
+/// and `|digits| < 10^15`. Then `digits / 10^k` is one correctly rounded division, the parse
+/// of the 12-digit text. `None` for 0, non-finite `t` and outside that range.
+fn rounded_digits(t: f64) -> Option<(i64, u32)> {
+    if t == 0.0 || !t.is_finite() {
+        return None;
+    }
+    let k = TIME_DIGITS as i32 - 1 - t.abs().log10().floor() as i32;
+    if !(0..=22).contains(&k) {
+        return None;
+    }
+    let digits = (t * POWERS_OF_TEN[k as usize]).round();
+    (digits.abs() < 1e15).then_some((digits as i64, k as u32))
+}
+
+/// Appends the text of `output_time(t)` as `Display` writes it (`output_time(t).to_string()`,
+/// the same bytes), through Żmij rather than `core::fmt`. Both give the shortest digits that
+/// read back to the value (here unique: a rounded time is the double nearest a decimal of at
+/// most 15 digits, and any other such decimal on its grid is far beyond an ulp away); they
+/// differ only in layout. In Żmij's fixed-point range (`1e-5 <= |t| < 1e16`) the layouts agree
+/// but for Żmij's `.0` on whole numbers, which is dropped; elsewhere `Display` writes the text.
+pub fn push_output_time(t: f64, out: &mut Vec<u8>) {
+    let t = output_time(t);
+    if t.is_finite() {
+        let mut buffer = zmij::Buffer::new();
+        let text = buffer.format_finite(t).as_bytes();
+        if !text.contains(&b'e') {
+            out.extend_from_slice(text.strip_suffix(b".0").unwrap_or(text));
+            return;
+        }
+    }
+    out.extend_from_slice(t.to_string().as_bytes());
 }
 
 fn serialize_time<S: serde::Serializer>(t: &f64, s: S) -> Result<S::Ok, S::Error> {
@@ -344,6 +378,55 @@ impl Tracker {
             output: None,
             inaccurate_steps: report.as_ref().and_then(|r| r.inaccurate_steps),
             audit: report.map(|r| r.audit),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check(t: f64) {
+        let mut out = Vec::new();
+        push_output_time(t, &mut out);
+        assert_eq!(
+            String::from_utf8(out).unwrap(),
+            output_time(t).to_string(),
+            "t = {t:e} ({:#x})",
+            t.to_bits()
+        );
+    }
+
+    #[test]
+    fn powers_of_ten_are_those_powi_gives() {
+        for (k, p) in POWERS_OF_TEN.iter().enumerate() {
+            assert_eq!(p.to_bits(), 10f64.powi(k as i32).to_bits());
+        }
+    }
+
+    #[test]
+    fn pushed_text_is_the_display_of_the_rounded_time() {
+        for t in [0.0, -0.0, 1.0, -1.0, 0.1, 1e-12, 9.9999999999995, 1e12, 123456.0, 3.03] {
+            check(t);
+        }
+        for t in [f64::NAN, f64::INFINITY, f64::MIN_POSITIVE, 1e300, 5e-324] {
+            check(t);
+        }
+        // Grid points as the runs write them, and random doubles over 30 decades.
+        for (count, step) in [(20_000, std::f64::consts::PI / 16384.0), (5_000, 0.005), (5_000, 3.125e-5)] {
+            for i in 0..count {
+                check(i as f64 * step);
+            }
+        }
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..200_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let mantissa = (state >> 11) as f64 / (1u64 << 53) as f64;
+            let decade = (state % 31) as i32 - 15;
+            let sign = if state & 1 == 0 { 1.0 } else { -1.0 };
+            check(sign * mantissa * 10f64.powi(decade));
         }
     }
 }
