@@ -11,7 +11,7 @@
 //! exact step against the unconstrained step of the same body with a free bottom, at 1e4 …
 //! 2e5 unknowns with up to 200 contact normals and at 1e5 with 500; it prints the ratio, the
 //! set-up cost of `S` (the contact run's set-up minus the free one's) and OSQP's step over the
-//! exact one (up to 1e5 unknowns).
+//! exact one (up to 5e4 unknowns).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use std::time::Instant;
@@ -112,7 +112,7 @@ fn resting(nx: u64, ny: u64, contact: bool) -> PlaneScene {
 const CONTACT_SIZES: [(u64, u64); 4] = [(99, 50), (199, 100), (199, 500), (499, 100)];
 
 /// The exact step with contact against the unconstrained step of the same body, the set-up of
-/// `S` (m solves, blocked), and OSQP's step where it is affordable (at most 1e5 unknowns).
+/// `S` (m solves, blocked), and OSQP's step where it is affordable (at most 5e4 unknowns).
 fn bench_contact(c: &mut Criterion) {
     use viscobar::plane::contact::ContactMethod;
     use viscobar::step::osqp::OsqpSettings;
@@ -147,7 +147,7 @@ fn bench_contact(c: &mut Criterion) {
             free.step().unwrap();
         });
         let active = sim.step().unwrap().contact.active;
-        let osqp = (n <= 100_000).then(|| {
+        let osqp = (n <= 50_000).then(|| {
             let mut o = PlaneSimulation::with_method(
                 &resting(nx, ny, true),
                 ContactMethod::Osqp(OsqpSettings::default()),

@@ -43,8 +43,11 @@ pub struct DenseLcp {
     active: Vec<bool>,
     /// The active indices of the current iterate.
     index: Vec<usize>,
-    /// Cholesky factor of `S_AA`, row-major with stride `|A|`.
+    /// Cholesky factor of `S_AA`, row-major with stride `|A|`, and the set it was made for
+    /// (a warm start that keeps the active set reuses it: no refactorisation).
     factor: Vec<f64>,
+    factored: Vec<bool>,
+    factor_valid: bool,
     infeasible: Vec<usize>,
     max_iterations: u32,
 }
@@ -64,6 +67,8 @@ impl DenseLcp {
             active: vec![true; m],
             index: Vec::with_capacity(m),
             factor: vec![0.0; m * m],
+            factored: vec![false; m],
+            factor_valid: false,
             infeasible: Vec::with_capacity(m),
             // Murty's rule is finite but may in theory need exponentially many pivots; beyond
             // this the call fails instead of returning an unverified point.
@@ -72,6 +77,7 @@ impl DenseLcp {
         // The whole matrix must factorise: S positive definite.
         this.collect_active();
         this.factor_active()?;
+        this.factor_valid = false;
         this.active.fill(false);
         Ok(this)
     }
@@ -99,6 +105,12 @@ impl DenseLcp {
     /// Forgets the warm start.
     pub fn reset(&mut self) {
         self.active.fill(false);
+    }
+
+    /// Test access: sets the warm-start active set.
+    #[cfg(test)]
+    fn set_active(&mut self, active: &[bool]) {
+        self.active.copy_from_slice(active);
     }
 
     fn collect_active(&mut self) {
@@ -138,7 +150,12 @@ impl DenseLcp {
     /// `r_A = −S_AA⁻¹ q_A`, `r_F = 0`, then `w = S r + q` (every row, so that `w_A` shows the
     /// round-off of the answer).
     fn solve_active(&mut self, q: &[f64], r: &mut [f64], w: &mut [f64]) -> Result<(), LcpError> {
-        self.factor_active()?;
+        if !(self.factor_valid && self.factored == self.active) {
+            self.factor_valid = false;
+            self.factor_active()?;
+            self.factored.copy_from_slice(&self.active);
+            self.factor_valid = true;
+        }
         let (a, m) = (self.index.len(), self.m);
         let l = &self.factor;
         r.fill(0.0);
@@ -319,7 +336,7 @@ mod tests {
             let q = &q[..m];
             let mut lcp = DenseLcp::new(s.clone(), m).unwrap();
             // A random warm start must not change the answer (uniqueness).
-            lcp.active.copy_from_slice(&warm[..m]);
+            lcp.set_active(&warm[..m]);
             let (mut r, mut w) = (vec![0.0; m], vec![0.0; m]);
             lcp.solve(q, &mut r, &mut w).unwrap();
             check_kkt(&s, q, &r, &w);
