@@ -664,11 +664,13 @@ impl StepSolver for BlockPivotSolver {
             self.flips.clear();
         }
         for iteration in 1..=self.max_iterations {
-            let local = self.incremental
+            let unconstrained = self.active_count == 0;
+            let local = !unconstrained
+                && self.incremental
                 && swept
                 && self.factor_valid
                 && self.flips.len() * FULL_SOLVE_FLIPS <= n;
-            if self.active_count == 0 {
+            if unconstrained {
                 self.factor.solve_into(rhs, z);
                 self.factor_valid = false;
                 swept = false;
@@ -694,10 +696,11 @@ impl StepSolver for BlockPivotSolver {
             }
             let tol_z = TIE_ULPS * eps * z_max.max(lo_max);
             let tol_l = TIE_ULPS * eps * (self.c_norm * z_max + b_max);
-            if local {
-                self.margins_changed(rhs, z);
-            } else if !swept {
+            // The whole-bar solve evaluated every margin itself.
+            if unconstrained {
                 self.margins_all(rhs, z);
+            } else if local {
+                self.margins_changed(rhs, z);
             }
             self.select_infeasible(tol_z, tol_l);
             self.flips.clear();
