@@ -140,7 +140,9 @@ impl BlockPivotSolver {
             slot[i] = k;
         }
         let c_norm = c.inf_norm();
-        let ranges = || Vec::with_capacity(n + 1);
+        // An incremental iteration flips at most `n / FULL_SOLVE_FLIPS` indices, and each
+        // flip adds at most two ranges to a list.
+        let ranges = || Vec::with_capacity(2 * (n / FULL_SOLVE_FLIPS) + 2);
         Ok(Self {
             c: c.clone(),
             c_norm,
