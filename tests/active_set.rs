@@ -288,7 +288,7 @@ impl StepSolver for Checked {
 }
 
 /// Every step of obstacle runs (the bench's scene: a load pressing the left half onto the
-/// obstacle, Δt = Δx and 10 Δx; the talk's distributed scenes) meets the KKT conditions at
+/// obstacle, Δt = Δx and 10 Δx; the talk's distributed scenes, one also coarse) meets the KKT conditions at
 /// the audit's round-off floors and equals the whole-bar reference bit for bit.
 #[test]
 fn obstacle_runs_meet_kkt_at_the_round_off_floors_at_every_step() {
@@ -316,6 +316,15 @@ fn obstacle_runs_meet_kkt_at_the_round_off_floors_at_every_step() {
         ("bench dt = 10 dx", bench(3000, 10.0)),
         ("distributed", common::builtin("distributed", &[])),
         ("distributed-forced", common::builtin("distributed-forced", &[])),
+        // Regression: a step whose incremental iteration released every active node used to
+        // keep stale margins in its plain solve and cycle to the iteration limit (step 102).
+        (
+            "distributed-forced, 100 elements, dt 0.02",
+            common::builtin(
+                "distributed-forced",
+                &["mesh.elements=100", "time.step=0.02"],
+            ),
+        ),
     ];
     for (label, scene) in scenes {
         let disc = Discretisation::new(&scene).unwrap();

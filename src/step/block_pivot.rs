@@ -140,7 +140,9 @@ impl BlockPivotSolver {
             slot[i] = k;
         }
         let c_norm = c.inf_norm();
-        let ranges = || Vec::with_capacity(n + 1);
+        // An incremental iteration flips at most `n / FULL_SOLVE_FLIPS` indices, and each
+        // flip adds at most two ranges to a list.
+        let ranges = || Vec::with_capacity(2 * (n / FULL_SOLVE_FLIPS) + 2);
         Ok(Self {
             c: c.clone(),
             c_norm,
@@ -664,11 +666,13 @@ impl StepSolver for BlockPivotSolver {
             self.flips.clear();
         }
         for iteration in 1..=self.max_iterations {
-            let local = self.incremental
+            let unconstrained = self.active_count == 0;
+            let local = !unconstrained
+                && self.incremental
                 && swept
                 && self.factor_valid
                 && self.flips.len() * FULL_SOLVE_FLIPS <= n;
-            if self.active_count == 0 {
+            if unconstrained {
                 self.factor.solve_into(rhs, z);
                 self.factor_valid = false;
                 swept = false;
@@ -694,10 +698,11 @@ impl StepSolver for BlockPivotSolver {
             }
             let tol_z = TIE_ULPS * eps * z_max.max(lo_max);
             let tol_l = TIE_ULPS * eps * (self.c_norm * z_max + b_max);
-            if local {
-                self.margins_changed(rhs, z);
-            } else if !swept {
+            // The whole-bar solve evaluated every margin itself.
+            if unconstrained {
                 self.margins_all(rhs, z);
+            } else if local {
+                self.margins_changed(rhs, z);
             }
             self.select_infeasible(tol_z, tol_l);
             self.flips.clear();
