@@ -178,6 +178,18 @@ fn eval_into(node: &Node, xs: &[f64], t: f64, out: &mut [f64], pool: &mut [Vec<f
     }
 }
 
+/// Scratch arrays for [`eval_block`] of `expr`.
+pub fn block_pool(expr: &Expression) -> Vec<Vec<f64>> {
+    vec![vec![0.0; BLOCK]; scratch(expr.root())]
+}
+
+/// `out[i] = f(xs[i], t)` for at most [`BLOCK`] points with the scratch arrays of
+/// [`block_pool`], the bits of [`Expression::eval`], non-finite values left in `out` unchecked.
+pub fn eval_block(expr: &Expression, xs: &[f64], t: f64, out: &mut [f64], pool: &mut [Vec<f64>]) {
+    debug_assert!(xs.len() <= BLOCK && out.len() == xs.len());
+    eval_into(expr.root(), xs, t, out, pool);
+}
+
 impl NodalEvaluator {
     /// Prepares `expr` for evaluation at the nodes `xs`.
     pub fn new(expr: Expression, xs: Vec<f64>) -> Self {
