@@ -160,7 +160,15 @@ fn bench_contact(c: &mut Criterion) {
                 o.step().unwrap();
             })
         });
-        rows.push((n, m, active, exact, unconstrained, setup_contact - setup_free, osqp));
+        rows.push((
+            n,
+            m,
+            active,
+            exact,
+            unconstrained,
+            setup_contact - setup_free,
+            osqp,
+        ));
     }
     group.finish();
     println!(

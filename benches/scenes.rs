@@ -9,9 +9,7 @@
 //! set-up outside the timing), and the refined run `both-ends` with 1e5 elements and
 //! Δt = 3.125e-5 to t = 0.05 with its default output (`refined-1e5`, 1600 steps).
 
-use criterion::{
-    BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main,
-};
+use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use std::path::Path;
 use std::time::{Duration, Instant};
 use viscobar::study::figures::talk_scenes;

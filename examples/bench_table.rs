@@ -173,7 +173,11 @@ fn main() {
         }
     }
     let mut setup_runs = BTreeMap::new();
-    for entry in std::fs::read_dir(target.join("setup")).into_iter().flatten().flatten() {
+    for entry in std::fs::read_dir(target.join("setup"))
+        .into_iter()
+        .flatten()
+        .flatten()
+    {
         let name = entry.file_name().to_string_lossy().into_owned();
         if let Some(t) = median_ns(&entry.path().join("new/estimates.json")) {
             setup_runs.insert(name, t);
@@ -209,7 +213,8 @@ fn main() {
                 verdict(t / 1e6 <= ONE_STEP_MS_TARGET)
             );
         }
-        if let (Some(run), Some(steps)) = (setup.get("400-steps"), setup.get("400-steps-stepping")) {
+        if let (Some(run), Some(steps)) = (setup.get("400-steps"), setup.get("400-steps-stepping"))
+        {
             println!(
                 "- 400-step run: {:.2}x its steps alone (target <= {SETUP_RATIO_TARGET}): {}",
                 run / steps,

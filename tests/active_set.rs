@@ -181,7 +181,10 @@ fn incremental_matches_reference(
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert!(bits(&z) == bits(&z_ref), "step {step}: z differs");
         assert!(bits(&r) == bits(&r_ref), "step {step}: reactions differ");
-        assert!(kkt(c, &b, nodes, &lo, &z, &r) <= AGREEMENT_TOL, "step {step}");
+        assert!(
+            kkt(c, &b, nodes, &lo, &z, &r) <= AGREEMENT_TOL,
+            "step {step}"
+        );
     }
     let work = fast.work();
     assert_eq!(reference.work().local_solves, 0);
@@ -209,7 +212,8 @@ fn incremental_re_solves_equal_the_whole_bar_solves_on_moving_contact() {
             let z_target: Vec<f64> = (0..n)
                 .map(|i| {
                     let x = i as f64 / n as f64;
-                    (6.0 * x - phase).sin() + 0.3 * (23.0 * x + 2.0 * phase).cos()
+                    (6.0 * x - phase).sin()
+                        + 0.3 * (23.0 * x + 2.0 * phase).cos()
                         + 0.05 * kicks[(i + 7 * step) % n]
                 })
                 .collect();
@@ -275,8 +279,17 @@ impl StepSolver for Checked {
         let info = self.fast.solve(rhs, lower, z, reactions)?;
         self.reference
             .solve(rhs, lower, &mut self.z_ref, &mut self.r_ref)?;
-        assert!(z.iter().zip(&self.z_ref).all(|(a, b)| a.to_bits() == b.to_bits()));
-        assert!(reactions.iter().zip(&self.r_ref).all(|(a, b)| a.to_bits() == b.to_bits()));
+        assert!(
+            z.iter()
+                .zip(&self.z_ref)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+        );
+        assert!(
+            reactions
+                .iter()
+                .zip(&self.r_ref)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+        );
         let law = viscobar::step::audit::Law::Signorini {
             eps_abs: 0.0,
             eps_rel: 0.0,
@@ -315,7 +328,10 @@ fn obstacle_runs_meet_kkt_at_the_round_off_floors_at_every_step() {
         ("bench dt = dx", bench(3000, 1.0)),
         ("bench dt = 10 dx", bench(3000, 10.0)),
         ("distributed", common::builtin("distributed", &[])),
-        ("distributed-forced", common::builtin("distributed-forced", &[])),
+        (
+            "distributed-forced",
+            common::builtin("distributed-forced", &[]),
+        ),
         // Regression: a step whose incremental iteration released every active node used to
         // keep stale margins in its plain solve and cycle to the iteration limit (step 102).
         (

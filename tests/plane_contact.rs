@@ -21,7 +21,11 @@ fn the_bar_with_contact_is_an_exact_special_case_of_the_plane_body() {
             "{name}: ux off by {:e}",
             c.max_ux_deviation
         );
-        assert!(c.max_uy <= BAR_CASE_TOL * c.max_u, "{name}: uy {:e}", c.max_uy);
+        assert!(
+            c.max_uy <= BAR_CASE_TOL * c.max_u,
+            "{name}: uy {:e}",
+            c.max_uy
+        );
         assert!(
             c.max_reaction_deviation <= BAR_CASE_TOL * c.max_reaction,
             "{name}: reactions off by {:e}",
@@ -48,30 +52,54 @@ fn contact_conditions_and_energy_identity_hold_at_every_node_and_step_of_every_p
             continue;
         }
         with_contact += 1;
-        assert!(records.iter().any(|r| r.contact.active > 0), "{name}: no contact");
+        assert!(
+            records.iter().any(|r| r.contact.active > 0),
+            "{name}: no contact"
+        );
         assert!(
             records.iter().any(|r| r.contact.active > 0)
-                && records.last().unwrap().contact.active < records.iter().map(|r| r.contact.active).max().unwrap(),
+                && records.last().unwrap().contact.active
+                    < records.iter().map(|r| r.contact.active).max().unwrap(),
             "{name}: the contact set never shrinks"
         );
         for r in &records {
             let c = &r.contact;
-            assert!(c.penetration <= GAP_TOL * c.gap_scale, "{name} step {}: penetration {:e}", r.step, c.penetration);
+            assert!(
+                c.penetration <= GAP_TOL * c.gap_scale,
+                "{name} step {}: penetration {:e}",
+                r.step,
+                c.penetration
+            );
             assert!(
                 c.complementarity <= GAP_TOL * c.gap_scale * c.total_reaction,
                 "{name} step {}: r·gap {:e}",
                 r.step,
                 c.complementarity
             );
-            assert!(r.contact.dissipation >= -GAP_TOL * r.energy, "{name} step {}", r.step);
+            assert!(
+                r.contact.dissipation >= -GAP_TOL * r.energy,
+                "{name} step {}",
+                r.step
+            );
         }
         for r in &records[1..] {
-            assert!(r.identity_residual <= IDENTITY_TOL, "{name} step {}: {:e}", r.step, r.identity_residual);
+            assert!(
+                r.identity_residual <= IDENTITY_TOL,
+                "{name} step {}: {:e}",
+                r.step,
+                r.identity_residual
+            );
         }
         assert!(summary.max_identity_residual <= IDENTITY_TOL);
         // The contact term is part of the balance: dropping it breaks the identity.
-        let big = records.iter().map(|r| r.contact.dissipation).fold(0.0, f64::max);
-        assert!(big > 1e3 * IDENTITY_TOL * records[0].energy, "{name}: contact dissipates nothing");
+        let big = records
+            .iter()
+            .map(|r| r.contact.dissipation)
+            .fold(0.0, f64::max);
+        assert!(
+            big > 1e3 * IDENTITY_TOL * records[0].energy,
+            "{name}: contact dissipates nothing"
+        );
     }
     assert!(with_contact >= 2);
 }
@@ -89,7 +117,11 @@ fn exact_and_osqp_agree_on_the_two_dimensional_contact_scenes() {
         let a = agreement(&scene, osqp_method()).unwrap();
         eprintln!("{a:?}");
         assert!(a.max_active > 1 && a.contact_steps > 0, "{name}: contact");
-        assert!(a.max_u_deviation <= OSQP_AGREEMENT_TOL * a.max_u, "{name}: u {:e}", a.max_u_deviation);
+        assert!(
+            a.max_u_deviation <= OSQP_AGREEMENT_TOL * a.max_u,
+            "{name}: u {:e}",
+            a.max_u_deviation
+        );
         assert!(
             a.max_reaction_deviation <= OSQP_AGREEMENT_TOL * a.max_reaction,
             "{name}: r {:e}",
@@ -108,11 +140,17 @@ const ORDER_BAND: (f64, f64) = (1.55, 2.1);
 #[test]
 fn the_tilted_drop_converges_against_a_finer_exact_run() {
     use viscobar::study::plane_contact::*;
-    let scene =
-        plane_scene("plane-tilted-drop", &[format!("time.end={CONVERGENCE_END}")]).unwrap();
+    let scene = plane_scene(
+        "plane-tilted-drop",
+        &[format!("time.end={CONVERGENCE_END}")],
+    )
+    .unwrap();
     let levels = convergence(&scene, &CONVERGENCE_LEVELS, CONVERGENCE_REFERENCE).unwrap();
     for p in orders(&levels) {
-        assert!((ORDER_BAND.0..=ORDER_BAND.1).contains(&p), "order {p}: {levels:?}");
+        assert!(
+            (ORDER_BAND.0..=ORDER_BAND.1).contains(&p),
+            "order {p}: {levels:?}"
+        );
     }
 }
 

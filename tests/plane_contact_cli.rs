@@ -33,7 +33,10 @@ fn run_writes_the_contact_columns_and_summary() {
     assert!(summary["max_identity_residual"].as_f64().unwrap() <= IDENTITY_TOL);
     let c = &summary["contact"];
     assert_eq!(c["normals"], 17, "the bottom edge's 17 nodes");
-    assert_eq!(c["max_active"], 17, "the block comes to rest on its whole bottom");
+    assert_eq!(
+        c["max_active"], 17,
+        "the block comes to rest on its whole bottom"
+    );
     assert!(c["dissipation"].as_f64().unwrap() > 0.0);
     assert!(c["max_penetration"].as_f64().unwrap() <= GAP_TOL);
     assert!(c["max_complementarity"].as_f64().unwrap() <= GAP_TOL * 10.0);

@@ -24,7 +24,9 @@ fn round_sig(x: f64, scale: f64) -> f64 {
     let exponent = scale.abs().log10().floor() as i32 - (SIGNIFICANT_DIGITS - 1);
     let q = 10f64.powi(exponent);
     let digits = (-exponent).max(0) as usize;
-    let r: f64 = format!("{:.*}", digits, (x / q).round() * q).parse().unwrap();
+    let r: f64 = format!("{:.*}", digits, (x / q).round() * q)
+        .parse()
+        .unwrap();
     r + 0.0
 }
 
@@ -77,11 +79,13 @@ fn the_tilted_drop_matches_its_reviewed_snapshot() {
             t: n as f64 * scene.time.step,
             energy,
             in_contact: touching.len(),
-            contact_s: (!touching.is_empty()).then(|| {
-                [touching[0].0.s, touching[touching.len() - 1].0.s]
-            }),
+            contact_s: (!touching.is_empty())
+                .then(|| [touching[0].0.s, touching[touching.len() - 1].0.s]),
             total_reaction: touching.iter().map(|(_, r)| **r).sum::<f64>() + 0.0,
-            max_pressure: touching.iter().map(|(k, r)| **r / k.weight).fold(0.0, f64::max),
+            max_pressure: touching
+                .iter()
+                .map(|(k, r)| **r / k.weight)
+                .fold(0.0, f64::max),
             mean_u,
             min_bottom_uy,
         });
@@ -93,7 +97,12 @@ fn the_tilted_drop_matches_its_reviewed_snapshot() {
         scale(&|r| r.total_reaction),
         scale(&|r| r.max_pressure),
     );
-    let su = scale(&|r| r.mean_u[0].abs().max(r.mean_u[1].abs()).max(r.min_bottom_uy.abs()));
+    let su = scale(&|r| {
+        r.mean_u[0]
+            .abs()
+            .max(r.mean_u[1].abs())
+            .max(r.min_bottom_uy.abs())
+    });
     for r in &mut rows {
         r.t = round_sig(r.t, 1.0);
         r.energy = round_sig(r.energy, se);

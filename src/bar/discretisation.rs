@@ -299,14 +299,19 @@ mod tests {
                 clamped: [false, false],
             };
             let (mut u, mut v) = (vec![0.0; disc.nodes], vec![0.0; disc.nodes]);
-            let got = data.eval_into(&disc, &mut u, &mut v).map_err(|e| e.to_string());
+            let got = data
+                .eval_into(&disc, &mut u, &mut v)
+                .map_err(|e| e.to_string());
             let plain = (0..disc.nodes)
                 .try_for_each(|i| {
                     let (pu, pv) = (
                         data.displacement.eval(disc.x(i), 0.0)?,
                         data.velocity.eval(disc.x(i), 0.0)?,
                     );
-                    assert_eq!((pu.to_bits(), pv.to_bits()), (u[i].to_bits(), v[i].to_bits()));
+                    assert_eq!(
+                        (pu.to_bits(), pv.to_bits()),
+                        (u[i].to_bits(), v[i].to_bits())
+                    );
                     Ok::<(), SceneError>(())
                 })
                 .map_err(|e| e.to_string());

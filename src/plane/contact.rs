@@ -26,8 +26,8 @@
 
 use crate::plane::error::PlaneError;
 use crate::plane::factor::SparseCholesky;
-pub use crate::plane::normals::{Normal, normals};
 use crate::plane::matrices::Pattern;
+pub use crate::plane::normals::{Normal, normals};
 use crate::plane::osqp::PlaneOsqp;
 use crate::step::lcp::DenseLcp;
 use crate::step::osqp::OsqpSettings;

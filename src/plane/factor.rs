@@ -121,11 +121,13 @@ impl SparseCholesky {
     /// `X ← A⁻¹ X` for `ncols` right-hand sides stored column after column in `x` (one pass
     /// over the factor for all of them). Allocates its work space: for set-up, not per step.
     pub fn solve_columns_in_place(&mut self, x: &mut [f64], ncols: usize) {
-        assert_eq!(x.len(), self.n * ncols, "right-hand sides of the wrong length");
-        let mut buffer = MemBuffer::new(
-            self.symbolic
-                .solve_in_place_scratch::<f64>(ncols, Par::Seq),
+        assert_eq!(
+            x.len(),
+            self.n * ncols,
+            "right-hand sides of the wrong length"
         );
+        let mut buffer =
+            MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(ncols, Par::Seq));
         let llt = LltRef::new(&self.symbolic, &self.values);
         let rhs = MatMut::from_column_major_slice_mut(x, self.n, ncols);
         llt.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut buffer));

@@ -73,7 +73,11 @@ pub fn normals(
                     ),
                 });
             }
-            let lo = if k > 0 { coords[k] - coords[k - 1] } else { 0.0 };
+            let lo = if k > 0 {
+                coords[k] - coords[k - 1]
+            } else {
+                0.0
+            };
             let hi = if k + 1 < count {
                 coords[k + 1] - coords[k]
             } else {

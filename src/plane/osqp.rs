@@ -16,9 +16,9 @@
 //! complementarity `|r_k (h − E z)_k| <= tol_z |r_k| + tol_f |(h − Ez)_k|`, stationarity
 //! `‖C z − b + Eᵀ r‖∞` and the same mapped to displacement by a solve with the factor of `C`.
 
-use crate::plane::normals::Normal;
 use crate::plane::factor::SparseCholesky;
 use crate::plane::matrices::Pattern;
+use crate::plane::normals::Normal;
 use crate::step::audit::{AUDIT_MARGIN, dual_tolerance};
 use crate::step::osqp::{OSQP_INFTY, OsqpSettings};
 use crate::step::report::{AuditReport, StepFailure, Worst};
@@ -114,10 +114,14 @@ impl PlaneOsqp {
         let q = vec![0.0; n];
         let lower = vec![-OSQP_INFTY; m];
         let upper = vec![OSQP_INFTY; m];
-        let problem = Problem::new(p, &q, a, &lower, &upper, &osqp_settings)
-            .map_err(|e| e.to_string())?;
+        let problem =
+            Problem::new(p, &q, a, &lower, &upper, &osqp_settings).map_err(|e| e.to_string())?;
         let c_norm = (0..n)
-            .map(|r| (pattern.row_ptr[r]..pattern.row_ptr[r + 1]).map(|k| c[k].abs()).sum())
+            .map(|r| {
+                (pattern.row_ptr[r]..pattern.row_ptr[r + 1])
+                    .map(|k| c[k].abs())
+                    .sum()
+            })
             .fold(0.0f64, f64::max);
         let mut ones = vec![1.0; n];
         chol.solve_in_place(&mut ones);

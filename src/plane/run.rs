@@ -111,9 +111,7 @@ impl Tracker {
             s.dissipation += c.dissipation;
             if c.gap_scale > 0.0 {
                 s.max_penetration = s.max_penetration.max(c.penetration / c.gap_scale);
-                s.max_complementarity = s
-                    .max_complementarity
-                    .max(c.complementarity / c.gap_scale);
+                s.max_complementarity = s.max_complementarity.max(c.complementarity / c.gap_scale);
             }
             s.iterations_max = s.iterations_max.max(c.iterations);
             self.iterations += u64::from(c.iterations);

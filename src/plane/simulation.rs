@@ -11,12 +11,12 @@
 //! ([`SparseCholesky`]), and measures the energy balance ([`crate::plane::energy`]).
 
 use crate::plane::contact::{Contact, ContactMethod, ContactStep};
-use crate::plane::normals::normals;
 use crate::plane::energy::{Balance, StrainForms, balance, measure};
 use crate::plane::error::PlaneError;
 use crate::plane::factor::SparseCholesky;
 use crate::plane::matrices::{Material, Pattern, assemble};
 use crate::plane::mesh::Grid;
+use crate::plane::normals::normals;
 use crate::plane::rhs::{RhsTerms, rhs_into};
 use crate::scene::expr::Expression;
 use crate::scene::plane::PlaneScene;

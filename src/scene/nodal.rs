@@ -251,7 +251,9 @@ mod tests {
     #[test]
     fn blocks_and_operands_in_place_give_the_bits_of_the_scalar_evaluation() {
         // Several blocks and a partial one; leaves on either side of every kind of node.
-        let xs: Vec<f64> = (0..3 * BLOCK + 37).map(|i| -2.0 + 0.005 * i as f64).collect();
+        let xs: Vec<f64> = (0..3 * BLOCK + 37)
+            .map(|i| -2.0 + 0.005 * i as f64)
+            .collect();
         for text in [
             "0.1*sin(x*t)*exp(-(x-t)^2)",
             "x - t + (x / 3) ^ 3 - 2 ^ x + (t - x) * 3 - (x < t) + (t >= x) + min(x, 0.5)",

@@ -157,9 +157,10 @@ impl Edges {
                     return Err(SceneError::Invalid {
                         field,
                         value: "absent".into(),
-                        allowed: "an edge with condition = \"signorini\" needs its gap: a number or \
+                        allowed:
+                            "an edge with condition = \"signorini\" needs its gap: a number or \
                                   an expression in s"
-                            .into(),
+                                .into(),
                     });
                 }
                 (c, Some(text)) => {

@@ -369,7 +369,11 @@ impl BlockPivotSolver {
             while j > 0 && self.active[j - 1] != free {
                 j -= 1;
                 let w = self.t[j] * self.inv_d[j];
-                z_next = if !free || j == top { w } else { w - self.l[j] * z_next };
+                z_next = if !free || j == top {
+                    w
+                } else {
+                    w - self.l[j] * z_next
+                };
                 z[j] = z_next;
                 block = max_of(block, z_next.abs());
                 if j.is_multiple_of(MAX_BLOCK) {
@@ -435,7 +439,9 @@ impl BlockPivotSolver {
             };
             push_merged(&mut backward, r);
         }
-        sweep_up(n, &backward, &mut forward, &mut rows, |j| self.forward_at(j, rhs));
+        sweep_up(n, &backward, &mut forward, &mut rows, |j| {
+            self.forward_at(j, rhs)
+        });
         // Backward chain: every row whose w_j or l_j changed lies in `forward`.
         sweep_down(n, &forward, &mut backward, &mut rows, |j| {
             self.backward_at(j, z)

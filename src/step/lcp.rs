@@ -311,7 +311,8 @@ mod tests {
 
     fn check_kkt(s: &[f64], q: &[f64], r: &[f64], w: &[f64]) {
         let m = q.len();
-        let scale = s.iter().fold(0.0f64, |a, v| a.max(v.abs())) * m as f64
+        let scale = s.iter().fold(0.0f64, |a, v| a.max(v.abs()))
+            * m as f64
             * r.iter().fold(0.0f64, |a, v| a.max(v.abs()))
             + q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let tol = KKT_TOL * scale.max(f64::MIN_POSITIVE);

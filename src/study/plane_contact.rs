@@ -277,7 +277,10 @@ pub fn markdown() -> Result<String, ConvergeError> {
         let scene = plane_scene(name, &[])?;
         let mut methods = vec![(osqp_method(), "osqp, eps = 1e-10".to_string())];
         for e in PENALTY_EPSILONS {
-            methods.push((ContactMethod::Penalty { epsilon: e }, format!("penalty, ε = {e:e}")));
+            methods.push((
+                ContactMethod::Penalty { epsilon: e },
+                format!("penalty, ε = {e:e}"),
+            ));
         }
         for (method, label) in methods {
             let a = agreement(&scene, method)?;

@@ -406,14 +406,29 @@ mod tests {
 
     #[test]
     fn pushed_text_is_the_display_of_the_rounded_time() {
-        for t in [0.0, -0.0, 1.0, -1.0, 0.1, 1e-12, 9.9999999999995, 1e12, 123456.0, 3.03] {
+        for t in [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.1,
+            1e-12,
+            9.9999999999995,
+            1e12,
+            123456.0,
+            3.03,
+        ] {
             check(t);
         }
         for t in [f64::NAN, f64::INFINITY, f64::MIN_POSITIVE, 1e300, 5e-324] {
             check(t);
         }
         // Grid points as the runs write them, and random doubles over 30 decades.
-        for (count, step) in [(20_000, std::f64::consts::PI / 16384.0), (5_000, 0.005), (5_000, 3.125e-5)] {
+        for (count, step) in [
+            (20_000, std::f64::consts::PI / 16384.0),
+            (5_000, 0.005),
+            (5_000, 3.125e-5),
+        ] {
             for i in 0..count {
                 check(i as f64 * step);
             }
