@@ -19,7 +19,7 @@
 use crate::plane::factor::SparseCholesky;
 use crate::plane::matrices::Pattern;
 use crate::plane::normals::Normal;
-use crate::step::audit::{AUDIT_MARGIN, dual_tolerance};
+use crate::step::audit::{AUDIT_MARGIN, dual_tolerance, record_and_check};
 use crate::step::osqp::{OSQP_INFTY, OsqpSettings};
 use crate::step::report::{AuditReport, StepFailure, Worst};
 use osqp::{CscMatrix, Problem, Settings, Status};
@@ -255,39 +255,20 @@ impl PlaneOsqp {
                 (comp, comp_tol) = (c, t);
             }
         }
-        let rep = &mut self.report;
-        rep.steps += 1;
-        rep.stationarity.observe(res_norm, tol_f);
-        rep.stationarity_displacement.observe(dz_norm, tol_dz);
-        rep.negative_reaction.observe(negative, tol_f);
-        if let Some(w) = rep.primal_violation.as_mut() {
-            w.observe(primal, tol_z);
-        }
-        if let Some(w) = rep.complementarity.as_mut() {
-            w.observe(comp, comp_tol);
-        }
-        let checks = [
-            ("primal violation (Ez - h)+", primal, tol_z),
-            ("negative reaction (-r_k)+", negative, tol_f),
-            ("complementarity |r_k (h - Ez)_k|", comp, comp_tol),
-            ("stationarity |Cz - b + E^T r|", res_norm, tol_f),
-            (
-                "stationarity in displacement |C^-1 (Cz - b + E^T r)|",
-                dz_norm,
-                tol_dz,
-            ),
-        ];
-        for (what, value, tolerance) in checks {
-            // Negated so that a NaN residual fails.
-            #[allow(clippy::neg_cmp_op_on_partial_ord)]
-            if !(value <= tolerance) {
-                return Err(StepFailure::AuditFailed {
-                    what,
-                    value,
-                    tolerance,
-                });
-            }
-        }
-        Ok(())
+        record_and_check(
+            &mut self.report,
+            [
+                ("primal violation (Ez - h)+", primal, tol_z),
+                ("negative reaction (-r_k)+", negative, tol_f),
+                ("complementarity |r_k (h - Ez)_k|", comp, comp_tol),
+                ("stationarity |Cz - b + E^T r|", res_norm, tol_f),
+                (
+                    "stationarity in displacement |C^-1 (Cz - b + E^T r)|",
+                    dz_norm,
+                    tol_dz,
+                ),
+            ],
+            None,
+        )
     }
 }

@@ -190,45 +190,65 @@ impl KktAudit {
             }
         }
 
-        let rep = &mut self.report;
-        rep.steps += 1;
-        rep.stationarity.observe(res_norm, tol_f);
-        rep.stationarity_displacement.observe(dz_norm, tol_dz);
-        rep.negative_reaction.observe(negative, tol_f);
-        if let Some(w) = rep.primal_violation.as_mut() {
-            w.observe(primal, tol_z);
-        }
-        if let Some(w) = rep.complementarity.as_mut() {
-            w.observe(comp, comp_tol);
-        }
-        if let Some(w) = rep.penalty_law.as_mut() {
-            w.observe(law_res, law_tol);
-        }
-        let checks = [
-            ("primal violation (lo_j - z_j)+", primal, tol_z),
-            ("negative reaction (-r_j)+", negative, tol_f),
-            ("complementarity |r_j (z_j - lo_j)|", comp, comp_tol),
-            ("penalty law |eps r_j - (lo_j - z_j)+|", law_res, law_tol),
-            ("stationarity |Cz - b - r|", res_norm, tol_f),
-            (
-                "stationarity in displacement |C^-1 (Cz - b - r)|",
-                dz_norm,
-                tol_dz,
-            ),
-        ];
-        for (what, value, tolerance) in checks {
-            // Negated so that a NaN residual fails.
-            #[allow(clippy::neg_cmp_op_on_partial_ord)]
-            if !(value <= tolerance) {
-                return Err(StepFailure::AuditFailed {
-                    what,
-                    value,
-                    tolerance,
-                });
-            }
-        }
-        Ok(())
+        record_and_check(
+            &mut self.report,
+            [
+                ("primal violation (lo_j - z_j)+", primal, tol_z),
+                ("negative reaction (-r_j)+", negative, tol_f),
+                ("complementarity |r_j (z_j - lo_j)|", comp, comp_tol),
+                ("stationarity |Cz - b - r|", res_norm, tol_f),
+                (
+                    "stationarity in displacement |C^-1 (Cz - b - r)|",
+                    dz_norm,
+                    tol_dz,
+                ),
+            ],
+            Some(("penalty law |eps r_j - (lo_j - z_j)+|", law_res, law_tol)),
+        )
     }
+}
+
+/// One audited residual: what it measures, its value and its tolerance.
+pub type Residual = (&'static str, f64, f64);
+
+/// Records one step's residuals in `report` (worst ratios) and fails on the first one above
+/// its tolerance; shared by the bar's audit and the plane body's. `checks` are, in order:
+/// primal violation, negative reaction, complementarity, stationarity, stationarity in
+/// displacement; `penalty_law` is the penalty solver's law, when it has one.
+pub fn record_and_check(
+    report: &mut AuditReport,
+    checks: [Residual; 5],
+    penalty_law: Option<Residual>,
+) -> Result<(), StepFailure> {
+    let [primal, negative, comp, stationarity, displacement] = checks;
+    report.steps += 1;
+    report.stationarity.observe(stationarity.1, stationarity.2);
+    report
+        .stationarity_displacement
+        .observe(displacement.1, displacement.2);
+    report.negative_reaction.observe(negative.1, negative.2);
+    if let Some(w) = report.primal_violation.as_mut() {
+        w.observe(primal.1, primal.2);
+    }
+    if let Some(w) = report.complementarity.as_mut() {
+        w.observe(comp.1, comp.2);
+    }
+    if let (Some(w), Some(law)) = (report.penalty_law.as_mut(), penalty_law) {
+        w.observe(law.1, law.2);
+    }
+    let in_order = [primal, negative, comp].into_iter().chain(penalty_law);
+    for (what, value, tolerance) in in_order.chain([stationarity, displacement]) {
+        // Negated so that a NaN residual fails.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        if !(value <= tolerance) {
+            return Err(StepFailure::AuditFailed {
+                what,
+                value,
+                tolerance,
+            });
+        }
+    }
+    Ok(())
 }
 
 fn ratio(value: f64, tolerance: f64) -> f64 {
