@@ -86,8 +86,8 @@ const CASES: &[(&str, &[&str], &str)] = &[
     ("unknown key", &["plane.viscocity=1"], "viscocity"),
     (
         "unknown edge condition",
-        &["edges.top={ condition = \"signorini\" }"],
-        "signorini",
+        &["edges.top={ condition = \"sticky\" }"],
+        "edges.top.condition",
     ),
     (
         "one component",
