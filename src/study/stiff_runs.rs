@@ -7,24 +7,49 @@
 //! Apart from the case list, the tolerances and the table (`study::stiff`), which say what is
 //! checked and why; this file only produces the numbers they are checked on.
 
+use crate::linalg::ldlt::Ldlt;
 use crate::linalg::norms::{max_abs, max_distance};
+use crate::linalg::spectrum::reference::STURM_ERROR_ULPS;
+use crate::linalg::tridiag::SymTridiag;
 use crate::step::audit::{KktAudit, Law};
 use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
 use crate::study::accuracy::rigid_drift;
-use crate::study::stiff::{Case, CaseResult, Family, Size, SolverRun, cases};
+use crate::study::stiff::{
+    COMBINATION_ROUNDINGS, Case, CaseResult, Family, RESIDUAL_ROUNDINGS, Size, SolverRun,
+    StepTerms, UNIT_ROUNDOFF, Worst, cases,
+};
 use crate::time::RunError;
+use crate::time::simulation::StepRecord;
 use crate::time::simulation::{Discretisation, Simulation, make_solver};
 use crate::time::summary::Tracker;
 use rayon::prelude::*;
+use std::cell::RefCell;
+use std::rc::Rc;
 
-/// The exact solver with the KKT audit at round-off floors recorded after every step (not
-/// enforced: a miss is reported in the table, the run goes on).
-struct Audited {
-    inner: Box<dyn StepSolver>,
-    audit: KktAudit,
+/// What the last solve formed, shared between a run's [`Traced`] solver and its [`Live`]
+/// state: the right-hand side `b̂`, the answer `z`, the reactions `r` and the previous answer
+/// `w` (the increment the scheme's `u^n − u^{n−1}` is, bit for bit: the simulation swaps its
+/// `z` into `w` after each step, the start-up's included).
+#[derive(Default)]
+struct Trace {
+    rhs: Vec<f64>,
+    z: Vec<f64>,
+    w: Vec<f64>,
+    reactions: Vec<f64>,
+    lower: Vec<f64>,
 }
 
-impl StepSolver for Audited {
+/// Every solver of the matrix, wrapped so that each solve's vectors are recorded for the
+/// a-posteriori tolerances; the exact solver also runs the KKT audit at round-off floors
+/// after every step (recorded, not enforced: a miss is reported in the table, the run goes
+/// on).
+struct Traced {
+    inner: Box<dyn StepSolver>,
+    audit: Option<KktAudit>,
+    trace: Rc<RefCell<Trace>>,
+}
+
+impl StepSolver for Traced {
     fn name(&self) -> &'static str {
         self.inner.name()
     }
@@ -42,19 +67,36 @@ impl StepSolver for Audited {
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
         let info = self.inner.solve(rhs, lower, z, reactions)?;
+        {
+            let mut t = self.trace.borrow_mut();
+            let t = &mut *t;
+            std::mem::swap(&mut t.w, &mut t.z);
+            for (dst, src) in [
+                (&mut t.rhs, rhs),
+                (&mut t.z, &*z),
+                (&mut t.reactions, &*reactions),
+                (&mut t.lower, lower),
+            ] {
+                dst.clear();
+                dst.extend_from_slice(src);
+            }
+        }
+        let Some(audit) = self.audit.as_mut() else {
+            return Ok(info);
+        };
         let law = Law::Signorini {
             eps_abs: 0.0,
             eps_rel: 0.0,
         };
-        match self.audit.check(law, rhs, lower, z, reactions) {
+        match audit.check(law, rhs, lower, z, reactions) {
             Err(StepFailure::NonFinite) => Err(StepFailure::NonFinite),
             _ => Ok(info),
         }
     }
 
     fn report(&self) -> Option<SolverReport> {
-        Some(SolverReport {
-            audit: self.audit.report().clone(),
+        self.audit.as_ref().map(|a| SolverReport {
+            audit: a.report().clone(),
             inaccurate_steps: None,
         })
     }
@@ -75,15 +117,27 @@ fn worst_ratio(r: &crate::step::AuditReport) -> f64 {
     .fold(0.0, f64::max)
 }
 
-fn build(case: &Case, method: &str) -> Result<Simulation, RunError> {
+fn build(case: &Case, method: &str, trace: Rc<RefCell<Trace>>) -> Result<Simulation, RunError> {
     let scene = case.scene(method)?;
-    if method != "exact" {
-        return Simulation::new(&scene);
-    }
     let disc = Discretisation::new(&scene)?;
     let inner = make_solver(&scene, &disc)?;
-    let audit = KktAudit::new(&disc.step_matrix, &disc.constrained_locals(), false)?;
-    Simulation::with_solver(&scene, disc, Box::new(Audited { inner, audit }))
+    let audit = match method {
+        "exact" => Some(KktAudit::new(
+            &disc.step_matrix,
+            &disc.constrained_locals(),
+            false,
+        )?),
+        _ => None,
+    };
+    Simulation::with_solver(
+        &scene,
+        disc,
+        Box::new(Traced {
+            inner,
+            audit,
+            trace,
+        }),
+    )
 }
 
 /// The table's short form of an error.
@@ -101,17 +155,232 @@ fn short_error(e: &RunError) -> (String, bool) {
     }
 }
 
+/// `|A|x` in difference form: `|s_i||x_i| + |e_{i−1}||x_{i−1} − x_i| + |e_i||x_{i+1} − x_i|`,
+/// the absolute size of what `A x` forms row by row (no rigid offset, as in `mul_into`).
+fn abs_rows(a: &SymTridiag, x: &[f64], out: &mut [f64]) {
+    let n = x.len();
+    let (s, e) = (a.row_sums(), &a.off);
+    for i in 0..n {
+        let mut v = (s[i] * x[i]).abs();
+        if i > 0 {
+            v += (e[i - 1] * (x[i - 1] - x[i])).abs();
+        }
+        if i + 1 < n {
+            v += (e[i] * (x[i + 1] - x[i])).abs();
+        }
+        out[i] = v;
+    }
+}
+
+/// `Σ |s_i| x_i² + Σ |e_i| (Δx_i)²`: the absolute terms of `xᵀAx` in difference form.
+fn abs_quad(a: &SymTridiag, x: &[f64]) -> f64 {
+    let (s, e) = (a.row_sums(), &a.off);
+    let mut q = 0.0;
+    for i in 0..x.len() {
+        q += s[i].abs() * x[i] * x[i];
+        if i + 1 < x.len() {
+            let d = x[i + 1] - x[i];
+            q += e[i].abs() * d * d;
+        }
+    }
+    q
+}
+
+/// `P(v) = Σ |s_i| v_i² + Σ |e_i| |Δv_i| (|v_i| + |v_{i+1}|)`: `|vᵀA e|` for `|e_i| <= |v_i|`.
+fn stored_form(a: &SymTridiag, v: &[f64]) -> f64 {
+    let (s, e) = (a.row_sums(), &a.off);
+    let mut q = 0.0;
+    for i in 0..v.len() {
+        q += s[i].abs() * v[i] * v[i];
+        if i + 1 < v.len() {
+            q += e[i].abs() * (v[i + 1] - v[i]).abs() * (v[i].abs() + v[i + 1].abs());
+        }
+    }
+    q
+}
+
+/// The a-posteriori quantities of a step (see [`StepTerms`]): `t` the solve's vectors, `u1`,
+/// `u0`, `um` the stored `û^{n+1}, û^n, û^{n−1}` on the unknowns, `force` the step's `F^n`, `e_prev = E^{n−1/2}`,
+/// `lambda_min` a lower bound on `λ_min(C)`.
+#[allow(clippy::too_many_arguments)]
+fn step_terms(
+    d: &Discretisation,
+    locals: &[usize],
+    t: &Trace,
+    force: &[f64],
+    u1: &[f64],
+    u0: &[f64],
+    um: &[f64],
+    rec: &StepRecord,
+    e_prev: f64,
+    lambda_min: f64,
+) -> StepTerms {
+    let n = t.z.len();
+    let u = UNIT_ROUNDOFF;
+    let (z, w, b) = (&t.z[..], &t.w[..], &t.rhs[..]);
+    let inv_dt2 = 1.0 / (d.dt * d.dt);
+    let c_w = 0.5 - d.alpha / (2.0 * d.dt);
+    let delta: Vec<f64> = z.iter().zip(w).map(|(a, b)| a + b).collect();
+    let mut pr = vec![0.0; n];
+    for (j, &l) in locals.iter().enumerate() {
+        pr[l] += t.reactions[j];
+    }
+    let mut rho = vec![0.0; n];
+    d.step_matrix.mul_into(z, &mut rho);
+    for i in 0..n {
+        rho[i] = rho[i] - b[i] - pr[i];
+    }
+    let y: Vec<f64> = (0..n).map(|i| c_w * w[i] - u0[i]).collect();
+    let (mut cz, mut mw, mut ry) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    abs_rows(&d.step_matrix, z, &mut cz);
+    abs_rows(&d.mass, w, &mut mw);
+    abs_rows(&d.stiffness, &y, &mut ry);
+    let (rs, re) = (d.stiffness.row_sums(), &d.stiffness.off);
+    let mut f = vec![0.0; n];
+    let mut force_dot = 0.0;
+    for i in 0..n {
+        let force_bound = force[i].abs();
+        // `y_i` is rounded once (`u |y_i|`); R carries that into rows i and i ± 1.
+        let mut y_round = (rs[i].abs()) * y[i].abs();
+        if i > 0 {
+            y_round += re[i - 1].abs() * (y[i].abs() + y[i - 1].abs());
+        }
+        if i + 1 < n {
+            y_round += re[i].abs() * (y[i].abs() + y[i + 1].abs());
+        }
+        f[i] = RESIDUAL_ROUNDINGS
+            * u
+            * (cz[i] + 2.0 * b[i].abs() + pr[i].abs() + mw[i] * inv_dt2 + ry[i] + force_bound)
+            + u * y_round;
+        force_dot += force_bound * delta[i].abs();
+    }
+    let half = |v: f64| 0.5 * v;
+    let rho_dot = half((0..n).map(|i| rho[i] * delta[i]).sum::<f64>()).abs();
+    let floor_rho_abs = half((0..n).map(|i| (delta[i] * f[i]).abs()).sum::<f64>());
+    let contact_dot: f64 = (0..n).map(|i| (pr[i] * delta[i]).abs()).sum();
+    let sum_terms = 0.5 * inv_dt2 * (abs_quad(&d.mass, z) + abs_quad(&d.mass, w))
+        // `|û^n|²_R` enters both energies as the same computed number: its rounding cancels.
+        + 0.25 * (abs_quad(&d.stiffness, u1) + abs_quad(&d.stiffness, um))
+        + d.alpha / (4.0 * d.dt) * abs_quad(&d.stiffness, &delta)
+        + 0.5 * force_dot
+        + 0.5 * contact_dot;
+    let stored_rounding = 0.5 * u * (stored_form(&d.stiffness, u1) + stored_form(&d.stiffness, um));
+    let scale = [
+        rec.energy,
+        e_prev,
+        rec.work.abs(),
+        rec.viscous_dissipation,
+        rec.contact_dissipation.abs(),
+    ]
+    .into_iter()
+    .fold(0.0, f64::max);
+    let combination = rec.energy.abs()
+        + e_prev.abs()
+        + rec.work.abs()
+        + rec.viscous_dissipation
+        + rec.contact_dissipation.abs();
+    // Forward error of the inactive unknowns I (all but the constrained ones carrying a
+    // reaction, which the exact solvers put on their bound): the exact answer for the same
+    // `b̂` and active set differs from z by `e`, `e_A = 0`, `C_II e_I = ρ_I`, and
+    // `|ρ_I| <= |ρ̂_I| + f_solve` (the rounding of ρ̂ only: the solver answered `b̂`).
+    let mut active = Vec::new();
+    for (j, &l) in locals.iter().enumerate() {
+        if t.reactions[j] > 0.0 {
+            active.push(l);
+        }
+    }
+    let mut v: Vec<f64> = (0..n)
+        .map(|i| rho[i].abs() + RESIDUAL_ROUNDINGS * u * (cz[i] + b[i].abs() + pr[i].abs()))
+        .collect();
+    for &l in &active {
+        v[l] = 0.0;
+    }
+    let inactive_constrained = locals
+        .iter()
+        .enumerate()
+        .filter(|&(j, _)| t.reactions[j] <= 0.0)
+        .map(|(_, &l)| l);
+    let stieltjes = d.step_matrix.off.iter().all(|&e| e <= 0.0);
+    let factor = if stieltjes {
+        Ldlt::factor_with_identity_rows(&d.step_matrix, &active).ok()
+    } else {
+        None
+    };
+    let forward = match factor {
+        // C_II is a Stieltjes matrix (SPD, off-diagonals <= 0): C_II⁻¹ >= 0 entrywise, so
+        // |e_I| <= C_II⁻¹ (|ρ̂_I| + f_I) componentwise; that solve has no cancellation (all
+        // its factors keep their signs) and errs by at most γ_{3n} relative, covered by the
+        // factor 1 + 2nε.
+        Some(f) => {
+            f.solve_in_place(&mut v);
+            let grow = 1.0 + 2.0 * n as f64 * f64::EPSILON;
+            inactive_constrained
+                .map(|l| grow * v[l].max(0.0))
+                .fold(0.0, f64::max)
+        }
+        // Otherwise the norm bound: |e_j| <= ‖e_I‖₂ <= ‖ρ_I‖₂ / λ_min(C_II), and
+        // λ_min(C_II) >= λ_min(C) (interlacing).
+        None => {
+            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if inactive_constrained.count() > 0 {
+                norm / lambda_min
+            } else {
+                0.0
+            }
+        }
+    };
+    let mut gap_rounding = 0.0f64;
+    let mut max_reaction = 0.0f64;
+    for (j, (&l, c)) in locals.iter().zip(&d.constraints).enumerate() {
+        let size = t.lower[j].abs() + z[l].abs() + u1[l].abs() + c.gap.abs();
+        gap_rounding = gap_rounding.max(2.0 * u * size);
+        max_reaction = max_reaction.max(t.reactions[j]);
+    }
+    StepTerms {
+        residual: rec.identity_residual,
+        scale,
+        rho_dot,
+        floor_rho_abs,
+        sum_terms,
+        sum_len: n,
+        stored_rounding,
+        combination,
+        violation: if d.constraints.is_empty() {
+            0.0
+        } else {
+            (-rec.min_gap).max(0.0)
+        },
+        forward,
+        gap_rounding,
+        max_reaction,
+    }
+}
+
 /// One solver's run state while stepping in lockstep with the others.
 struct Live {
     sim: Option<Simulation>,
     /// The run's summary statistics (identity residual, penetration, first and last energy),
     /// taken into `out` by [`Live::settle`] when the run ends.
     tracker: Option<Tracker>,
+    trace: Rc<RefCell<Trace>>,
     out: SolverRun,
     u: Vec<f64>,
+    /// `û^n` and `û^{n−1}` on the unknowns (before the step observed).
+    u_now: Vec<f64>,
+    u_before: Vec<f64>,
+    energy_prev: f64,
+    /// A lower bound on `λ_min(C)` of the case.
+    lambda_min: f64,
+    /// `max_j (C⁻¹)_jj` over the constrained ends (0 with an obstacle).
+    schur_max: f64,
     energy_max: f64,
     balance: f64,
     magnitude: f64,
+    /// `Σ_n` of the steps' signed identity residuals (absolute), and of the drift's per-step
+    /// rounding bounds.
+    residual_sum: f64,
+    drift_rounding: f64,
+    dump: Option<StepTerms>,
 }
 
 impl Live {
@@ -128,23 +397,82 @@ impl Live {
         // Unforced or not: the energy rise is not read here.
         self.tracker = Some(Tracker::new(&sim, false));
         let first = sim.first_record();
+        let d = sim.discretisation();
+        let unknowns = d.first..d.first + d.unknowns();
+        let (u0, _) = sim.initial_state();
+        self.u_before = u0[unknowns.clone()].to_vec();
+        sim.displacement_into(&mut self.u);
+        self.u_now = self.u[unknowns].to_vec();
+        self.energy_prev = first.energy;
         self.sim = Some(sim);
         self.observe(&first, true);
     }
 
-    fn observe(&mut self, r: &crate::time::simulation::StepRecord, first: bool) {
-        let o = &mut self.out;
-        o.steps_done = r.step;
+    fn observe(&mut self, r: &StepRecord, first: bool) {
+        self.out.steps_done = r.step;
+        if let Some(sim) = &self.sim {
+            sim.displacement_into(&mut self.u);
+        }
         if !first {
             if let Some(t) = self.tracker.as_mut() {
                 t.observe(r);
             }
-            self.balance += r.work - r.viscous_dissipation - r.contact_dissipation;
-            self.magnitude += r.work.abs() + r.viscous_dissipation + r.contact_dissipation.abs();
+            let u = UNIT_ROUNDOFF;
+            let term = r.work - r.viscous_dissipation - r.contact_dissipation;
+            let size = r.work.abs() + r.viscous_dissipation + r.contact_dissipation.abs();
+            self.balance += term;
+            self.magnitude += size;
+            // The step's residual with its sign, in the record's own operations (the same
+            // bits as `identity_residual · scale`).
+            let residual = r.energy - self.energy_prev - r.work
+                + r.viscous_dissipation
+                + r.contact_dissipation;
+            self.residual_sum += residual;
+            // This step's rounding in the drift's two computations: the four roundings of
+            // the residual, two of the balance's term and one of each running sum.
+            let combination = r.energy.abs() + self.energy_prev.abs() + size;
+            let c = u
+                * (COMBINATION_ROUNDINGS * combination
+                    + 2.0 * size
+                    + self.balance.abs()
+                    + self.residual_sum.abs());
+            self.drift_rounding += c;
+            if let Some(sim) = self.sim.as_mut() {
+                // F^n as the step used it, evaluated again (deterministic).
+                let force = match sim.load_vector(r.step - 1) {
+                    Ok(f) => f.to_vec(),
+                    Err(_) => vec![f64::NAN; self.u_now.len()],
+                };
+                let d = sim.discretisation();
+                let unknowns = d.first..d.first + d.unknowns();
+                let terms = step_terms(
+                    d,
+                    &d.constrained_locals(),
+                    &self.trace.borrow(),
+                    &force,
+                    &self.u[unknowns.clone()],
+                    &self.u_now,
+                    &self.u_before,
+                    r,
+                    self.energy_prev,
+                    self.lambda_min,
+                );
+                let id_tol = terms.identity_tolerance();
+                if terms.residual / id_tol >= self.out.identity.ratio() {
+                    self.dump = Some(terms);
+                }
+                self.out.identity.update(terms.residual, id_tol);
+                let scale = self.out.max_displacement.max(max_abs(&self.u));
+                let v_tol = terms.violation_tolerance(self.out.solver, scale, self.schur_max);
+                self.out.violation.update(terms.violation, v_tol);
+                self.u_before.clone_from(&self.u_now);
+                self.u_now.copy_from_slice(&self.u[unknowns]);
+            }
+            self.energy_prev = r.energy;
         }
         self.energy_max = self.energy_max.max(r.energy.abs());
+        let o = &mut self.out;
         if let Some(sim) = &self.sim {
-            sim.displacement_into(&mut self.u);
             o.all_finite &= self.u.iter().all(|v| v.is_finite());
             o.max_displacement = o.max_displacement.max(max_abs(&self.u));
             o.max_reaction = o.max_reaction.max(max_abs(sim.reactions()));
@@ -163,7 +491,39 @@ impl Live {
         o.max_violation = s.max_violation;
         let scale = self.energy_max.max(self.magnitude);
         let drift = (s.energy_final - s.energy_initial - self.balance).abs();
-        o.energy_drift = if scale > 0.0 { drift / scale } else { 0.0 };
+        // The drift is the sum of the steps' residuals (telescoping): both computed, they
+        // differ by the per-step roundings and the final difference's two.
+        let bound = self.residual_sum.abs()
+            + self.drift_rounding
+            + 2.0
+                * UNIT_ROUNDOFF
+                * (s.energy_final.abs() + s.energy_initial.abs() + self.balance.abs());
+        (o.energy_drift, o.drift_tolerance) = if scale > 0.0 {
+            (drift / scale, bound / scale)
+        } else {
+            (0.0, 0.0)
+        };
+        if let (Some(t), true) = (self.dump, std::env::var_os("VISCOBAR_STIFF_DUMP").is_some()) {
+            let id_tol = t.identity_tolerance();
+            eprintln!(
+                "DUMP {} id {:.2e}/{:.2e}={:.1e} | sc {:.1e} rhodot {:.1e} fl1 {:.1e} sums {:.1e} m {} st {:.1e} comb {:.1e} | viol {:.1e}/{:.1e} drift {:.1e}/{:.1e}",
+                o.solver,
+                t.residual,
+                id_tol,
+                t.residual / id_tol,
+                t.scale,
+                t.rho_dot,
+                t.floor_rho_abs,
+                t.sum_terms,
+                t.sum_len,
+                t.stored_rounding,
+                t.combination,
+                o.violation.value,
+                o.violation.tolerance,
+                o.energy_drift,
+                o.drift_tolerance
+            );
+        }
     }
 }
 
@@ -173,6 +533,7 @@ pub fn run_case(case: &Case) -> CaseResult {
     let mut kappa = None;
     let mut max_gap = 0.0f64;
     let mut schur = None;
+    let mut lambda_min = f64::NAN;
     let mut live: Vec<Live> = case
         .solvers()
         .into_iter()
@@ -193,21 +554,41 @@ pub fn run_case(case: &Case) -> CaseResult {
                     audit_ratio: None,
                     rigid_drift: None,
                     all_finite: true,
+                    identity: Worst::default(),
+                    violation: Worst::default(),
+                    drift_tolerance: 0.0,
                 },
                 tracker: None,
+                trace: Rc::new(RefCell::new(Trace::default())),
                 u: vec![0.0; nodes],
+                u_now: Vec::new(),
+                u_before: Vec::new(),
+                energy_prev: 0.0,
+                lambda_min: f64::NAN,
+                schur_max: 0.0,
                 energy_max: 0.0,
                 balance: 0.0,
                 magnitude: 0.0,
+                residual_sum: 0.0,
+                drift_rounding: 0.0,
+                dump: None,
             };
-            match build(case, solver) {
+            match build(case, solver, l.trace.clone()) {
                 Ok(sim) => {
                     if kappa.is_none() {
                         let d = sim.discretisation();
-                        kappa = crate::linalg::spectrum::condition_number(&d.step_matrix);
+                        let c = &d.step_matrix;
+                        kappa = crate::linalg::spectrum::condition_number(c);
+                        // The bisection's error bound, tested against the double-double
+                        // reference in `linalg::spectrum`.
+                        lambda_min = (crate::linalg::spectrum::smallest_eigenvalue_spd(c)
+                            - STURM_ERROR_ULPS * f64::EPSILON * c.inf_norm())
+                        .max(0.0);
                         max_gap = d.constraints.iter().fold(0.0, |m, c| m.max(c.gap));
                         schur = d.ends_only().then(|| inverse_diagonal_range(d)).flatten();
                     }
+                    l.lambda_min = lambda_min;
+                    l.schur_max = schur.map_or(0.0, |(_, hi): (f64, f64)| hi);
                     l.start(sim);
                 }
                 Err(e) => l.fail(&e),
@@ -256,7 +637,7 @@ pub fn run_case(case: &Case) -> CaseResult {
 
 /// `(min_j, max_j) (C⁻¹)_jj` over the constrained nodes, one O(n) solve each (at most two).
 fn inverse_diagonal_range(d: &Discretisation) -> Option<(f64, f64)> {
-    let factor = crate::linalg::ldlt::Ldlt::factor(&d.step_matrix).ok()?;
+    let factor = Ldlt::factor(&d.step_matrix).ok()?;
     d.constrained_locals()
         .iter()
         .map(|&j| factor.column_of_inverse(j)[j])
