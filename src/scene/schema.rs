@@ -517,6 +517,10 @@ pub const PLANE_BUILTIN: &[(&str, &str)] = &[
         "plane-curved-obstacle",
         include_str!("../../scenes/plane-curved-obstacle.toml"),
     ),
+    (
+        "plane-block-drop",
+        include_str!("../../scenes/plane-block-drop.toml"),
+    ),
 ];
 
 /// The TOML text of a built-in plane scene.
