@@ -398,3 +398,25 @@ fn without_signorini_edges_the_method_is_named_and_penalty_is_the_exact_step() {
     assert!(outs[0] != outs[2]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn an_osqp_failure_exits_1_naming_the_step_and_writes_nothing() {
+    let out = fresh_dir("osqp-fails");
+    let o = viscobar(&[
+        "run",
+        "plane-tilted-drop",
+        "--solver",
+        "osqp",
+        "--set",
+        "solver.max_iter=1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("step 1:") && stderr.contains("maximum iterations reached"),
+        "{stderr}"
+    );
+    assert!(!out.exists(), "wrote {}", out.display());
+}
