@@ -11,7 +11,8 @@
 //! exact step against the unconstrained step of the same body with a free bottom, at 1e4 …
 //! 2e5 unknowns with up to 200 contact normals and at 1e5 with 500; it prints the ratio, the
 //! set-up cost of `S` (the contact run's set-up minus the free one's) and OSQP's step over the
-//! exact one (up to 5e4 unknowns).
+//! exact one (up to 5e4 unknowns). `plane-contact/kratos-block-30x15-200-steps` is the issue's
+//! Kratos point: the built-in `plane-block-drop` end to end in memory (`bench_kratos`).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use std::time::Instant;
@@ -107,9 +108,9 @@ fn resting(nx: u64, ny: u64, contact: bool) -> PlaneScene {
     PlaneScene::from_toml(&text, &[]).unwrap()
 }
 
-/// `(nx, ny)` of the contact bench: about 1e4, 4e4 and 2e5 unknowns with up to 200 contact
-/// normals, and 500 normals at 1e5 unknowns.
-const CONTACT_SIZES: [(u64, u64); 4] = [(99, 50), (199, 100), (199, 500), (499, 100)];
+/// `(nx, ny)` of the contact bench: about 1e4 unknowns with 100 and 200 contact normals, 4e4
+/// and 2e5 with 200, and 500 normals at 1e5 unknowns.
+const CONTACT_SIZES: [(u64, u64); 5] = [(99, 50), (199, 24), (199, 100), (199, 500), (499, 100)];
 
 /// The exact step with contact against the unconstrained step of the same body, the set-up of
 /// `S` (m solves, blocked), and OSQP's step where it is affordable (at most 5e4 unknowns).
@@ -186,10 +187,45 @@ fn bench_contact(c: &mut Criterion) {
     }
 }
 
+/// The Kratos point (Kratos 10.4.4: 12–28 s on this machine): the built-in
+/// `plane-block-drop`, a 30 × 15 block falling onto a floor for 200 steps, undamped (α = 0, as
+/// Kratos' Newmark run) and with the talk's α = 0.1; set-up and the 200 exact steps end to end
+/// in memory (`run_plane_in_memory`: the scene validated, the factor, `S`, every record).
+fn bench_kratos(c: &mut Criterion) {
+    use viscobar::plane::run::run_plane_in_memory;
+    use viscobar::scene::{AnyScene, load_any};
+    let mut group = c.benchmark_group("plane-contact");
+    group.sample_size(20);
+    let mut rows = Vec::new();
+    for (id, set) in [
+        ("kratos-block-30x15-200-steps", vec![]),
+        (
+            "kratos-block-30x15-200-steps-alpha0.1",
+            vec!["plane.viscosity=0.1".to_string()],
+        ),
+    ] {
+        let AnyScene::Plane(scene) = load_any("plane-block-drop", &set).unwrap().1 else {
+            panic!("plane-block-drop is a plane scene");
+        };
+        group.bench_function(id, |b| {
+            b.iter(|| run_plane_in_memory("plane-block-drop", &scene).unwrap())
+        });
+        let t = median(21, || {
+            run_plane_in_memory("plane-block-drop", &scene).unwrap();
+        });
+        rows.push((id, t));
+    }
+    group.finish();
+    println!("\n| run (set-up + 200 steps, in memory) | median ms |\n|---|---|");
+    for (id, t) in rows {
+        println!("| {id} | {:.2} |", t * 1e3);
+    }
+}
+
 // No HTML plots, as in benches/step.rs (criterion's plotters backend would need a font).
 criterion_group! {
     name = benches;
     config = Criterion::default().without_plots();
-    targets = bench, bench_contact
+    targets = bench, bench_contact, bench_kratos
 }
 criterion_main!(benches);

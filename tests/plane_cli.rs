@@ -109,7 +109,11 @@ const CASES: &[(&str, &[&str], &str)] = &[
         &["load.density=[\"1/(x-x)\", \"0\"]"],
         "load.density[0]",
     ),
-    ("solver on a plane", &["solver.method=\"osqp\""], "solver"),
+    (
+        "unknown solver method",
+        &["solver.method=\"simplex\""],
+        "solver.method",
+    ),
     (
         "a number for a vector",
         &["initial.displacement=0.1"],

@@ -1,6 +1,6 @@
 //! `viscobar run` on plane scenes with Signorini edges through the binary: the contact columns
-//! and summary, and bad contact input refused with exit code 2 naming the field, nothing
-//! written.
+//! and summary, each `[solver]` method bit for bit against the library run of that method, and
+//! bad contact or solver input refused with exit code 2 naming the field, nothing written.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -93,6 +93,55 @@ const CASES: &[(&str, &[&str], &str)] = &[
         "edges.bottom.gap",
     ),
     (
+        "unknown solver method",
+        &["solver.method=\"lemke\""],
+        "solver.method",
+    ),
+    (
+        "unknown solver key",
+        &["solver.colour=1"],
+        "unknown field `colour`",
+    ),
+    (
+        "penalty epsilon zero",
+        &["solver.method=\"penalty\"", "solver.epsilon=0"],
+        "solver.epsilon",
+    ),
+    (
+        "penalty epsilon not finite",
+        &["solver.method=\"penalty\"", "solver.epsilon=inf"],
+        "solver.epsilon",
+    ),
+    (
+        "osqp eps negative",
+        &["solver.method=\"osqp\"", "solver.eps_rel=-1e-9"],
+        "solver.eps_rel",
+    ),
+    (
+        "osqp eps both zero",
+        &[
+            "solver.method=\"osqp\"",
+            "solver.eps_abs=0",
+            "solver.eps_rel=0",
+        ],
+        "solver.eps_abs",
+    ),
+    (
+        "osqp max_iter zero",
+        &["solver.method=\"osqp\"", "solver.max_iter=0"],
+        "solver.max_iter",
+    ),
+    (
+        "epsilon with osqp",
+        &["solver.method=\"osqp\"", "solver.epsilon=1e-6"],
+        "solver.epsilon",
+    ),
+    (
+        "osqp key with the exact method",
+        &["solver.polish=false"],
+        "solver.polish",
+    ),
+    (
         "too many contact normals",
         &[
             "mesh.nx=3000",
@@ -144,4 +193,230 @@ fn run_figure_draws_the_contact_pressure_beside_the_deformed_mesh() {
         assert!(len > MIN_FIGURE_BYTES, "{f}: {len} bytes");
     }
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Reads `displacement.csv` and `history.csv` of a run: per kept step the `ux, uy, vx, vy`
+/// of every node (in node order), and the `energy` column of every step.
+fn read_run(out: &Path) -> (Vec<Vec<[f64; 4]>>, Vec<f64>) {
+    let disp = std::fs::read_to_string(out.join("displacement.csv")).unwrap();
+    let mut kept: Vec<Vec<[f64; 4]>> = Vec::new();
+    let mut last_t = String::new();
+    for line in disp.lines().skip(1) {
+        let cells: Vec<&str> = line.split(',').collect();
+        if cells[0] != last_t {
+            kept.push(Vec::new());
+            last_t = cells[0].to_string();
+        }
+        let v = [3, 4, 5, 6].map(|k| cells[k].parse::<f64>().unwrap());
+        kept.last_mut().unwrap().push(v);
+    }
+    let hist = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    let energy = hist
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(2).unwrap().parse::<f64>().unwrap())
+        .collect();
+    (kept, energy)
+}
+
+/// The same run in the library with `method` given explicitly (not read from `[solver]`):
+/// `ux, uy, vx, vy` at the steps `keep` selects (and `t = 0`), and every step's energy.
+fn library_run(
+    scene: &viscobar::PlaneScene,
+    method: viscobar::plane::contact::ContactMethod,
+) -> (Vec<Vec<[f64; 4]>>, Vec<f64>) {
+    use viscobar::plane::PlaneSimulation;
+    let mut sim = PlaneSimulation::with_method(scene, method).unwrap();
+    let nodes = sim.discretisation().grid.nodes();
+    let field = |u: &[f64], v: &[f64]| -> Vec<[f64; 4]> {
+        (0..nodes)
+            .map(|k| [u[2 * k], u[2 * k + 1], v[2 * k], v[2 * k + 1]])
+            .collect()
+    };
+    let (u0, v0) = sim.initial_state();
+    let mut kept = vec![field(u0, v0)];
+    let mut energy = vec![sim.first_record().energy];
+    let (steps, every) = (scene.steps(), scene.output.every as usize);
+    let mut u = vec![0.0; 2 * nodes];
+    let mut v = vec![0.0; 2 * nodes];
+    for n in 1..=steps {
+        if n > 1 {
+            energy.push(sim.step().unwrap().energy);
+        }
+        if n % every == 0 || n == steps {
+            sim.displacement_into(&mut u);
+            sim.velocity_into(&mut v);
+            kept.push(field(&u, &v));
+        }
+    }
+    (kept, energy)
+}
+
+fn bits(rows: &[Vec<[f64; 4]>]) -> Vec<u64> {
+    rows.iter()
+        .flatten()
+        .flatten()
+        .map(|x| x.to_bits())
+        .collect()
+}
+
+/// `--set solver.epsilon` of the penalty run (a setting, not a tolerance).
+const PENALTY_EPSILON: &str = "1e-7";
+/// `--set solver.eps_abs` and `eps_rel` of the OSQP run: not the default, so that the settings
+/// are seen to reach OSQP.
+const OSQP_EPS: &str = "1e-9";
+
+#[test]
+fn each_solver_method_runs_through_the_binary_bit_for_bit_as_in_the_library() {
+    use viscobar::plane::contact::ContactMethod;
+    use viscobar::step::osqp::OsqpSettings;
+    let eps: f64 = OSQP_EPS.parse().unwrap();
+    let epsilon: f64 = PENALTY_EPSILON.parse().unwrap();
+    let dir = fresh_dir("methods");
+    std::fs::create_dir_all(&dir).unwrap();
+    // The penalty through a scene file with a [solver] table, the others through flags.
+    let shown = String::from_utf8(viscobar(&["show", "plane-tilted-drop"]).stdout).unwrap();
+    assert!(
+        shown.contains("[plane]") && !shown.contains("[solver]"),
+        "{shown}"
+    );
+    let file = dir.join("drop-penalty.toml");
+    std::fs::write(
+        &file,
+        format!("{shown}\n[solver]\nmethod = \"penalty\"\nepsilon = {PENALTY_EPSILON}\n"),
+    )
+    .unwrap();
+    let osqp_eps = [
+        format!("solver.eps_abs={OSQP_EPS}"),
+        format!("solver.eps_rel={OSQP_EPS}"),
+    ];
+    let runs: [(&str, Vec<&str>, ContactMethod); 3] = [
+        ("exact", vec!["plane-tilted-drop"], ContactMethod::Exact),
+        (
+            "osqp",
+            vec![
+                "plane-tilted-drop",
+                "--solver",
+                "osqp",
+                "--set",
+                &osqp_eps[0],
+                "--set",
+                &osqp_eps[1],
+            ],
+            ContactMethod::Osqp(OsqpSettings {
+                eps_abs: eps,
+                eps_rel: eps,
+                ..OsqpSettings::default()
+            }),
+        ),
+        (
+            "penalty",
+            vec![file.to_str().unwrap()],
+            ContactMethod::Penalty { epsilon },
+        ),
+    ];
+    let scene = match viscobar::scene::load_any("plane-tilted-drop", &[])
+        .unwrap()
+        .1
+    {
+        viscobar::scene::AnyScene::Plane(s) => *s,
+        _ => unreachable!(),
+    };
+    let mut all = Vec::new();
+    for (name, args, method) in runs {
+        let out = dir.join(name);
+        let mut a = vec!["run"];
+        a.extend(&args);
+        a.extend(["--out", out.to_str().unwrap()]);
+        let o = viscobar(&a);
+        assert!(
+            o.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(summary["method"], name);
+        assert_eq!(summary["audit"].is_object(), name == "osqp", "{name}");
+        assert!(
+            summary["contact"]["max_active"].as_u64().unwrap() > 1,
+            "{name}"
+        );
+        let (kept, energy) = read_run(&out);
+        let (lib_kept, lib_energy) = library_run(&scene, method);
+        assert_eq!(kept.len(), lib_kept.len(), "{name}: kept steps");
+        assert!(bits(&kept) == bits(&lib_kept), "{name}: u, v differ");
+        let e_bits = |e: &[f64]| e.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert!(
+            e_bits(&energy) == e_bits(&lib_energy),
+            "{name}: energies differ"
+        );
+        all.push(bits(&kept));
+    }
+    // The three methods give three different runs (a method ignored would repeat one).
+    assert!(all[0] != all[1] && all[0] != all[2] && all[1] != all[2]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn without_signorini_edges_the_method_is_named_and_penalty_is_the_exact_step() {
+    let dir = fresh_dir("no-edges");
+    let mut outs = Vec::new();
+    for method in ["exact", "penalty", "osqp"] {
+        let out = dir.join(method);
+        let o = viscobar(&[
+            "run",
+            "plane-strip",
+            "--solver",
+            method,
+            "--set",
+            "time.end=0.1",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(
+            o.status.success(),
+            "{method}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(summary["method"], method);
+        assert!(summary.get("contact").is_none(), "{method}");
+        // OSQP runs (on the unconstrained problem, as the bar's does) and is audited.
+        assert_eq!(
+            summary["audit"]["steps"].as_u64().is_some(),
+            method == "osqp"
+        );
+        outs.push(std::fs::read(out.join("displacement.csv")).unwrap());
+    }
+    // No contact normal: the penalty's step is the exact one, byte for byte; OSQP's ADMM
+    // answer is not.
+    assert!(outs[0] == outs[1]);
+    assert!(outs[0] != outs[2]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_osqp_failure_exits_1_naming_the_step_and_writes_nothing() {
+    let out = fresh_dir("osqp-fails");
+    let o = viscobar(&[
+        "run",
+        "plane-tilted-drop",
+        "--solver",
+        "osqp",
+        "--set",
+        "solver.max_iter=1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("step 1:") && stderr.contains("maximum iterations reached"),
+        "{stderr}"
+    );
+    assert!(!out.exists(), "wrote {}", out.display());
 }

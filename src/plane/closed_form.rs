@@ -214,6 +214,7 @@ impl Manufactured {
             },
             mesh: PlaneMesh { nx, ny, y_grading },
             time: Time { step: dt, end },
+            solver: Default::default(),
             output: PlaneOutput::default(),
         }
     }

@@ -29,6 +29,7 @@ use crate::plane::factor::SparseCholesky;
 use crate::plane::matrices::Pattern;
 pub use crate::plane::normals::{Normal, normals};
 use crate::plane::osqp::PlaneOsqp;
+use crate::scene::schema::{SolverMethod, SolverSpec};
 use crate::step::lcp::DenseLcp;
 use crate::step::osqp::OsqpSettings;
 use crate::step::report::AuditReport;
@@ -47,6 +48,18 @@ pub enum ContactMethod {
 }
 
 impl ContactMethod {
+    /// The method a scene's `[solver]` table names, with its settings (the bar's defaults for
+    /// those not given; the table is validated with the scene).
+    pub fn from_spec(spec: &SolverSpec) -> Self {
+        match spec.method {
+            SolverMethod::Exact => ContactMethod::Exact,
+            SolverMethod::Osqp => ContactMethod::Osqp(spec.osqp_settings()),
+            SolverMethod::Penalty => ContactMethod::Penalty {
+                epsilon: spec.penalty_settings().epsilon,
+            },
+        }
+    }
+
     /// `exact`, `penalty`, `osqp`.
     pub fn name(&self) -> &'static str {
         match self {
@@ -188,6 +201,11 @@ impl Contact {
     /// OSQP's audit so far (OSQP only).
     pub fn audit(&self) -> Option<&AuditReport> {
         self.osqp.as_ref().map(|o| o.report())
+    }
+
+    /// Steps where OSQP's "solved inaccurate" was accepted (OSQP only).
+    pub fn inaccurate_steps(&self) -> Option<u64> {
+        self.osqp.as_ref().map(|o| o.inaccurate_steps())
     }
 
     /// The increment `z` of a step with right-hand side `b` at the state `u = u^n`, the

@@ -5,6 +5,7 @@
 use crate::plane::error::PlaneError;
 use crate::plane::simulation::{PlaneRecord, PlaneSimulation};
 use crate::scene::plane::PlaneScene;
+use crate::step::report::AuditReport;
 use crate::time::run::{RUN_FILES, write_whole};
 use crate::time::summary::output_time;
 use serde::Serialize;
@@ -21,6 +22,9 @@ pub struct PlaneSummary {
     pub scene: String,
     /// [`SOLVER_NAME`]: one solve with the factor of `C` per step.
     pub solver: String,
+    /// The step problems' method, `[solver] method`: `exact`, `osqp` or `penalty` (named
+    /// even without Signorini edges, as the bar's `solver`).
+    pub method: String,
     /// `(nx + 1)(ny + 1)`.
     pub nodes: usize,
     /// Cells, `nx · ny`.
@@ -44,6 +48,12 @@ pub struct PlaneSummary {
     /// With Signorini edges only: the contact figures over all steps.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact: Option<ContactSummary>,
+    /// OSQP only: the worst audit residuals, each with its ratio to its tolerance.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub audit: Option<AuditReport>,
+    /// OSQP only: steps accepted as "solved inaccurate" (`solver.accept_inaccurate`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inaccurate_steps: Option<u64>,
 }
 
 /// The contact figures of a plane run with Signorini edges.
@@ -61,7 +71,8 @@ pub struct ContactSummary {
     /// (`max(|g|, |u·n|)`): round-off.
     pub max_penetration: f64,
     pub max_complementarity: f64,
-    /// `mean` and `max` of the LCP solver's active sets tried per step.
+    /// `mean` and `max` of the iterations per step: active sets tried (exact, penalty) or
+    /// ADMM iterations (OSQP).
     pub iterations_mean: f64,
     pub iterations_max: u32,
 }
@@ -137,6 +148,7 @@ impl Tracker {
         PlaneSummary {
             scene: name.to_string(),
             solver: SOLVER_NAME.into(),
+            method: sim.method().name().into(),
             nodes: d.grid.nodes(),
             elements: d.grid.cells(),
             unknowns: d.unknowns(),
@@ -154,6 +166,8 @@ impl Tracker {
                 c.iterations_mean = self.iterations as f64 / self.records.max(1) as f64;
                 c
             }),
+            audit: sim.osqp_report().map(|(a, _)| a.clone()),
+            inaccurate_steps: sim.osqp_report().map(|(_, n)| n),
         }
     }
 }

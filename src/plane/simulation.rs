@@ -20,6 +20,7 @@ use crate::plane::normals::normals;
 use crate::plane::rhs::{RhsTerms, rhs_into};
 use crate::scene::expr::Expression;
 use crate::scene::plane::PlaneScene;
+use crate::step::report::AuditReport;
 
 /// The discretised body: grid, unknowns, and `M`, `K` on the unknowns (one pattern).
 pub struct PlaneDiscretisation {
@@ -164,8 +165,10 @@ pub struct PlaneRecord {
 pub struct PlaneSimulation {
     disc: PlaneDiscretisation,
     chol: SparseCholesky,
-    /// The Signorini edges' exact contact solver (`None` without contact normals).
+    /// The Signorini edges' contact solver (`None` without contact normals, but for OSQP,
+    /// which then solves the unconstrained problem, as the bar's does).
     contact: Option<Contact>,
+    method: ContactMethod,
     load: LoadTerm,
     n: usize,
     /// `u^n`, `w = u^n − u^{n−1}` on the unknowns.
@@ -183,15 +186,17 @@ pub struct PlaneSimulation {
 }
 
 impl PlaneSimulation {
-    /// Sets up a run of `scene` and takes the start-up step to `u^1`:
+    /// Sets up a run of `scene` with the contact solver its `[solver]` table names
+    /// ([`ContactMethod::from_spec`]) and takes the start-up step to `u^1`:
     /// `u^1 = u^0 + Δt u_1 + Δt²/2 M⁻¹(F^0 − K u^0 − α K u_1)` (Taylor, second order for
-    /// smooth data; the bar's start-up without its projection, which has no constraint here).
+    /// smooth data), projected onto the admissible set with Signorini edges.
     pub fn new(scene: &PlaneScene) -> Result<Self, PlaneError> {
-        Self::with_method(scene, ContactMethod::Exact)
+        Self::with_method(scene, ContactMethod::from_spec(&scene.solver))
     }
 
-    /// [`PlaneSimulation::new`] with the contact problems solved by `method` (ignored without
-    /// Signorini edges).
+    /// [`PlaneSimulation::new`] with the contact problems solved by `method` instead of the
+    /// scene's. Without Signorini edges `exact` and `penalty` are the one sparse solve and
+    /// `osqp` runs OSQP on the unconstrained problem (the bar's behaviour).
     pub fn with_method(scene: &PlaneScene, method: ContactMethod) -> Result<Self, PlaneError> {
         scene.validate()?;
         let exprs = scene.expressions()?;
@@ -261,7 +266,7 @@ impl PlaneSimulation {
         // With contact, the Taylor step is projected onto the admissible set in the C-norm
         // (the step problem with b = C z_T), as the bar's start-up does.
         let mut contact_step = ContactStep::default();
-        let contact = if normals.is_empty() {
+        let contact = if normals.is_empty() && !matches!(method, ContactMethod::Osqp(_)) {
             None
         } else {
             let mut contact = Contact::new(normals, &mut chol, method, &disc.pattern, &c)?;
@@ -293,6 +298,7 @@ impl PlaneSimulation {
         Ok(Self {
             chol,
             contact,
+            method,
             load,
             n: 1,
             u,
@@ -397,7 +403,19 @@ impl PlaneSimulation {
 
     /// The contact solver (`None` without Signorini edges): normals, `S`, last reactions.
     pub fn contact(&self) -> Option<&Contact> {
-        self.contact.as_ref()
+        self.contact.as_ref().filter(|c| !c.is_empty())
+    }
+
+    /// The method solving the step problems (named even without Signorini edges).
+    pub fn method(&self) -> ContactMethod {
+        self.method
+    }
+
+    /// OSQP's audit so far and its accepted "solved inaccurate" steps (OSQP only, with or
+    /// without contact normals).
+    pub fn osqp_report(&self) -> Option<(&AuditReport, u64)> {
+        let c = self.contact.as_ref()?;
+        Some((c.audit()?, c.inaccurate_steps()?))
     }
 
     /// The record of the start-up step.

@@ -1,12 +1,12 @@
 //! Plane scene files (TOML): a Kelvin–Voigt body in plane strain on `(0, W) × (0, H)`, its four
 //! edges, initial data and load (two components each, expressions in `x`, `y` and, for the
-//! load, `t`), the graded mesh, the time step and the output. A scene file has `[bar]` or
-//! `[plane]`, never both ([`load_any`] tells them apart). Unknown keys are refused, as for the
-//! bar.
+//! load, `t`), the graded mesh, the time step, the contact solver (`[solver]`, the bar's
+//! keys) and the output. A scene file has `[bar]` or `[plane]`, never both ([`load_any`] tells
+//! them apart). Unknown keys are refused, as for the bar.
 
 use crate::scene::expr::Expression;
 use crate::scene::schema::{
-    GIB, MAX_STEPS, Scene, Time, available_memory_bytes, check_time_grid, invalid,
+    GIB, MAX_STEPS, Scene, SolverSpec, Time, available_memory_bytes, check_time_grid, invalid,
     number_or_expression, number_text, positive, toml_syntax, with_overrides,
 };
 /// The built-in plane scenes (kept beside the bar's list in [`crate::scene::schema`]).
@@ -30,6 +30,12 @@ pub struct PlaneScene {
     pub load: PlaneLoad,
     pub mesh: PlaneMesh,
     pub time: Time,
+    /// The contact solver: the bar's `[solver]` table, keys and defaults
+    /// (`crate::plane::contact::ContactMethod::from_spec` maps it). Without Signorini edges
+    /// the method is still the one named, as for the bar: `osqp` runs OSQP on the
+    /// unconstrained step problem, `exact` and `penalty` are the one sparse solve.
+    #[serde(default)]
+    pub solver: SolverSpec,
     #[serde(default)]
     pub output: PlaneOutput,
 }
@@ -437,6 +443,7 @@ impl PlaneScene {
                 "must be >= 1",
             ));
         }
+        self.solver.validate()?;
         self.expressions()?;
         self.edges.gaps()?;
         let m = self.contact_normals();

@@ -364,7 +364,9 @@ impl SolverSpec {
         out
     }
 
-    fn validate(&self) -> Result<(), SceneError> {
+    /// Refuses a setting of another method and out-of-range values, naming `solver.<key>`
+    /// (shared by bar and plane scenes).
+    pub(crate) fn validate(&self) -> Result<(), SceneError> {
         if let Some((name, owner)) = self.foreign_settings().first() {
             return Err(SceneError::Invalid {
                 field: format!("solver.{name}"),
@@ -514,6 +516,10 @@ pub const PLANE_BUILTIN: &[(&str, &str)] = &[
     (
         "plane-curved-obstacle",
         include_str!("../../scenes/plane-curved-obstacle.toml"),
+    ),
+    (
+        "plane-block-drop",
+        include_str!("../../scenes/plane-block-drop.toml"),
     ),
 ];
 

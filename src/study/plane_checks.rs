@@ -167,6 +167,7 @@ pub fn plane_of_bar(bar: &Scene, height: f64, ny: u64, y_grading: f64) -> Option
             y_grading,
         },
         time: bar.time.clone(),
+        solver: Default::default(),
         output: PlaneOutput::default(),
     })
 }
