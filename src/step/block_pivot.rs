@@ -288,17 +288,7 @@ impl BlockPivotSolver {
     /// `(C z)_i`, with the bits of [`SymTridiag::mul_into`] (difference form).
     #[inline(always)]
     fn row_product(&self, i: usize, z: &[f64]) -> f64 {
-        let n = z.len();
-        let (s, e) = (self.c.row_sums(), &self.c.off);
-        if n == 1 {
-            self.c.diag[0] * z[0]
-        } else if i == 0 {
-            s[0] * z[0] + e[0] * (z[1] - z[0])
-        } else if i + 1 == n {
-            s[i] * z[i] + e[i - 1] * (z[i - 1] - z[i])
-        } else {
-            s[i] * z[i] + e[i - 1] * (z[i - 1] - z[i]) + e[i] * (z[i + 1] - z[i])
-        }
+        row_product(&self.c, i, z)
     }
 
     // ---- whole-bar solves ---------------------------------------------------------------
@@ -310,18 +300,19 @@ impl BlockPivotSolver {
         self.factor_valid = true;
     }
 
-    /// The whole-bar solve with the current factor, with every margin and the block maxima
-    /// of `|z|` evaluated inside the backward sweep (off its dependency chain).
-    /// Returns `(max|b|, max|lo|)`, taken in the forward sweep.
+    /// The whole-bar solve with the current factor, then every margin and the block maxima
+    /// of `|z|`. Returns `(max|b|, max|lo|)`, taken in the forward sweep.
+    ///
+    /// The arithmetic of `forward_value` and `backward_value` (the tests compare the two bit
+    /// for bit), one loop per run of active or free nodes so that the chains run through the
+    /// free runs only; the chains' inner loops are small functions of their own
+    /// ([`forward_chain`], [`backward_chain`]): inlined into `solve`, their carried values
+    /// were spilled to the stack, a store and a reload on every link of the chain.
     fn solve_all(&mut self, rhs: &[f64], z: &mut [f64]) -> (f64, f64) {
         let n = z.len();
         let (mut b_max, mut lo_max) = (0.0f64, 0.0f64);
+        let (active, lo, off, l) = (&self.active[..n], &self.lo[..n], &self.c.off, &self.l);
         {
-            // The arithmetic of `forward_value`, on local slices (no reloads through `self`),
-            // one loop per run of active or free nodes so that the chain runs through the free
-            // runs only (a select on `active` would chain every node); the tests compare the
-            // two bit for bit.
-            let (active, lo, off, l) = (&self.active[..n], &self.lo[..n], &self.c.off, &self.l);
             let ts = &mut self.t[..n];
             let reduced_rhs = |j: usize| {
                 let mut r = rhs[j];
@@ -343,69 +334,64 @@ impl BlockPivotSolver {
                         j += 1;
                     }
                 } else {
-                    b_max = max_of(b_max, rhs[j].abs());
-                    lo_max = max_of(lo_max, lo[j].abs());
-                    let mut t = reduced_rhs(j);
-                    ts[j] = t;
-                    j += 1;
-                    while j < n && !active[j] {
-                        b_max = max_of(b_max, rhs[j].abs());
-                        lo_max = max_of(lo_max, lo[j].abs());
-                        t = reduced_rhs(j) - l[j - 1] * t;
-                        ts[j] = t;
-                        j += 1;
+                    // The free run s..e: only its first and last rows have an active neighbour.
+                    let s = j;
+                    let e = active[s..].iter().position(|&a| a).map_or(n, |k| s + k);
+                    b_max = max_of(b_max, rhs[s].abs());
+                    lo_max = max_of(lo_max, lo[s].abs());
+                    let mut t = reduced_rhs(s);
+                    ts[s] = t;
+                    // Rows s + 1..last have free neighbours on both sides.
+                    let last = if e < n { e - 1 } else { e };
+                    if last > s + 1 {
+                        (t, b_max, lo_max) = forward_chain(
+                            &rhs[s + 1..last],
+                            &lo[s + 1..last],
+                            &l[s..last - 1],
+                            &mut ts[s + 1..last],
+                            t,
+                            b_max,
+                            lo_max,
+                        );
+                    }
+                    if last > s && last < e {
+                        b_max = max_of(b_max, rhs[last].abs());
+                        lo_max = max_of(lo_max, lo[last].abs());
+                        ts[last] = reduced_rhs(last) - l[last - 1] * t;
+                    }
+                    j = e;
+                }
+            }
+        }
+        {
+            let (t, inv_d) = (&self.t[..n], &self.inv_d[..n]);
+            let block_max = &mut self.block_max[..];
+            let mut j = n;
+            while j > 0 {
+                // The run top..=j − 1 (top found downwards); its top row takes no `l` term.
+                let top = j - 1;
+                let free = !active[top];
+                let s = active[..top]
+                    .iter()
+                    .rposition(|&a| a == free)
+                    .map_or(0, |k| k + 1);
+                z[top] = t[top] * inv_d[top];
+                if free && s < top {
+                    backward_chain(&t[s..top], &inv_d[s..top], &l[s..top], &mut z[s..=top]);
+                } else {
+                    for i in s..top {
+                        z[i] = t[i] * inv_d[i];
                     }
                 }
+                j = s;
+            }
+            for (b, chunk) in block_max.iter_mut().zip(z.chunks(MAX_BLOCK)) {
+                *b = max_abs_4(chunk);
             }
         }
-        self.negative.clear();
-        // `backward_value` run by run, downwards (same remark).
-        let mut block = 0.0f64;
-        let mut j = n;
-        while j > 0 {
-            let top = j - 1;
-            let free = !self.active[top];
-            let mut z_next = 0.0;
-            while j > 0 && self.active[j - 1] != free {
-                j -= 1;
-                let w = self.t[j] * self.inv_d[j];
-                z_next = if !free || j == top {
-                    w
-                } else {
-                    w - self.l[j] * z_next
-                };
-                z[j] = z_next;
-                block = max_of(block, z_next.abs());
-                if j.is_multiple_of(MAX_BLOCK) {
-                    self.block_max[j / MAX_BLOCK] = block;
-                    block = 0.0;
-                }
-                if j + 1 < n {
-                    self.margin_into_negative(j + 1, rhs, z);
-                }
-            }
-        }
-        if n > 0 {
-            self.margin_into_negative(0, rhs, z);
-        }
-        self.negative.reverse();
+        self.margins_all(rhs, z);
         self.work.full_solves += 1;
         (b_max, lo_max)
-    }
-
-    /// Evaluates the margin of node `i` if it is constrained, and lists it when negative.
-    #[inline(always)]
-    fn margin_into_negative(&mut self, i: usize, rhs: &[f64], z: &[f64]) {
-        if self.all_constrained || self.slot[i] != NONE {
-            let m = self.margin_at(i, rhs, z);
-            // Read back only for active nodes (reactions) and negative margins.
-            if m < 0.0 {
-                self.margin[i] = m;
-                self.negative.push(i);
-            } else if self.active[i] {
-                self.margin[i] = m;
-            }
-        }
     }
 
     // ---- incremental re-solve after `flips` --------------------------------------------
@@ -470,17 +456,33 @@ impl BlockPivotSolver {
         }
     }
 
-    /// Re-evaluates every margin.
+    /// Evaluates every margin and lists the negative ones (increasing). A margin is stored
+    /// when it is negative or its node active (the reactions read those), not otherwise.
     fn margins_all(&mut self, rhs: &[f64], z: &[f64]) {
-        self.negative.clear();
-        for k in 0..self.nodes.len() {
-            let i = self.nodes[k];
-            let m = self.margin_at(i, rhs, z);
-            self.margin[i] = m;
+        let n = z.len();
+        let mut negative = std::mem::take(&mut self.negative);
+        negative.clear();
+        let (active, lo, c) = (&self.active[..n], &self.lo[..n], &self.c);
+        let margin = &mut self.margin[..n];
+        let mut visit = |i: usize| {
+            let m = if active[i] {
+                row_product(c, i, z) - rhs[i]
+            } else {
+                z[i] - lo[i]
+            };
             if m < 0.0 {
-                self.negative.push(i);
+                margin[i] = m;
+                negative.push(i);
+            } else if active[i] {
+                margin[i] = m;
             }
+        };
+        if self.all_constrained {
+            (0..n).for_each(&mut visit);
+        } else {
+            self.nodes.iter().for_each(|&i| visit(i));
         }
+        self.negative = negative;
     }
 
     /// Re-evaluates the margins within one node of the rows where `z` changed
@@ -530,6 +532,56 @@ impl BlockPivotSolver {
                 self.infeasible.push(i);
             }
         }
+    }
+}
+
+/// The forward chain `t_j = b_j − l_{j−1} t_{j−1}` over rows with free neighbours (`l` holds
+/// `l_{j−1}` for each row, `t` is the value before the first), with the running maxima of
+/// `|b|` and `|lo|`; returns the last `t` and the maxima.
+#[inline(never)]
+fn forward_chain(
+    rhs: &[f64],
+    lo: &[f64],
+    l: &[f64],
+    ts: &mut [f64],
+    mut t: f64,
+    mut b_max: f64,
+    mut lo_max: f64,
+) -> (f64, f64, f64) {
+    for (((tj, &b), &lo), &l) in ts.iter_mut().zip(rhs).zip(lo).zip(l) {
+        b_max = max_of(b_max, b.abs());
+        lo_max = max_of(lo_max, lo.abs());
+        t = b - l * t;
+        *tj = t;
+    }
+    (t, b_max, lo_max)
+}
+
+/// The backward chain `z_j = t_j / d_j − l_j z_{j+1}` downwards over the rows of `t`, from
+/// `z`'s last entry (one more than `t`), which is given.
+#[inline(never)]
+fn backward_chain(t: &[f64], inv_d: &[f64], l: &[f64], z: &mut [f64]) {
+    let k = t.len();
+    let mut z_next = z[k];
+    for (((zj, &t), &inv_d), &l) in z[..k].iter_mut().zip(t).zip(inv_d).zip(l).rev() {
+        z_next = t * inv_d - l * z_next;
+        *zj = z_next;
+    }
+}
+
+/// `(C z)_i`, with the bits of [`SymTridiag::mul_into`] (difference form).
+#[inline(always)]
+fn row_product(c: &SymTridiag, i: usize, z: &[f64]) -> f64 {
+    let n = z.len();
+    let (s, e) = (c.row_sums(), &c.off);
+    if n == 1 {
+        c.diag[0] * z[0]
+    } else if i == 0 {
+        s[0] * z[0] + e[0] * (z[1] - z[0])
+    } else if i + 1 == n {
+        s[i] * z[i] + e[i - 1] * (z[i - 1] - z[i])
+    } else {
+        s[i] * z[i] + e[i - 1] * (z[i - 1] - z[i]) + e[i] * (z[i + 1] - z[i])
     }
 }
 
