@@ -327,16 +327,15 @@ impl BlockPivotSolver {
             let mut j = 0;
             while j < n {
                 if active[j] {
-                    while j < n && active[j] {
-                        b_max = max_of(b_max, rhs[j].abs());
-                        lo_max = max_of(lo_max, lo[j].abs());
-                        ts[j] = lo[j];
-                        j += 1;
-                    }
+                    let s = j;
+                    j = run_end(active, s, true);
+                    b_max = max_of(b_max, max_abs_4(&rhs[s..j]));
+                    lo_max = max_of(lo_max, max_abs_4(&lo[s..j]));
+                    ts[s..j].copy_from_slice(&lo[s..j]);
                 } else {
                     // The free run s..e: only its first and last rows have an active neighbour.
                     let s = j;
-                    let e = active[s..].iter().position(|&a| a).map_or(n, |k| s + k);
+                    let e = run_end(active, s, false);
                     b_max = max_of(b_max, rhs[s].abs());
                     lo_max = max_of(lo_max, lo[s].abs());
                     let mut t = reduced_rhs(s);
@@ -371,17 +370,13 @@ impl BlockPivotSolver {
                 // The run top..=j − 1 (top found downwards); its top row takes no `l` term.
                 let top = j - 1;
                 let free = !active[top];
-                let s = active[..top]
-                    .iter()
-                    .rposition(|&a| a == free)
-                    .map_or(0, |k| k + 1);
+                let s = run_start(active, top, !free);
                 z[top] = t[top] * inv_d[top];
                 if free && s < top {
                     backward_chain(&t[s..top], &inv_d[s..top], &l[s..top], &mut z[s..=top]);
                 } else {
-                    for i in s..top {
-                        z[i] = t[i] * inv_d[i];
-                    }
+                    // Active: `t_i = lo_i` and `1/d_i = 1` exactly, so `t_i/d_i` is `t_i`.
+                    z[s..top].copy_from_slice(&t[s..top]);
                 }
                 j = s;
             }
@@ -456,31 +451,32 @@ impl BlockPivotSolver {
         }
     }
 
-    /// Evaluates every margin and lists the negative ones (increasing). A margin is stored
-    /// when it is negative or its node active (the reactions read those), not otherwise.
+    /// Evaluates every margin and lists the negative ones (increasing).
     fn margins_all(&mut self, rhs: &[f64], z: &[f64]) {
         let n = z.len();
         let mut negative = std::mem::take(&mut self.negative);
         negative.clear();
         let (active, lo, c) = (&self.active[..n], &self.lo[..n], &self.c);
         let margin = &mut self.margin[..n];
-        let mut visit = |i: usize| {
+        let visit = |i: usize, margin: &mut [f64], negative: &mut Vec<usize>| {
             let m = if active[i] {
                 row_product(c, i, z) - rhs[i]
             } else {
                 z[i] - lo[i]
             };
+            margin[i] = m;
             if m < 0.0 {
-                margin[i] = m;
                 negative.push(i);
-            } else if active[i] {
-                margin[i] = m;
             }
         };
-        if self.all_constrained {
-            (0..n).for_each(&mut visit);
+        if self.all_constrained && n >= 3 {
+            visit(0, margin, &mut negative);
+            margins_interior(active, lo, rhs, c, z, margin, &mut negative);
+            visit(n - 1, margin, &mut negative);
+        } else if self.all_constrained {
+            (0..n).for_each(|i| visit(i, margin, &mut negative));
         } else {
-            self.nodes.iter().for_each(|&i| visit(i));
+            self.nodes.iter().for_each(|&i| visit(i, margin, &mut negative));
         }
         self.negative = negative;
     }
@@ -566,6 +562,36 @@ fn backward_chain(t: &[f64], inv_d: &[f64], l: &[f64], z: &mut [f64]) {
     for (((zj, &t), &inv_d), &l) in z[..k].iter_mut().zip(t).zip(inv_d).zip(l).rev() {
         z_next = t * inv_d - l * z_next;
         *zj = z_next;
+    }
+}
+
+/// The margins of the interior nodes `1..n − 1` (all constrained), as `margin_at` (the
+/// interior branch of [`row_product`]), negative ones appended to `negative`. A loop of its
+/// own: as a closure called per node it was not inlined.
+#[inline(never)]
+fn margins_interior(
+    active: &[bool],
+    lo: &[f64],
+    rhs: &[f64],
+    c: &SymTridiag,
+    z: &[f64],
+    margin: &mut [f64],
+    negative: &mut Vec<usize>,
+) {
+    let n = z.len();
+    let (s, e) = (&c.row_sums()[..n], &c.off[..n - 1]);
+    let (active, lo, rhs, margin) = (&active[..n], &lo[..n], &rhs[..n], &mut margin[..n]);
+    for i in 1..n - 1 {
+        let zi = z[i];
+        let m = if active[i] {
+            s[i] * zi + e[i - 1] * (z[i - 1] - zi) + e[i] * (z[i + 1] - zi) - rhs[i]
+        } else {
+            zi - lo[i]
+        };
+        margin[i] = m;
+        if m < 0.0 {
+            negative.push(i);
+        }
     }
 }
 
@@ -659,6 +685,29 @@ fn sweep_down(
     out.truncate(w);
 }
 
+/// Flags compared a word at a time by [`run_end`] and [`run_start`].
+const SCAN: usize = 32;
+
+/// The first index at or after `from` whose flag is not `flag` (`flags.len()` if none).
+#[inline]
+fn run_end(flags: &[bool], from: usize, flag: bool) -> usize {
+    let mut i = from;
+    while i + SCAN <= flags.len() && flags[i..i + SCAN].iter().fold(true, |a, &f| a & (f == flag)) {
+        i += SCAN;
+    }
+    flags[i..].iter().position(|&f| f != flag).map_or(flags.len(), |k| i + k)
+}
+
+/// The least `s <= top` with every flag of `s..=top` equal to `flag` (that of `top`).
+#[inline]
+fn run_start(flags: &[bool], top: usize, flag: bool) -> usize {
+    let mut s = top;
+    while s >= SCAN && flags[s - SCAN..s].iter().fold(true, |a, &f| a & (f == flag)) {
+        s -= SCAN;
+    }
+    flags[..s].iter().rposition(|&f| f != flag).map_or(0, |k| k + 1)
+}
+
 /// `m.max(x)` for a running maximum `m` that is not NaN (it starts at 0): the same value (a
 /// NaN `x` is ignored either way) in one `maxsd`, without `f64::max`'s NaN blend on the
 /// dependency chain.
@@ -675,10 +724,10 @@ fn max_abs_4(v: &[f64]) -> f64 {
     let rest = max_abs(chunks.remainder());
     for c in chunks {
         for k in 0..4 {
-            m[k] = m[k].max(c[k].abs());
+            m[k] = max_of(m[k], c[k].abs());
         }
     }
-    m[0].max(m[1]).max(m[2].max(m[3])).max(rest)
+    max_of(max_of(max_of(m[0], m[1]), max_of(m[2], m[3])), rest)
 }
 
 /// Appends `r` to sorted ranges, merging it with the last one when they overlap or touch.
@@ -765,11 +814,17 @@ impl StepSolver for BlockPivotSolver {
             self.select_infeasible(tol_z, tol_l);
             self.flips.clear();
             if self.infeasible.is_empty() {
-                let (active, margin) = (&self.active[..], &self.margin[..]);
-                let reaction = |i: usize| if active[i] { margin[i].max(0.0) } else { 0.0 };
+                let (active, margin) = (&self.active[..n], &self.margin[..n]);
+                // `max(λ_i, 0)` on active nodes, `+0` for `λ_i = −0` and NaN (the bits of the
+                // `maxsd` that `f64::max(λ_i, 0.0)` compiled to), without a branch per node.
+                let reaction = |i: usize| {
+                    let m = margin[i];
+                    if active[i] & (m > 0.0) { m } else { 0.0 }
+                };
                 if self.all_constrained {
-                    for (i, r) in reactions[..n].iter_mut().enumerate() {
-                        *r = reaction(i);
+                    let it = reactions[..n].iter_mut().zip(active).zip(margin);
+                    for ((r, &a), &m) in it {
+                        *r = if a & (m > 0.0) { m } else { 0.0 };
                     }
                 } else {
                     for (r, &i) in reactions.iter_mut().zip(&self.nodes) {
