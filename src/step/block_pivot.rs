@@ -91,7 +91,8 @@ pub struct BlockPivotSolver {
     /// `max_i Σ_j |C_ij|`, for the round-off threshold of the multipliers.
     c_norm: f64,
     factor: Ldlt,
-    /// Constrained nodes (strictly increasing) and, per node, its constraint index or `NONE`.
+    /// Constrained nodes (strictly increasing) and, per node, its constraint index or `NONE`;
+    /// both empty when every node is constrained.
     nodes: Vec<usize>,
     slot: Vec<usize>,
     /// Every node is constrained (`nodes = 0..n`).
@@ -100,7 +101,8 @@ pub struct BlockPivotSolver {
     /// false at unconstrained nodes.
     active: Vec<bool>,
     active_count: usize,
-    /// Per node: the bound (0 at unconstrained nodes).
+    /// Per node: the bound (0 at unconstrained nodes); empty when every node is constrained
+    /// (the solve reads the caller's bounds then).
     lo: Vec<f64>,
     /// The reduced `L D Lᵀ`: `d_j`, `1/d_j`, `l_j = e_j / d_j` (the reduced off-diagonal).
     d: Vec<f64>,
@@ -135,8 +137,10 @@ impl BlockPivotSolver {
         let n = c.dim();
         assert!(nodes.windows(2).all(|w| w[0] < w[1]) && nodes.iter().all(|&i| i < n));
         let factor = Ldlt::factor(c)?;
-        let mut slot = vec![NONE; n];
-        for (k, &i) in nodes.iter().enumerate() {
+        let all_constrained = nodes.len() == n;
+        // Only a subset of the nodes needs the map (and the list of nodes, and its bounds).
+        let mut slot = if all_constrained { Vec::new() } else { vec![NONE; n] };
+        for (k, &i) in nodes.iter().enumerate().filter(|_| !all_constrained) {
             slot[i] = k;
         }
         let c_norm = c.inf_norm();
@@ -147,12 +151,12 @@ impl BlockPivotSolver {
             c: c.clone(),
             c_norm,
             factor,
-            nodes: nodes.to_vec(),
+            nodes: if all_constrained { Vec::new() } else { nodes.to_vec() },
             slot,
-            all_constrained: nodes.len() == n,
+            all_constrained,
             active: vec![false; n],
             active_count: 0,
-            lo: vec![0.0; n],
+            lo: if all_constrained { Vec::new() } else { vec![0.0; n] },
             d: vec![0.0; n],
             inv_d: vec![0.0; n],
             l: vec![0.0; n.saturating_sub(1)],
@@ -204,16 +208,16 @@ impl BlockPivotSolver {
 
     /// The reduced right-hand side: `lo_i` on an active row, else `b_i − C_{i,A} lo_A`.
     #[inline(always)]
-    fn rhs_r(&self, i: usize, rhs: &[f64]) -> f64 {
+    fn rhs_r(&self, i: usize, rhs: &[f64], lo: &[f64]) -> f64 {
         if self.active[i] {
-            return self.lo[i];
+            return lo[i];
         }
         let mut r = rhs[i];
         if i > 0 && self.active[i - 1] {
-            r -= self.c.off[i - 1] * self.lo[i - 1];
+            r -= self.c.off[i - 1] * lo[i - 1];
         }
         if i + 1 < rhs.len() && self.active[i + 1] {
-            r -= self.c.off[i] * self.lo[i + 1];
+            r -= self.c.off[i] * lo[i + 1];
         }
         r
     }
@@ -239,11 +243,11 @@ impl BlockPivotSolver {
     /// (`t_j = lo_j`, `d_j = 1`) and at the free node after it (`l_{j−1} = 0`), so that a run
     /// of free nodes is solved without reading the rest of the bar.
     #[inline(always)]
-    fn forward_value(&self, j: usize, rhs: &[f64], t_prev: f64) -> f64 {
+    fn forward_value(&self, j: usize, rhs: &[f64], lo: &[f64], t_prev: f64) -> f64 {
         if self.active[j] {
-            self.lo[j]
+            lo[j]
         } else {
-            let r = self.rhs_r(j, rhs);
+            let r = self.rhs_r(j, rhs, lo);
             if j == 0 || self.active[j - 1] {
                 r
             } else {
@@ -254,9 +258,9 @@ impl BlockPivotSolver {
 
     /// Forward chain at `j`; whether `t_j` kept its bits.
     #[inline(always)]
-    fn forward_at(&mut self, j: usize, rhs: &[f64]) -> bool {
+    fn forward_at(&mut self, j: usize, rhs: &[f64], lo: &[f64]) -> bool {
         let t_prev = if j == 0 { 0.0 } else { self.t[j - 1] };
-        let tj = self.forward_value(j, rhs, t_prev);
+        let tj = self.forward_value(j, rhs, lo, t_prev);
         let same = tj.to_bits() == self.t[j].to_bits();
         self.t[j] = tj;
         same
@@ -308,10 +312,10 @@ impl BlockPivotSolver {
     /// free runs only; the chains' inner loops are small functions of their own
     /// ([`forward_chain`], [`backward_chain`]): inlined into `solve`, their carried values
     /// were spilled to the stack, a store and a reload on every link of the chain.
-    fn solve_all(&mut self, rhs: &[f64], z: &mut [f64]) -> (f64, f64) {
+    fn solve_all(&mut self, rhs: &[f64], lo: &[f64], z: &mut [f64]) -> (f64, f64) {
         let n = z.len();
         let (mut b_max, mut lo_max) = (0.0f64, 0.0f64);
-        let (active, lo, off, l) = (&self.active[..n], &self.lo[..n], &self.c.off, &self.l);
+        let (active, lo, off, l) = (&self.active[..n], &lo[..n], &self.c.off, &self.l);
         {
             let ts = &mut self.t[..n];
             let reduced_rhs = |j: usize| {
@@ -384,7 +388,7 @@ impl BlockPivotSolver {
                 *b = max_abs_4(chunk);
             }
         }
-        self.margins_all(rhs, z);
+        self.margins_all(rhs, lo, z);
         self.work.full_solves += 1;
         (b_max, lo_max)
     }
@@ -393,7 +397,7 @@ impl BlockPivotSolver {
 
     /// Re-solves after the active flags of `self.flips` changed; leaves the rows where `z`
     /// changed in `self.ranges[2]`.
-    fn solve_local(&mut self, rhs: &[f64], z: &mut [f64]) {
+    fn solve_local(&mut self, rhs: &[f64], lo: &[f64], z: &mut [f64]) {
         let n = z.len();
         let [mut pivots, mut forward, mut backward] = std::mem::take(&mut self.ranges);
         // Pivots: row k's diagonal and left coupling, row k + 1's left coupling.
@@ -421,7 +425,7 @@ impl BlockPivotSolver {
             push_merged(&mut backward, r);
         }
         sweep_up(n, &backward, &mut forward, &mut rows, |j| {
-            self.forward_at(j, rhs)
+            self.forward_at(j, rhs, lo)
         });
         // Backward chain: every row whose w_j or l_j changed lies in `forward`.
         sweep_down(n, &forward, &mut backward, &mut rows, |j| {
@@ -443,20 +447,20 @@ impl BlockPivotSolver {
     /// The margin of index `i`: `λ_i = (C z − b)_i` when active, `z_i − lo_i` when free; the
     /// index is infeasible when its margin is below minus the round-off threshold.
     #[inline(always)]
-    fn margin_at(&self, i: usize, rhs: &[f64], z: &[f64]) -> f64 {
+    fn margin_at(&self, i: usize, rhs: &[f64], lo: &[f64], z: &[f64]) -> f64 {
         if self.active[i] {
             self.row_product(i, z) - rhs[i]
         } else {
-            z[i] - self.lo[i]
+            z[i] - lo[i]
         }
     }
 
     /// Evaluates every margin and lists the negative ones (increasing).
-    fn margins_all(&mut self, rhs: &[f64], z: &[f64]) {
+    fn margins_all(&mut self, rhs: &[f64], lo: &[f64], z: &[f64]) {
         let n = z.len();
         let mut negative = std::mem::take(&mut self.negative);
         negative.clear();
-        let (active, lo, c) = (&self.active[..n], &self.lo[..n], &self.c);
+        let (active, lo, c) = (&self.active[..n], &lo[..n], &self.c);
         let margin = &mut self.margin[..n];
         let visit = |i: usize, margin: &mut [f64], negative: &mut Vec<usize>| {
             let m = if active[i] {
@@ -483,7 +487,7 @@ impl BlockPivotSolver {
 
     /// Re-evaluates the margins within one node of the rows where `z` changed
     /// (`self.ranges[2]`, which include the flipped nodes).
-    fn margins_changed(&mut self, rhs: &[f64], z: &[f64]) {
+    fn margins_changed(&mut self, rhs: &[f64], lo: &[f64], z: &[f64]) {
         let n = z.len();
         let ranges = std::mem::take(&mut self.ranges);
         let old = std::mem::take(&mut self.negative);
@@ -503,8 +507,8 @@ impl BlockPivotSolver {
                 o += 1;
             }
             for i in a..=b {
-                if self.slot[i] != NONE {
-                    let m = self.margin_at(i, rhs, z);
+                if self.all_constrained || self.slot[i] != NONE {
+                    let m = self.margin_at(i, rhs, lo, z);
                     self.margin[i] = m;
                     if m < 0.0 {
                         merged.push(i);
@@ -750,19 +754,37 @@ impl StepSolver for BlockPivotSolver {
         z: &mut [f64],
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
+        // The bounds per node: `lower` itself when every node is constrained (no copy),
+        // else scattered into `self.lo`, lent out for the solve.
+        let mut store = std::mem::take(&mut self.lo);
+        let lo = if self.all_constrained {
+            lower
+        } else {
+            for (&i, &v) in self.nodes.iter().zip(lower) {
+                store[i] = v;
+            }
+            &store[..]
+        };
+        let result = self.solve_with(rhs, lo, z, reactions);
+        self.lo = store;
+        result
+    }
+}
+
+impl BlockPivotSolver {
+    /// [`StepSolver::solve`] with the bounds `lo` per node.
+    fn solve_with(
+        &mut self,
+        rhs: &[f64],
+        lo: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<SolveInfo, StepFailure> {
         let eps = f64::EPSILON;
         let n = z.len();
+        let lower = lo;
         // `(max|b|, max|lo|)`, taken by the step's first solve.
         let mut maxima = None;
-        if self.all_constrained {
-            // Every node constrained (nodes = 0..n).
-            self.lo.copy_from_slice(lower);
-        } else {
-            let lo = &mut self.lo[..];
-            for (&i, &v) in self.nodes.iter().zip(lower) {
-                lo[i] = v;
-            }
-        }
         let mut best_count = usize::MAX;
         let mut patience = BLOCK_PATIENCE;
         // Whether `t` and `z` hold this step's sweep with `active` before `flips`.
@@ -789,12 +811,12 @@ impl StepSolver for BlockPivotSolver {
                 }
                 maxima.get_or_insert_with(|| (max_abs_4(rhs), max_abs_4(lower)));
             } else if local {
-                self.solve_local(rhs, z);
+                self.solve_local(rhs, lo, z);
             } else {
                 if !self.incremental || !self.factor_valid || !self.flips.is_empty() {
                     self.factor_all();
                 }
-                let m = self.solve_all(rhs, z);
+                let m = self.solve_all(rhs, lo, z);
                 maxima.get_or_insert(m);
                 swept = true;
             }
@@ -807,9 +829,9 @@ impl StepSolver for BlockPivotSolver {
             let tol_l = TIE_ULPS * eps * (self.c_norm * z_max + b_max);
             // The whole-bar solve evaluated every margin itself.
             if unconstrained {
-                self.margins_all(rhs, z);
+                self.margins_all(rhs, lo, z);
             } else if local {
-                self.margins_changed(rhs, z);
+                self.margins_changed(rhs, lo, z);
             }
             self.select_infeasible(tol_z, tol_l);
             self.flips.clear();
