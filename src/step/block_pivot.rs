@@ -139,7 +139,11 @@ impl BlockPivotSolver {
         let factor = Ldlt::factor(c)?;
         let all_constrained = nodes.len() == n;
         // Only a subset of the nodes needs the map (and the list of nodes, and its bounds).
-        let mut slot = if all_constrained { Vec::new() } else { vec![NONE; n] };
+        let mut slot = if all_constrained {
+            Vec::new()
+        } else {
+            vec![NONE; n]
+        };
         for (k, &i) in nodes.iter().enumerate().filter(|_| !all_constrained) {
             slot[i] = k;
         }
@@ -151,12 +155,20 @@ impl BlockPivotSolver {
             c: c.clone(),
             c_norm,
             factor,
-            nodes: if all_constrained { Vec::new() } else { nodes.to_vec() },
+            nodes: if all_constrained {
+                Vec::new()
+            } else {
+                nodes.to_vec()
+            },
             slot,
             all_constrained,
             active: vec![false; n],
             active_count: 0,
-            lo: if all_constrained { Vec::new() } else { vec![0.0; n] },
+            lo: if all_constrained {
+                Vec::new()
+            } else {
+                vec![0.0; n]
+            },
             d: vec![0.0; n],
             inv_d: vec![0.0; n],
             l: vec![0.0; n.saturating_sub(1)],
@@ -480,7 +492,9 @@ impl BlockPivotSolver {
         } else if self.all_constrained {
             (0..n).for_each(|i| visit(i, margin, &mut negative));
         } else {
-            self.nodes.iter().for_each(|&i| visit(i, margin, &mut negative));
+            self.nodes
+                .iter()
+                .for_each(|&i| visit(i, margin, &mut negative));
         }
         self.negative = negative;
     }
@@ -696,20 +710,34 @@ const SCAN: usize = 32;
 #[inline]
 fn run_end(flags: &[bool], from: usize, flag: bool) -> usize {
     let mut i = from;
-    while i + SCAN <= flags.len() && flags[i..i + SCAN].iter().fold(true, |a, &f| a & (f == flag)) {
+    while i + SCAN <= flags.len()
+        && flags[i..i + SCAN]
+            .iter()
+            .fold(true, |a, &f| a & (f == flag))
+    {
         i += SCAN;
     }
-    flags[i..].iter().position(|&f| f != flag).map_or(flags.len(), |k| i + k)
+    flags[i..]
+        .iter()
+        .position(|&f| f != flag)
+        .map_or(flags.len(), |k| i + k)
 }
 
 /// The least `s <= top` with every flag of `s..=top` equal to `flag` (that of `top`).
 #[inline]
 fn run_start(flags: &[bool], top: usize, flag: bool) -> usize {
     let mut s = top;
-    while s >= SCAN && flags[s - SCAN..s].iter().fold(true, |a, &f| a & (f == flag)) {
+    while s >= SCAN
+        && flags[s - SCAN..s]
+            .iter()
+            .fold(true, |a, &f| a & (f == flag))
+    {
         s -= SCAN;
     }
-    flags[..s].iter().rposition(|&f| f != flag).map_or(0, |k| k + 1)
+    flags[..s]
+        .iter()
+        .rposition(|&f| f != flag)
+        .map_or(0, |k| k + 1)
 }
 
 /// `m.max(x)` for a running maximum `m` that is not NaN (it starts at 0): the same value (a
@@ -881,5 +909,87 @@ impl BlockPivotSolver {
         Err(StepFailure::IterationLimit {
             iterations: self.max_iterations,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The whole-bar solve's run loops, kernels and margin pass against the row-by-row
+    /// recurrences (`pivot_at`, `forward_at`, `backward_at`, `margin_at`) that the incremental
+    /// re-solves use: the same bits of `t`, `z`, the block maxima and the negative margins, on
+    /// random SPD matrices and active patterns with runs of every length around [`SCAN`].
+    fn whole_bar_equals_rows(diag: Vec<f64>, off: Vec<f64>, runs: Vec<(bool, usize)>, all: bool) {
+        let n = diag.len();
+        let c = SymTridiag::new(diag, off);
+        let nodes: Vec<usize> = (0..n).filter(|&i| all || i % 3 != 1).collect();
+        let mut s = BlockPivotSolver::new(&c, &nodes).unwrap();
+        let mut i = 0;
+        for &(flag, len) in runs.iter().cycle() {
+            for _ in 0..len {
+                if i < n {
+                    s.active[i] = flag && (all || s.slot[i] != NONE);
+                    i += 1;
+                }
+            }
+            if i == n {
+                break;
+            }
+        }
+        let wave = |k: usize, a: f64| {
+            (0..n)
+                .map(|i| (a * (i + k) as f64).sin())
+                .collect::<Vec<_>>()
+        };
+        let (rhs, lo_nodes) = (wave(1, 0.37), wave(5, 0.11));
+        let lo: Vec<f64> = (0..n)
+            .map(|i| if all || i % 3 != 1 { lo_nodes[i] } else { 0.0 })
+            .collect();
+        s.factor_all();
+        let mut rows = s.clone();
+        let mut z = vec![f64::NAN; n];
+        let (b_max, lo_max) = s.solve_all(&rhs, &lo, &mut z);
+        let mut z_rows = vec![f64::NAN; n];
+        for j in 0..n {
+            rows.forward_at(j, &rhs, &lo);
+        }
+        for j in (0..n).rev() {
+            rows.backward_at(j, &mut z_rows);
+        }
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&s.t), bits(&rows.t), "forward chain");
+        assert_eq!(bits(&z), bits(&z_rows), "backward chain");
+        let blocks: Vec<f64> = z.chunks(MAX_BLOCK).map(max_abs).collect();
+        assert_eq!(bits(&s.block_max), bits(&blocks), "block maxima");
+        assert_eq!(b_max.to_bits(), max_abs(&rhs).to_bits());
+        assert_eq!(lo_max.to_bits(), max_abs(&lo).to_bits());
+        let negative: Vec<usize> = nodes
+            .iter()
+            .copied()
+            .filter(|&i| rows.margin_at(i, &rhs, &lo, &z_rows) < 0.0)
+            .collect();
+        assert_eq!(s.negative, negative, "negative margins");
+        for &i in nodes.iter().filter(|&&i| s.active[i] || s.margin[i] < 0.0) {
+            let m = rows.margin_at(i, &rhs, &lo, &z_rows);
+            assert_eq!(s.margin[i].to_bits(), m.to_bits(), "margin {i}");
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn whole_bar_solve_has_the_bits_of_the_row_recurrences(
+            n in 1usize..700,
+            seed in 0u64..1000,
+            runs in prop::collection::vec((any::<bool>(), 1usize..80), 1..12),
+            all in any::<bool>(),
+        ) {
+            // Diagonally dominant: SPD, and the reduced pivots stay positive.
+            let r = |i: usize, k: u64| ((i as u64 * 2654435761 + seed * 97 + k) % 1000) as f64 / 1000.0;
+            let off: Vec<f64> = (0..n.saturating_sub(1)).map(|i| -0.2 - r(i, 1)).collect();
+            let diag: Vec<f64> = (0..n).map(|i| 2.5 + r(i, 2)).collect();
+            whole_bar_equals_rows(diag, off, runs, all);
+        }
     }
 }
