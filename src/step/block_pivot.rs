@@ -91,7 +91,8 @@ pub struct BlockPivotSolver {
     /// `max_i Σ_j |C_ij|`, for the round-off threshold of the multipliers.
     c_norm: f64,
     factor: Ldlt,
-    /// Constrained nodes (strictly increasing) and, per node, its constraint index or `NONE`.
+    /// Constrained nodes (strictly increasing) and, per node, its constraint index or `NONE`;
+    /// both empty when every node is constrained.
     nodes: Vec<usize>,
     slot: Vec<usize>,
     /// Every node is constrained (`nodes = 0..n`).
@@ -100,7 +101,8 @@ pub struct BlockPivotSolver {
     /// false at unconstrained nodes.
     active: Vec<bool>,
     active_count: usize,
-    /// Per node: the bound (0 at unconstrained nodes).
+    /// Per node: the bound (0 at unconstrained nodes); empty when every node is constrained
+    /// (the solve reads the caller's bounds then).
     lo: Vec<f64>,
     /// The reduced `L D Lᵀ`: `d_j`, `1/d_j`, `l_j = e_j / d_j` (the reduced off-diagonal).
     d: Vec<f64>,
@@ -135,8 +137,14 @@ impl BlockPivotSolver {
         let n = c.dim();
         assert!(nodes.windows(2).all(|w| w[0] < w[1]) && nodes.iter().all(|&i| i < n));
         let factor = Ldlt::factor(c)?;
-        let mut slot = vec![NONE; n];
-        for (k, &i) in nodes.iter().enumerate() {
+        let all_constrained = nodes.len() == n;
+        // Only a subset of the nodes needs the map (and the list of nodes, and its bounds).
+        let mut slot = if all_constrained {
+            Vec::new()
+        } else {
+            vec![NONE; n]
+        };
+        for (k, &i) in nodes.iter().enumerate().filter(|_| !all_constrained) {
             slot[i] = k;
         }
         let c_norm = c.inf_norm();
@@ -147,12 +155,20 @@ impl BlockPivotSolver {
             c: c.clone(),
             c_norm,
             factor,
-            nodes: nodes.to_vec(),
+            nodes: if all_constrained {
+                Vec::new()
+            } else {
+                nodes.to_vec()
+            },
             slot,
-            all_constrained: nodes.len() == n,
+            all_constrained,
             active: vec![false; n],
             active_count: 0,
-            lo: vec![0.0; n],
+            lo: if all_constrained {
+                Vec::new()
+            } else {
+                vec![0.0; n]
+            },
             d: vec![0.0; n],
             inv_d: vec![0.0; n],
             l: vec![0.0; n.saturating_sub(1)],
@@ -204,16 +220,16 @@ impl BlockPivotSolver {
 
     /// The reduced right-hand side: `lo_i` on an active row, else `b_i − C_{i,A} lo_A`.
     #[inline(always)]
-    fn rhs_r(&self, i: usize, rhs: &[f64]) -> f64 {
+    fn rhs_r(&self, i: usize, rhs: &[f64], lo: &[f64]) -> f64 {
         if self.active[i] {
-            return self.lo[i];
+            return lo[i];
         }
         let mut r = rhs[i];
         if i > 0 && self.active[i - 1] {
-            r -= self.c.off[i - 1] * self.lo[i - 1];
+            r -= self.c.off[i - 1] * lo[i - 1];
         }
         if i + 1 < rhs.len() && self.active[i + 1] {
-            r -= self.c.off[i] * self.lo[i + 1];
+            r -= self.c.off[i] * lo[i + 1];
         }
         r
     }
@@ -239,11 +255,11 @@ impl BlockPivotSolver {
     /// (`t_j = lo_j`, `d_j = 1`) and at the free node after it (`l_{j−1} = 0`), so that a run
     /// of free nodes is solved without reading the rest of the bar.
     #[inline(always)]
-    fn forward_value(&self, j: usize, rhs: &[f64], t_prev: f64) -> f64 {
+    fn forward_value(&self, j: usize, rhs: &[f64], lo: &[f64], t_prev: f64) -> f64 {
         if self.active[j] {
-            self.lo[j]
+            lo[j]
         } else {
-            let r = self.rhs_r(j, rhs);
+            let r = self.rhs_r(j, rhs, lo);
             if j == 0 || self.active[j - 1] {
                 r
             } else {
@@ -254,9 +270,9 @@ impl BlockPivotSolver {
 
     /// Forward chain at `j`; whether `t_j` kept its bits.
     #[inline(always)]
-    fn forward_at(&mut self, j: usize, rhs: &[f64]) -> bool {
+    fn forward_at(&mut self, j: usize, rhs: &[f64], lo: &[f64]) -> bool {
         let t_prev = if j == 0 { 0.0 } else { self.t[j - 1] };
-        let tj = self.forward_value(j, rhs, t_prev);
+        let tj = self.forward_value(j, rhs, lo, t_prev);
         let same = tj.to_bits() == self.t[j].to_bits();
         self.t[j] = tj;
         same
@@ -288,17 +304,7 @@ impl BlockPivotSolver {
     /// `(C z)_i`, with the bits of [`SymTridiag::mul_into`] (difference form).
     #[inline(always)]
     fn row_product(&self, i: usize, z: &[f64]) -> f64 {
-        let n = z.len();
-        let (s, e) = (self.c.row_sums(), &self.c.off);
-        if n == 1 {
-            self.c.diag[0] * z[0]
-        } else if i == 0 {
-            s[0] * z[0] + e[0] * (z[1] - z[0])
-        } else if i + 1 == n {
-            s[i] * z[i] + e[i - 1] * (z[i - 1] - z[i])
-        } else {
-            s[i] * z[i] + e[i - 1] * (z[i - 1] - z[i]) + e[i] * (z[i + 1] - z[i])
-        }
+        row_product(&self.c, i, z)
     }
 
     // ---- whole-bar solves ---------------------------------------------------------------
@@ -310,18 +316,19 @@ impl BlockPivotSolver {
         self.factor_valid = true;
     }
 
-    /// The whole-bar solve with the current factor, with every margin and the block maxima
-    /// of `|z|` evaluated inside the backward sweep (off its dependency chain).
-    /// Returns `(max|b|, max|lo|)`, taken in the forward sweep.
-    fn solve_all(&mut self, rhs: &[f64], z: &mut [f64]) -> (f64, f64) {
+    /// The whole-bar solve with the current factor, then every margin and the block maxima
+    /// of `|z|`. Returns `(max|b|, max|lo|)`, taken in the forward sweep.
+    ///
+    /// The arithmetic of `forward_value` and `backward_value` (the tests compare the two bit
+    /// for bit), one loop per run of active or free nodes so that the chains run through the
+    /// free runs only; the chains' inner loops are small functions of their own
+    /// ([`forward_chain`], [`backward_chain`]): inlined into `solve`, their carried values
+    /// were spilled to the stack, a store and a reload on every link of the chain.
+    fn solve_all(&mut self, rhs: &[f64], lo: &[f64], z: &mut [f64]) -> (f64, f64) {
         let n = z.len();
         let (mut b_max, mut lo_max) = (0.0f64, 0.0f64);
+        let (active, lo, off, l) = (&self.active[..n], &lo[..n], &self.c.off, &self.l);
         {
-            // The arithmetic of `forward_value`, on local slices (no reloads through `self`),
-            // one loop per run of active or free nodes so that the chain runs through the free
-            // runs only (a select on `active` would chain every node); the tests compare the
-            // two bit for bit.
-            let (active, lo, off, l) = (&self.active[..n], &self.lo[..n], &self.c.off, &self.l);
             let ts = &mut self.t[..n];
             let reduced_rhs = |j: usize| {
                 let mut r = rhs[j];
@@ -336,83 +343,73 @@ impl BlockPivotSolver {
             let mut j = 0;
             while j < n {
                 if active[j] {
-                    while j < n && active[j] {
-                        b_max = max_of(b_max, rhs[j].abs());
-                        lo_max = max_of(lo_max, lo[j].abs());
-                        ts[j] = lo[j];
-                        j += 1;
-                    }
+                    let s = j;
+                    j = run_end(active, s, true);
+                    b_max = max_of(b_max, max_abs_4(&rhs[s..j]));
+                    lo_max = max_of(lo_max, max_abs_4(&lo[s..j]));
+                    ts[s..j].copy_from_slice(&lo[s..j]);
                 } else {
-                    b_max = max_of(b_max, rhs[j].abs());
-                    lo_max = max_of(lo_max, lo[j].abs());
-                    let mut t = reduced_rhs(j);
-                    ts[j] = t;
-                    j += 1;
-                    while j < n && !active[j] {
-                        b_max = max_of(b_max, rhs[j].abs());
-                        lo_max = max_of(lo_max, lo[j].abs());
-                        t = reduced_rhs(j) - l[j - 1] * t;
-                        ts[j] = t;
-                        j += 1;
+                    // The free run s..e: only its first and last rows have an active neighbour.
+                    let s = j;
+                    let e = run_end(active, s, false);
+                    b_max = max_of(b_max, rhs[s].abs());
+                    lo_max = max_of(lo_max, lo[s].abs());
+                    let mut t = reduced_rhs(s);
+                    ts[s] = t;
+                    // Rows s + 1..last have free neighbours on both sides.
+                    let last = if e < n { e - 1 } else { e };
+                    if last > s + 1 {
+                        (t, b_max, lo_max) = forward_chain(
+                            &rhs[s + 1..last],
+                            &lo[s + 1..last],
+                            &l[s..last - 1],
+                            &mut ts[s + 1..last],
+                            t,
+                            b_max,
+                            lo_max,
+                        );
                     }
+                    if last > s && last < e {
+                        b_max = max_of(b_max, rhs[last].abs());
+                        lo_max = max_of(lo_max, lo[last].abs());
+                        ts[last] = reduced_rhs(last) - l[last - 1] * t;
+                    }
+                    j = e;
                 }
             }
         }
-        self.negative.clear();
-        // `backward_value` run by run, downwards (same remark).
-        let mut block = 0.0f64;
-        let mut j = n;
-        while j > 0 {
-            let top = j - 1;
-            let free = !self.active[top];
-            let mut z_next = 0.0;
-            while j > 0 && self.active[j - 1] != free {
-                j -= 1;
-                let w = self.t[j] * self.inv_d[j];
-                z_next = if !free || j == top {
-                    w
+        {
+            let (t, inv_d) = (&self.t[..n], &self.inv_d[..n]);
+            let block_max = &mut self.block_max[..];
+            let mut j = n;
+            while j > 0 {
+                // The run top..=j − 1 (top found downwards); its top row takes no `l` term.
+                let top = j - 1;
+                let free = !active[top];
+                let s = run_start(active, top, !free);
+                z[top] = t[top] * inv_d[top];
+                if free && s < top {
+                    backward_chain(&t[s..top], &inv_d[s..top], &l[s..top], &mut z[s..=top]);
                 } else {
-                    w - self.l[j] * z_next
-                };
-                z[j] = z_next;
-                block = max_of(block, z_next.abs());
-                if j.is_multiple_of(MAX_BLOCK) {
-                    self.block_max[j / MAX_BLOCK] = block;
-                    block = 0.0;
+                    // Active: `t_i = lo_i` and `1/d_i = 1` exactly, so `t_i/d_i` is `t_i`.
+                    z[s..top].copy_from_slice(&t[s..top]);
                 }
-                if j + 1 < n {
-                    self.margin_into_negative(j + 1, rhs, z);
-                }
+                j = s;
+            }
+            for (b, chunk) in block_max.iter_mut().zip(z.chunks(MAX_BLOCK)) {
+                *b = max_abs_4(chunk);
             }
         }
-        if n > 0 {
-            self.margin_into_negative(0, rhs, z);
-        }
-        self.negative.reverse();
+        self.margins_all(rhs, lo, z);
         self.work.full_solves += 1;
         (b_max, lo_max)
-    }
-
-    /// Evaluates the margin of node `i` if it is constrained, and lists it when negative.
-    #[inline(always)]
-    fn margin_into_negative(&mut self, i: usize, rhs: &[f64], z: &[f64]) {
-        if self.all_constrained || self.slot[i] != NONE {
-            let m = self.margin_at(i, rhs, z);
-            // Read back only for active nodes (reactions) and negative margins.
-            if m < 0.0 {
-                self.margin[i] = m;
-                self.negative.push(i);
-            } else if self.active[i] {
-                self.margin[i] = m;
-            }
-        }
     }
 
     // ---- incremental re-solve after `flips` --------------------------------------------
 
     /// Re-solves after the active flags of `self.flips` changed; leaves the rows where `z`
     /// changed in `self.ranges[2]`.
-    fn solve_local(&mut self, rhs: &[f64], z: &mut [f64]) {
+    fn solve_local(&mut self, rhs: &[f64], lo: &[f64], z: &mut [f64]) {
         let n = z.len();
         let [mut pivots, mut forward, mut backward] = std::mem::take(&mut self.ranges);
         // Pivots: row k's diagonal and left coupling, row k + 1's left coupling.
@@ -440,7 +437,7 @@ impl BlockPivotSolver {
             push_merged(&mut backward, r);
         }
         sweep_up(n, &backward, &mut forward, &mut rows, |j| {
-            self.forward_at(j, rhs)
+            self.forward_at(j, rhs, lo)
         });
         // Backward chain: every row whose w_j or l_j changed lies in `forward`.
         sweep_down(n, &forward, &mut backward, &mut rows, |j| {
@@ -462,30 +459,49 @@ impl BlockPivotSolver {
     /// The margin of index `i`: `λ_i = (C z − b)_i` when active, `z_i − lo_i` when free; the
     /// index is infeasible when its margin is below minus the round-off threshold.
     #[inline(always)]
-    fn margin_at(&self, i: usize, rhs: &[f64], z: &[f64]) -> f64 {
+    fn margin_at(&self, i: usize, rhs: &[f64], lo: &[f64], z: &[f64]) -> f64 {
         if self.active[i] {
             self.row_product(i, z) - rhs[i]
         } else {
-            z[i] - self.lo[i]
+            z[i] - lo[i]
         }
     }
 
-    /// Re-evaluates every margin.
-    fn margins_all(&mut self, rhs: &[f64], z: &[f64]) {
-        self.negative.clear();
-        for k in 0..self.nodes.len() {
-            let i = self.nodes[k];
-            let m = self.margin_at(i, rhs, z);
-            self.margin[i] = m;
+    /// Evaluates every margin and lists the negative ones (increasing).
+    fn margins_all(&mut self, rhs: &[f64], lo: &[f64], z: &[f64]) {
+        let n = z.len();
+        let mut negative = std::mem::take(&mut self.negative);
+        negative.clear();
+        let (active, lo, c) = (&self.active[..n], &lo[..n], &self.c);
+        let margin = &mut self.margin[..n];
+        let visit = |i: usize, margin: &mut [f64], negative: &mut Vec<usize>| {
+            let m = if active[i] {
+                row_product(c, i, z) - rhs[i]
+            } else {
+                z[i] - lo[i]
+            };
+            margin[i] = m;
             if m < 0.0 {
-                self.negative.push(i);
+                negative.push(i);
             }
+        };
+        if self.all_constrained && n >= 3 {
+            visit(0, margin, &mut negative);
+            margins_interior(active, lo, rhs, c, z, margin, &mut negative);
+            visit(n - 1, margin, &mut negative);
+        } else if self.all_constrained {
+            (0..n).for_each(|i| visit(i, margin, &mut negative));
+        } else {
+            self.nodes
+                .iter()
+                .for_each(|&i| visit(i, margin, &mut negative));
         }
+        self.negative = negative;
     }
 
     /// Re-evaluates the margins within one node of the rows where `z` changed
     /// (`self.ranges[2]`, which include the flipped nodes).
-    fn margins_changed(&mut self, rhs: &[f64], z: &[f64]) {
+    fn margins_changed(&mut self, rhs: &[f64], lo: &[f64], z: &[f64]) {
         let n = z.len();
         let ranges = std::mem::take(&mut self.ranges);
         let old = std::mem::take(&mut self.negative);
@@ -505,8 +521,8 @@ impl BlockPivotSolver {
                 o += 1;
             }
             for i in a..=b {
-                if self.slot[i] != NONE {
-                    let m = self.margin_at(i, rhs, z);
+                if self.all_constrained || self.slot[i] != NONE {
+                    let m = self.margin_at(i, rhs, lo, z);
                     self.margin[i] = m;
                     if m < 0.0 {
                         merged.push(i);
@@ -530,6 +546,86 @@ impl BlockPivotSolver {
                 self.infeasible.push(i);
             }
         }
+    }
+}
+
+/// The forward chain `t_j = b_j − l_{j−1} t_{j−1}` over rows with free neighbours (`l` holds
+/// `l_{j−1}` for each row, `t` is the value before the first), with the running maxima of
+/// `|b|` and `|lo|`; returns the last `t` and the maxima.
+#[inline(never)]
+fn forward_chain(
+    rhs: &[f64],
+    lo: &[f64],
+    l: &[f64],
+    ts: &mut [f64],
+    mut t: f64,
+    mut b_max: f64,
+    mut lo_max: f64,
+) -> (f64, f64, f64) {
+    for (((tj, &b), &lo), &l) in ts.iter_mut().zip(rhs).zip(lo).zip(l) {
+        b_max = max_of(b_max, b.abs());
+        lo_max = max_of(lo_max, lo.abs());
+        t = b - l * t;
+        *tj = t;
+    }
+    (t, b_max, lo_max)
+}
+
+/// The backward chain `z_j = t_j / d_j − l_j z_{j+1}` downwards over the rows of `t`, from
+/// `z`'s last entry (one more than `t`), which is given.
+#[inline(never)]
+fn backward_chain(t: &[f64], inv_d: &[f64], l: &[f64], z: &mut [f64]) {
+    let k = t.len();
+    let mut z_next = z[k];
+    for (((zj, &t), &inv_d), &l) in z[..k].iter_mut().zip(t).zip(inv_d).zip(l).rev() {
+        z_next = t * inv_d - l * z_next;
+        *zj = z_next;
+    }
+}
+
+/// The margins of the interior nodes `1..n − 1` (all constrained), as `margin_at` (the
+/// interior branch of [`row_product`]), negative ones appended to `negative`. A loop of its
+/// own: as a closure called per node it was not inlined.
+#[inline(never)]
+fn margins_interior(
+    active: &[bool],
+    lo: &[f64],
+    rhs: &[f64],
+    c: &SymTridiag,
+    z: &[f64],
+    margin: &mut [f64],
+    negative: &mut Vec<usize>,
+) {
+    let n = z.len();
+    let (s, e) = (&c.row_sums()[..n], &c.off[..n - 1]);
+    let (active, lo, rhs, margin) = (&active[..n], &lo[..n], &rhs[..n], &mut margin[..n]);
+    for i in 1..n - 1 {
+        let zi = z[i];
+        let m = if active[i] {
+            s[i] * zi + e[i - 1] * (z[i - 1] - zi) + e[i] * (z[i + 1] - zi) - rhs[i]
+        } else {
+            zi - lo[i]
+        };
+        margin[i] = m;
+        if m < 0.0 {
+            negative.push(i);
+        }
+    }
+}
+
+/// `(C z)_i`, with the bits of [`SymTridiag::mul_into`] (difference form).
+#[inline(always)]
+fn row_product(c: &SymTridiag, i: usize, z: &[f64]) -> f64 {
+    let n = z.len();
+    let (s, e) = (c.row_sums(), &c.off);
+    if n == 1 {
+        c.diag[0] * z[0]
+    } else if i == 0 {
+        s[0] * z[0] + e[0] * (z[1] - z[0])
+    } else if i + 1 == n {
+        s[i] * z[i] + e[i - 1] * (z[i - 1] - z[i])
+    } else {
+        s[i] * z[i] + e[i - 1] * (z[i - 1] - z[i]) + e[i] * (z[i + 1] - z[i])
     }
 }
 
@@ -607,6 +703,43 @@ fn sweep_down(
     out.truncate(w);
 }
 
+/// Flags compared a word at a time by [`run_end`] and [`run_start`].
+const SCAN: usize = 32;
+
+/// The first index at or after `from` whose flag is not `flag` (`flags.len()` if none).
+#[inline]
+fn run_end(flags: &[bool], from: usize, flag: bool) -> usize {
+    let mut i = from;
+    while i + SCAN <= flags.len()
+        && flags[i..i + SCAN]
+            .iter()
+            .fold(true, |a, &f| a & (f == flag))
+    {
+        i += SCAN;
+    }
+    flags[i..]
+        .iter()
+        .position(|&f| f != flag)
+        .map_or(flags.len(), |k| i + k)
+}
+
+/// The least `s <= top` with every flag of `s..=top` equal to `flag` (that of `top`).
+#[inline]
+fn run_start(flags: &[bool], top: usize, flag: bool) -> usize {
+    let mut s = top;
+    while s >= SCAN
+        && flags[s - SCAN..s]
+            .iter()
+            .fold(true, |a, &f| a & (f == flag))
+    {
+        s -= SCAN;
+    }
+    flags[..s]
+        .iter()
+        .rposition(|&f| f != flag)
+        .map_or(0, |k| k + 1)
+}
+
 /// `m.max(x)` for a running maximum `m` that is not NaN (it starts at 0): the same value (a
 /// NaN `x` is ignored either way) in one `maxsd`, without `f64::max`'s NaN blend on the
 /// dependency chain.
@@ -623,10 +756,10 @@ fn max_abs_4(v: &[f64]) -> f64 {
     let rest = max_abs(chunks.remainder());
     for c in chunks {
         for k in 0..4 {
-            m[k] = m[k].max(c[k].abs());
+            m[k] = max_of(m[k], c[k].abs());
         }
     }
-    m[0].max(m[1]).max(m[2].max(m[3])).max(rest)
+    max_of(max_of(max_of(m[0], m[1]), max_of(m[2], m[3])), rest)
 }
 
 /// Appends `r` to sorted ranges, merging it with the last one when they overlap or touch.
@@ -649,19 +782,37 @@ impl StepSolver for BlockPivotSolver {
         z: &mut [f64],
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
+        // The bounds per node: `lower` itself when every node is constrained (no copy),
+        // else scattered into `self.lo`, lent out for the solve.
+        let mut store = std::mem::take(&mut self.lo);
+        let lo = if self.all_constrained {
+            lower
+        } else {
+            for (&i, &v) in self.nodes.iter().zip(lower) {
+                store[i] = v;
+            }
+            &store[..]
+        };
+        let result = self.solve_with(rhs, lo, z, reactions);
+        self.lo = store;
+        result
+    }
+}
+
+impl BlockPivotSolver {
+    /// [`StepSolver::solve`] with the bounds `lo` per node.
+    fn solve_with(
+        &mut self,
+        rhs: &[f64],
+        lo: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<SolveInfo, StepFailure> {
         let eps = f64::EPSILON;
         let n = z.len();
+        let lower = lo;
         // `(max|b|, max|lo|)`, taken by the step's first solve.
         let mut maxima = None;
-        if self.all_constrained {
-            // Every node constrained (nodes = 0..n).
-            self.lo.copy_from_slice(lower);
-        } else {
-            let lo = &mut self.lo[..];
-            for (&i, &v) in self.nodes.iter().zip(lower) {
-                lo[i] = v;
-            }
-        }
         let mut best_count = usize::MAX;
         let mut patience = BLOCK_PATIENCE;
         // Whether `t` and `z` hold this step's sweep with `active` before `flips`.
@@ -688,12 +839,12 @@ impl StepSolver for BlockPivotSolver {
                 }
                 maxima.get_or_insert_with(|| (max_abs_4(rhs), max_abs_4(lower)));
             } else if local {
-                self.solve_local(rhs, z);
+                self.solve_local(rhs, lo, z);
             } else {
                 if !self.incremental || !self.factor_valid || !self.flips.is_empty() {
                     self.factor_all();
                 }
-                let m = self.solve_all(rhs, z);
+                let m = self.solve_all(rhs, lo, z);
                 maxima.get_or_insert(m);
                 swept = true;
             }
@@ -706,18 +857,24 @@ impl StepSolver for BlockPivotSolver {
             let tol_l = TIE_ULPS * eps * (self.c_norm * z_max + b_max);
             // The whole-bar solve evaluated every margin itself.
             if unconstrained {
-                self.margins_all(rhs, z);
+                self.margins_all(rhs, lo, z);
             } else if local {
-                self.margins_changed(rhs, z);
+                self.margins_changed(rhs, lo, z);
             }
             self.select_infeasible(tol_z, tol_l);
             self.flips.clear();
             if self.infeasible.is_empty() {
-                let (active, margin) = (&self.active[..], &self.margin[..]);
-                let reaction = |i: usize| if active[i] { margin[i].max(0.0) } else { 0.0 };
+                let (active, margin) = (&self.active[..n], &self.margin[..n]);
+                // `max(λ_i, 0)` on active nodes, `+0` for `λ_i = −0` and NaN (the bits of the
+                // `maxsd` that `f64::max(λ_i, 0.0)` compiled to), without a branch per node.
+                let reaction = |i: usize| {
+                    let m = margin[i];
+                    if active[i] & (m > 0.0) { m } else { 0.0 }
+                };
                 if self.all_constrained {
-                    for (i, r) in reactions[..n].iter_mut().enumerate() {
-                        *r = reaction(i);
+                    let it = reactions[..n].iter_mut().zip(active).zip(margin);
+                    for ((r, &a), &m) in it {
+                        *r = if a & (m > 0.0) { m } else { 0.0 };
                     }
                 } else {
                     for (r, &i) in reactions.iter_mut().zip(&self.nodes) {
@@ -752,5 +909,87 @@ impl StepSolver for BlockPivotSolver {
         Err(StepFailure::IterationLimit {
             iterations: self.max_iterations,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The whole-bar solve's run loops, kernels and margin pass against the row-by-row
+    /// recurrences (`pivot_at`, `forward_at`, `backward_at`, `margin_at`) that the incremental
+    /// re-solves use: the same bits of `t`, `z`, the block maxima and the negative margins, on
+    /// random SPD matrices and active patterns with runs of every length around [`SCAN`].
+    fn whole_bar_equals_rows(diag: Vec<f64>, off: Vec<f64>, runs: Vec<(bool, usize)>, all: bool) {
+        let n = diag.len();
+        let c = SymTridiag::new(diag, off);
+        let nodes: Vec<usize> = (0..n).filter(|&i| all || i % 3 != 1).collect();
+        let mut s = BlockPivotSolver::new(&c, &nodes).unwrap();
+        let mut i = 0;
+        for &(flag, len) in runs.iter().cycle() {
+            for _ in 0..len {
+                if i < n {
+                    s.active[i] = flag && (all || s.slot[i] != NONE);
+                    i += 1;
+                }
+            }
+            if i == n {
+                break;
+            }
+        }
+        let wave = |k: usize, a: f64| {
+            (0..n)
+                .map(|i| (a * (i + k) as f64).sin())
+                .collect::<Vec<_>>()
+        };
+        let (rhs, lo_nodes) = (wave(1, 0.37), wave(5, 0.11));
+        let lo: Vec<f64> = (0..n)
+            .map(|i| if all || i % 3 != 1 { lo_nodes[i] } else { 0.0 })
+            .collect();
+        s.factor_all();
+        let mut rows = s.clone();
+        let mut z = vec![f64::NAN; n];
+        let (b_max, lo_max) = s.solve_all(&rhs, &lo, &mut z);
+        let mut z_rows = vec![f64::NAN; n];
+        for j in 0..n {
+            rows.forward_at(j, &rhs, &lo);
+        }
+        for j in (0..n).rev() {
+            rows.backward_at(j, &mut z_rows);
+        }
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&s.t), bits(&rows.t), "forward chain");
+        assert_eq!(bits(&z), bits(&z_rows), "backward chain");
+        let blocks: Vec<f64> = z.chunks(MAX_BLOCK).map(max_abs).collect();
+        assert_eq!(bits(&s.block_max), bits(&blocks), "block maxima");
+        assert_eq!(b_max.to_bits(), max_abs(&rhs).to_bits());
+        assert_eq!(lo_max.to_bits(), max_abs(&lo).to_bits());
+        let negative: Vec<usize> = nodes
+            .iter()
+            .copied()
+            .filter(|&i| rows.margin_at(i, &rhs, &lo, &z_rows) < 0.0)
+            .collect();
+        assert_eq!(s.negative, negative, "negative margins");
+        for &i in nodes.iter().filter(|&&i| s.active[i] || s.margin[i] < 0.0) {
+            let m = rows.margin_at(i, &rhs, &lo, &z_rows);
+            assert_eq!(s.margin[i].to_bits(), m.to_bits(), "margin {i}");
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn whole_bar_solve_has_the_bits_of_the_row_recurrences(
+            n in 1usize..700,
+            seed in 0u64..1000,
+            runs in prop::collection::vec((any::<bool>(), 1usize..80), 1..12),
+            all in any::<bool>(),
+        ) {
+            // Diagonally dominant: SPD, and the reduced pivots stay positive.
+            let r = |i: usize, k: u64| ((i as u64 * 2654435761 + seed * 97 + k) % 1000) as f64 / 1000.0;
+            let off: Vec<f64> = (0..n.saturating_sub(1)).map(|i| -0.2 - r(i, 1)).collect();
+            let diag: Vec<f64> = (0..n).map(|i| 2.5 + r(i, 2)).collect();
+            whole_bar_equals_rows(diag, off, runs, all);
+        }
     }
 }

@@ -202,6 +202,32 @@ impl GeneralLoad {
     }
 }
 
+/// `m.min(x)` for a running minimum `m` that is never NaN: a NaN `x` is ignored and a tie
+/// keeps `m`, as `f64::min` does here, in one `minsd` instead of a NaN blend on the chain.
+#[inline(always)]
+fn min_of(m: f64, x: f64) -> f64 {
+    if x < m { x } else { m }
+}
+
+/// [`min_of`] for a running maximum.
+#[inline(always)]
+fn max_of(m: f64, x: f64) -> f64 {
+    if x > m { x } else { m }
+}
+
+/// Per-step sums over the constraints ([`Simulation::fill_contact`]).
+struct ContactSums {
+    min_gap: f64,
+    min_reaction: f64,
+    max_comp: f64,
+    total: f64,
+    dissipation: f64,
+    /// Nodes in contact, and the first and last of them (constraint indices).
+    count: usize,
+    first: usize,
+    last: usize,
+}
+
 /// A running simulation. Holds `u^n`, `u^n − u^{n−1}` and the matrix products the next step
 /// reuses; [`Simulation::step`] advances one step and allocates nothing.
 pub struct Simulation {
@@ -220,7 +246,13 @@ pub struct Simulation {
     force: Vec<f64>,
     lower: Vec<f64>,
     reactions: Vec<f64>,
+    /// Per constraint: its gap `a_j` (read contiguously, not through `disc.constraints`), its
+    /// local node, and the constraint indices of the Signorini ends (at most two). `locals`
+    /// is empty when constraint `j` is local node `j` (an obstacle: every node, in order), so
+    /// that the per-step passes over the constraints read plain slices.
+    gaps: Vec<f64>,
     locals: Vec<usize>,
+    ends: Vec<usize>,
     /// `1/Δt²` and `½ − α/(2Δt)`.
     inv_dt2: f64,
     c_w: f64,
@@ -363,8 +395,13 @@ impl Simulation {
                 }
             }
         };
-        let locals = disc.constrained_locals();
+        let mut locals = disc.constrained_locals();
         let k = locals.len();
+        let gaps: Vec<f64> = disc.constraints.iter().map(|c| c.gap).collect();
+        let ends = disc.end_constraints();
+        if locals.iter().enumerate().all(|(j, &l)| j == l) {
+            locals = Vec::new();
+        }
         // u^0 and u_1 on the unknowns, in the storage of the full-mesh vectors.
         let restrict = |mut v: Vec<f64>| {
             v.truncate(range.end);
@@ -384,7 +421,9 @@ impl Simulation {
             force,
             lower: vec![0.0; k],
             reactions: vec![0.0; k],
+            gaps,
             locals,
+            ends,
             inv_dt2: 1.0 / (dt * dt),
             c_w: 0.5 - alpha / (2.0 * dt),
             potential: 0.0,
@@ -420,9 +459,7 @@ impl Simulation {
             self.w[i] = dt * v0[i] + 0.5 * dt * dt * acc[i];
         }
         self.disc.step_matrix.mul_into(&self.w, &mut self.rhs);
-        for (j, c) in self.disc.constraints.iter().enumerate() {
-            self.lower[j] = -c.gap - self.u[self.locals[j]];
-        }
+        self.fill_lower();
         self.solver.set_state_scale(max_abs(&self.u));
         let info = self
             .solver
@@ -452,7 +489,7 @@ impl Simulation {
             iterations: info.iterations,
             ..Default::default()
         };
-        self.fill_contact(&mut record);
+        self.fill_contact(&mut record, false);
         self.first_record = record;
         Ok(())
     }
@@ -547,9 +584,7 @@ impl Simulation {
             rhs_into::<LOAD, _>(mass, stiffness, k, c_w, inv_dt2, u, w, force, rhs)
         });
         let clock = clock.lap(&mut self.timing.rhs_ns);
-        for (j, c) in self.disc.constraints.iter().enumerate() {
-            self.lower[j] = -c.gap - self.u[self.locals[j]];
-        }
+        self.fill_lower();
         let measure = (n + 1).is_multiple_of(self.diagnostics_every) || n + 1 == self.last_step;
         if measure && !self.measured {
             // E^{n−1/2} from u^n and w (u^{n−1} = u^n − w), before u moves on.
@@ -579,11 +614,12 @@ impl Simulation {
             iterations: info.iterations,
             ..Default::default()
         };
+        // The contact state, and with `measure` the contact dissipation, in one pass.
+        let contact = self.fill_contact(&mut record, measure);
         if measure {
-            self.measure_into(&mut record, has_load)?;
+            self.measure_into(&mut record, has_load, contact)?;
         }
         self.measured = measure;
-        self.fill_contact(&mut record);
         std::mem::swap(&mut self.w, &mut self.z);
         self.n = n + 1;
         clock.lap(&mut self.timing.diagnostics_ns);
@@ -592,7 +628,14 @@ impl Simulation {
 
     /// The energy balance of the step just taken (`u = u^{n+1}`, `z` its increment, `w` the
     /// previous one) into `record`; `self.energy`, `self.potential` move on to `n + 1`.
-    fn measure_into(&mut self, record: &mut StepRecord, has_load: bool) -> Result<(), RunError> {
+    /// `contact` is the contact dissipation `−½ Σ_j r_j (z_j + w_j)`, summed in constraint order
+    /// by [`Simulation::fill_contact`] (which also records the ends' shares).
+    fn measure_into(
+        &mut self,
+        record: &mut StepRecord,
+        has_load: bool,
+        contact: f64,
+    ) -> Result<(), RunError> {
         let (mass, stiffness) = (&self.disc.mass, &self.disc.stiffness);
         let (u, z, w, f) = (&self.u[..], &self.z[..], &self.w[..], &self.force[..]);
         let sums = monomorphise!(has_load, self.uniform, mass, stiffness, |LOAD, k| {
@@ -607,17 +650,6 @@ impl Simulation {
             0.0
         };
         let work = 0.5 * sums.work;
-        let mut contact = 0.0;
-        let mut end = 0;
-        for (j, &l) in self.locals.iter().enumerate() {
-            // `+= −½ r δ` has the bits of `−= ½ r δ` (negation is exact).
-            let share = -0.5 * self.reactions[j] * (self.z[l] + self.w[l]);
-            contact += share;
-            if self.disc.constraints[j].side.is_some() {
-                record.end_contact_dissipation[end] = share;
-                end += 1;
-            }
-        }
         let residual = energy - self.energy - work + viscous + contact;
         let scale = [energy, self.energy, work.abs(), viscous, contact.abs()]
             .into_iter()
@@ -645,47 +677,109 @@ impl Simulation {
         self.timing
     }
 
-    fn fill_contact(&self, record: &mut StepRecord) {
-        let (mut min_gap, mut min_reaction, mut max_comp) = (f64::INFINITY, f64::INFINITY, 0.0f64);
-        let (mut count, mut lo, mut hi) = (0, f64::NAN, f64::NAN);
-        let mut end = 0;
-        let mut total = 0.0;
-        for (j, c) in self.disc.constraints.iter().enumerate() {
-            let gap = self.u[self.locals[j]] + c.gap;
-            let reaction = self.reactions[j];
-            if c.side.is_some() {
-                record.gap[end] = gap;
-                record.reaction[end] = reaction;
-                end += 1;
+    /// `lower_j = −a_j − u^n_j` for every constraint.
+    fn fill_lower(&mut self) {
+        let (lower, gaps, u) = (&mut self.lower[..], &self.gaps[..], &self.u[..]);
+        if self.locals.is_empty() {
+            for ((lo, &a), &u) in lower.iter_mut().zip(gaps).zip(&u[..gaps.len()]) {
+                *lo = -a - u;
             }
-            total += reaction;
-            min_gap = min_gap.min(gap);
-            min_reaction = min_reaction.min(reaction);
-            max_comp = max_comp.max((gap * reaction).abs());
-            if gap <= CONTACT_GAP_TOL {
-                let x = self.disc.x(c.node);
-                if count == 0 {
-                    lo = x;
-                }
-                hi = x;
-                count += 1;
+        } else {
+            for ((lo, &a), &l) in lower.iter_mut().zip(gaps).zip(&self.locals) {
+                *lo = -a - u[l];
             }
         }
-        if self.disc.constraints.is_empty() {
-            (min_gap, min_reaction) = (0.0, 0.0);
+    }
+
+    /// The contact state of `u = u^{n+1}` into `record`; with `dissipation` also the contact
+    /// dissipation `−½ Σ_j r_j (z_j + w_j)` (returned; 0 without) and the ends' shares. One
+    /// pass over the constraints, in their order (the sums' bits depend on it).
+    fn fill_contact(&self, record: &mut StepRecord, dissipation: bool) -> f64 {
+        let s = if self.locals.is_empty() {
+            if dissipation {
+                self.contact_pass::<true>(|j| j)
+            } else {
+                self.contact_pass::<false>(|j| j)
+            }
+        } else {
+            let locals = &self.locals[..];
+            if dissipation {
+                self.contact_pass::<true>(|j| locals[j])
+            } else {
+                self.contact_pass::<false>(|j| locals[j])
+            }
+        };
+        for (e, &j) in self.ends.iter().enumerate() {
+            let l = self.locals.get(j).copied().unwrap_or(j);
+            record.gap[e] = self.u[l] + self.gaps[j];
+            record.reaction[e] = self.reactions[j];
+            if dissipation {
+                // `+= −½ r δ` has the bits of `−= ½ r δ` (negation is exact).
+                record.end_contact_dissipation[e] =
+                    -0.5 * self.reactions[j] * (self.z[l] + self.w[l]);
+            }
         }
+        let (min_gap, min_reaction) = if self.gaps.is_empty() {
+            (0.0, 0.0)
+        } else {
+            (s.min_gap, s.min_reaction)
+        };
+        let x = |j: usize| self.disc.x(self.disc.constraints[j].node);
         record.min_gap = min_gap;
         record.min_reaction = min_reaction;
-        record.max_complementarity = max_comp;
-        record.contact_nodes = count;
-        record.contact_extent = [lo, hi];
-        record.total_reaction = total;
+        record.max_complementarity = s.max_comp;
+        record.contact_nodes = s.count;
+        record.contact_extent = if s.count > 0 {
+            [x(s.first), x(s.last)]
+        } else {
+            [f64::NAN, f64::NAN]
+        };
+        record.total_reaction = s.total;
+        s.dissipation
+    }
+
+    /// The sums of [`Simulation::fill_contact`], constraint `j` at local node `local(j)`.
+    #[inline(always)]
+    fn contact_pass<const DISSIPATION: bool>(&self, local: impl Fn(usize) -> usize) -> ContactSums {
+        let k = self.gaps.len();
+        let (gaps, reactions) = (&self.gaps[..k], &self.reactions[..k]);
+        let (u, z, w) = (&self.u[..], &self.z[..], &self.w[..]);
+        let mut s = ContactSums {
+            min_gap: f64::INFINITY,
+            min_reaction: f64::INFINITY,
+            max_comp: 0.0,
+            total: 0.0,
+            dissipation: 0.0,
+            count: 0,
+            first: 0,
+            last: 0,
+        };
+        for j in 0..k {
+            let l = local(j);
+            let gap = u[l] + gaps[j];
+            let reaction = reactions[j];
+            s.total += reaction;
+            s.min_gap = min_of(s.min_gap, gap);
+            s.min_reaction = min_of(s.min_reaction, reaction);
+            s.max_comp = max_of(s.max_comp, (gap * reaction).abs());
+            if gap <= CONTACT_GAP_TOL {
+                if s.count == 0 {
+                    s.first = j;
+                }
+                s.last = j;
+                s.count += 1;
+            }
+            if DISSIPATION {
+                s.dissipation += -0.5 * reaction * (z[l] + w[l]);
+            }
+        }
+        s
     }
 
     /// `u^n_j + a_j` at every constrained node, in the order of `constraints`.
     pub fn constraint_gaps_into(&self, out: &mut [f64]) {
-        for (j, c) in self.disc.constraints.iter().enumerate() {
-            out[j] = self.u[self.locals[j]] + c.gap;
+        for (j, (o, &a)) in out.iter_mut().zip(&self.gaps).enumerate() {
+            *o = self.u[self.locals.get(j).copied().unwrap_or(j)] + a;
         }
     }
 
@@ -820,6 +914,159 @@ impl NodeValues<'_> {
         match node.checked_sub(self.first) {
             Some(i) if i < self.u.len() => (self.u[i], self.w[i] * self.scale),
             _ => (0.0, 0.0),
+        }
+    }
+}
+
+#[cfg(test)]
+mod contact_pass_tests {
+    use super::*;
+
+    /// The passes over the constraints as they were before issue 17 made them read contiguous
+    /// slices (through `disc.constraints` and the local of each, with `f64::min`/`max`): the
+    /// reference the contiguous passes must reproduce bit for bit.
+    fn reference(sim: &Simulation, dissipation: bool) -> (StepRecord, f64) {
+        let mut record = StepRecord::default();
+        let locals = sim.disc.constrained_locals();
+        // After `step`, `w` holds the increment just taken and `z` the one before it.
+        let (z, w) = (&sim.w, &sim.z);
+        let mut contact = 0.0;
+        let mut end = 0;
+        if dissipation {
+            for (j, &l) in locals.iter().enumerate() {
+                let share = -0.5 * sim.reactions[j] * (z[l] + w[l]);
+                contact += share;
+                if sim.disc.constraints[j].side.is_some() {
+                    record.end_contact_dissipation[end] = share;
+                    end += 1;
+                }
+            }
+        }
+        let (mut min_gap, mut min_reaction, mut max_comp) = (f64::INFINITY, f64::INFINITY, 0.0f64);
+        let (mut count, mut lo, mut hi) = (0, f64::NAN, f64::NAN);
+        let mut total = 0.0;
+        end = 0;
+        for (j, c) in sim.disc.constraints.iter().enumerate() {
+            let gap = sim.u[locals[j]] + c.gap;
+            let reaction = sim.reactions[j];
+            if c.side.is_some() {
+                record.gap[end] = gap;
+                record.reaction[end] = reaction;
+                end += 1;
+            }
+            total += reaction;
+            min_gap = min_gap.min(gap);
+            min_reaction = min_reaction.min(reaction);
+            max_comp = max_comp.max((gap * reaction).abs());
+            if gap <= CONTACT_GAP_TOL {
+                let x = sim.disc.x(c.node);
+                if count == 0 {
+                    lo = x;
+                }
+                hi = x;
+                count += 1;
+            }
+        }
+        if sim.disc.constraints.is_empty() {
+            (min_gap, min_reaction) = (0.0, 0.0);
+        }
+        record.min_gap = min_gap;
+        record.min_reaction = min_reaction;
+        record.max_complementarity = max_comp;
+        record.contact_nodes = count;
+        record.contact_extent = [lo, hi];
+        record.total_reaction = total;
+        (record, contact)
+    }
+
+    fn same_contact_bits(a: &StepRecord, b: &StepRecord) -> bool {
+        let bits = |r: &StepRecord| {
+            let mut v = vec![
+                r.total_reaction,
+                r.min_gap,
+                r.min_reaction,
+                r.max_complementarity,
+                r.contact_extent[0],
+                r.contact_extent[1],
+            ];
+            v.extend(
+                r.gap
+                    .iter()
+                    .chain(&r.reaction)
+                    .chain(&r.end_contact_dissipation),
+            );
+            v.into_iter().map(f64::to_bits).collect::<Vec<_>>()
+        };
+        bits(a) == bits(b) && a.contact_nodes == b.contact_nodes
+    }
+
+    /// Every step of scenes with an obstacle (free, clamped and Signorini ends), with ends only,
+    /// and with steps not measured: the bounds, the contact state and the contact dissipation
+    /// have the bits of the per-constraint loops. (An extent ending at a wrong node fails it;
+    /// `min_of`'s tie rule is not exercised: these runs have no `±0` ties.)
+    #[test]
+    fn the_contiguous_passes_have_the_bits_of_the_per_constraint_loops() {
+        let cases: [(&str, &[&str]); 6] = [
+            ("distributed", &["mesh.elements=200"]),
+            (
+                "distributed-forced",
+                &["mesh.elements=150", "output.diagnostics_every=3"],
+            ),
+            (
+                "distributed",
+                &[
+                    "mesh.elements=100",
+                    "left.condition=\"clamped\"",
+                    "initial.velocity=\"-0.5*x\"",
+                ],
+            ),
+            (
+                "distributed",
+                &[
+                    "mesh.elements=100",
+                    "left.condition=\"signorini\"",
+                    "left.gap=0.25",
+                    "right.condition=\"signorini\"",
+                    "right.gap=0.15",
+                ],
+            ),
+            ("impact", &["output.diagnostics_every=2"]),
+            ("both-ends", &[]),
+        ];
+        for (name, overrides) in cases {
+            let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+            let (_, scene) = crate::scene::load(name, &o).unwrap();
+            let mut sim = Simulation::new(&scene).unwrap();
+            let (first, _) = reference(&sim, false);
+            assert!(
+                same_contact_bits(&sim.first_record(), &first),
+                "{name}: start-up"
+            );
+            let mut contacts = 0;
+            for step in 0..400.min(scene.steps() - 1) {
+                let expected_lower: Vec<f64> = (sim.disc.constraints.iter())
+                    .zip(sim.disc.constrained_locals())
+                    .map(|(c, l)| -c.gap - sim.u[l])
+                    .collect();
+                sim.fill_lower();
+                assert!(
+                    (sim.lower.iter().map(|v| v.to_bits()))
+                        .eq(expected_lower.iter().map(|v| v.to_bits())),
+                    "{name}: bounds at step {step}"
+                );
+                let record = sim.step().unwrap();
+                let (expected, contact) = reference(&sim, record.measured);
+                assert!(same_contact_bits(&record, &expected), "{name}: step {step}");
+                if record.measured {
+                    assert_eq!(
+                        record.contact_dissipation.to_bits(),
+                        contact.to_bits(),
+                        "{name}: dissipation at step {step}"
+                    );
+                }
+                contacts += record.contact_nodes;
+            }
+            assert!(contacts > 0, "{name}: no contact, nothing compared");
         }
     }
 }
