@@ -144,7 +144,8 @@ pub struct Summary {
     /// whole contact set (`obstacle`: an episode lasts while any node is in contact).
     pub contact_episodes: std::collections::BTreeMap<String, Vec<ContactEpisode>>,
     pub solver_iterations: Iterations,
-    /// What `displacement.csv` holds (written runs only): kept steps, node stride, rows.
+    /// What the profile file holds (written runs only): its name and format, kept steps, node
+    /// stride, rows.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub output: Option<crate::scene::OutputSampling>,
     /// Worst optimality residuals of the solver's answers, for solvers that audit them
