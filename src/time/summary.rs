@@ -65,10 +65,10 @@ fn floor_log10(a: f64) -> i32 {
         }
     } else if (1e-11..1.0).contains(&a) {
         // `a·10^j` is within an ulp of the exact product, far inside the margin.
-        if let Some(j) = (1..=11).find(|&j| a * POWERS_OF_TEN[j] >= 1.0) {
-            if !near(a * POWERS_OF_TEN[j], 1.0) {
-                return -(j as i32);
-            }
+        if let Some(j) = (1..=11).find(|&j| a * POWERS_OF_TEN[j] >= 1.0)
+            && !near(a * POWERS_OF_TEN[j], 1.0)
+        {
+            return -(j as i32);
         }
     }
     a.log10().floor() as i32
