@@ -7,7 +7,8 @@
 //! for one step (`one-step`) and for 400 steps keeping `t = 0` and the last step
 //! (`400-steps`, `[output] every = 400`), the same 400 steps alone (`400-steps-stepping`: the
 //! set-up outside the timing), and the refined run `both-ends` with 1e5 elements and
-//! Δt = 3.125e-5 to t = 0.05 with its default output (`refined-1e5`, 1600 steps).
+//! Δt = 3.125e-5 to t = 0.05 with its default output (`refined-1e5`, 1600 steps), and with
+//! `--features npy` the same writing `displacement.npy` (`refined-1e5-npy`).
 
 use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use std::path::Path;
@@ -37,7 +38,8 @@ fn bench_setup(c: &mut Criterion) {
     let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/bench-setup");
     let mut group = c.benchmark_group("setup");
     group.sample_size(10);
-    let runs = [
+    #[cfg_attr(not(feature = "npy"), expect(unused_mut))]
+    let mut runs = vec![
         (
             "one-step",
             both_ends(&["mesh.elements=16384", "time.end=0.005"]),
@@ -55,6 +57,17 @@ fn bench_setup(c: &mut Criterion) {
             ]),
         ),
     ];
+    // With `--features npy`: the refined run writing `displacement.npy` instead.
+    #[cfg(feature = "npy")]
+    runs.push((
+        "refined-1e5-npy",
+        both_ends(&[
+            "mesh.elements=100000",
+            "time.step=0.00003125",
+            "time.end=0.05",
+            "output.format=npy",
+        ]),
+    ));
     for (label, scene) in &runs {
         let node_steps = (scene.elements() as u64 + 1) * scene.steps() as u64;
         group.throughput(Throughput::Elements(node_steps));

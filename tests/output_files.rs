@@ -122,3 +122,58 @@ fn output_nodes_below_two_is_refused_naming_the_key() {
     let err = viscobar::scene::load("impact", &["output.nodes=1".into()]).unwrap_err();
     assert!(err.to_string().contains("output.nodes"), "{err}");
 }
+
+#[test]
+fn an_unknown_output_format_is_refused_naming_the_key() {
+    let err = viscobar::scene::load("impact", &["output.format=hdf5".into()]).unwrap_err();
+    assert!(err.to_string().contains("format"), "{err}");
+    assert!(err.to_string().contains("hdf5"), "{err}");
+}
+
+#[test]
+fn summary_json_names_the_csv_profile_file_and_format() {
+    let scene = common::builtin("impact", &["output.every=50"]);
+    let (_, summary) = written(&scene, "format");
+    assert_eq!(summary["output"]["file"], "displacement.csv");
+    assert_eq!(summary["output"]["format"], "csv");
+    // The default stays out of the printed scene.
+    assert!(!scene.to_toml().contains("format"));
+}
+
+/// A build without the `npy` feature refuses `format = "npy"` naming `output.format` and the
+/// feature, at load and in `run_to_dir` (a scene built by hand), writing nothing.
+#[cfg(not(feature = "npy"))]
+#[test]
+fn npy_output_without_the_feature_is_refused_naming_the_key_and_the_feature() {
+    let err = viscobar::scene::load("impact", &["output.format=npy".into()]).unwrap_err();
+    let text = err.to_string();
+    assert!(text.contains("output.format"), "{text}");
+    assert!(text.contains("--features npy"), "{text}");
+
+    let mut scene = common::builtin("impact", &[]);
+    scene.output.format = viscobar::scene::OutputFormat::Npy;
+    let dir = std::env::temp_dir().join(format!("viscobar-no-npy-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let err = run_to_dir("impact", &scene, &dir, false).unwrap_err();
+    assert!(err.to_string().contains("output.format"), "{err}");
+    assert_eq!(err.exit_code(), 2);
+    assert!(!dir.exists(), "nothing written");
+}
+
+/// The same through the command line: exit code 2, the key named, nothing written.
+#[cfg(all(feature = "cli", not(feature = "npy")))]
+#[test]
+fn cli_run_with_npy_output_without_the_feature_exits_2_writing_nothing() {
+    let dir = std::env::temp_dir().join(format!("viscobar-no-npy-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_viscobar"))
+        .args(["run", "impact", "--set", "output.format=npy", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("output.format"), "{stderr}");
+    assert!(stderr.contains("--features npy"), "{stderr}");
+    assert!(!dir.exists(), "nothing written");
+}

@@ -403,6 +403,49 @@ pub struct OutputSpec {
     /// at the default); raise it, or set `nodes`, to write more.
     #[serde(default = "default_max_rows")]
     pub max_rows: u64,
+    /// The profile file's format: `displacement.csv`, or `displacement.npy` (the cargo feature
+    /// `npy`). Left out of the printed scene when it is the default.
+    #[serde(default, skip_serializing_if = "OutputFormat::is_csv")]
+    pub format: OutputFormat,
+}
+
+/// `[output] format`: how the displacement profiles are written.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum OutputFormat {
+    /// `displacement.csv`: text, `t,x,u,v`.
+    #[default]
+    Csv,
+    /// `displacement.npy`: a structured array `t, x, u, v` of `<f8` (cargo feature `npy`).
+    Npy,
+}
+
+impl OutputFormat {
+    fn is_csv(&self) -> bool {
+        *self == OutputFormat::Csv
+    }
+
+    /// The profile file's name.
+    pub fn file(self) -> &'static str {
+        match self {
+            OutputFormat::Csv => "displacement.csv",
+            OutputFormat::Npy => "displacement.npy",
+        }
+    }
+
+    /// Refuses `npy` in a build without the `npy` feature, naming `output.format`.
+    pub fn check_available(self) -> Result<(), SceneError> {
+        if self == OutputFormat::Npy && !cfg!(feature = "npy") {
+            return Err(SceneError::Invalid {
+                field: "output.format".into(),
+                value: "\"npy\"".into(),
+                allowed: "this build has no npy writer: build with the cargo feature `npy` \
+                          (`cargo run --release --features npy -- run ...`), or use \"csv\""
+                    .into(),
+            });
+        }
+        Ok(())
+    }
 }
 
 impl Default for OutputSpec {
@@ -412,6 +455,7 @@ impl Default for OutputSpec {
             diagnostics_every: 1,
             nodes: None,
             max_rows: DEFAULT_MAX_ROWS,
+            format: OutputFormat::Csv,
         }
     }
 }
@@ -423,10 +467,13 @@ fn default_max_rows() -> u64 {
     DEFAULT_MAX_ROWS
 }
 
-/// What `displacement.csv` holds: the kept steps and the written nodes (reported in
-/// summary.json as `output`).
+/// What the profile file holds: the kept steps and the written nodes (reported in
+/// summary.json as `output`, with the file's name and format).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct OutputSampling {
+    /// The profile file (`displacement.csv` or `displacement.npy`).
+    pub file: &'static str,
+    pub format: OutputFormat,
     /// Every `every`-th step is kept, and `t = 0` and the last step.
     pub every: u64,
     /// Every `node_stride`-th node is written, and the last node.
@@ -710,6 +757,7 @@ impl Scene {
                 "must be >= 2",
             ));
         }
+        self.output.format.check_available()?;
         Expression::parse("initial.displacement", &self.initial.displacement, false)?;
         Expression::parse("initial.velocity", &self.initial.velocity, false)?;
         if let Some(d) = &self.load.density {
@@ -822,6 +870,8 @@ impl Scene {
         }
         let nodes_written = written(stride);
         OutputSampling {
+            file: self.output.format.file(),
+            format: self.output.format,
             every,
             node_stride: stride,
             kept_steps,

@@ -6,6 +6,8 @@
 pub mod clock;
 pub mod energy;
 pub mod error;
+#[cfg(feature = "npy")]
+pub mod npy;
 pub mod rhs;
 pub mod run;
 pub mod simulation;

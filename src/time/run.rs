@@ -1,7 +1,7 @@
 //! Running a scene end to end: the step loop and the output files (`summary.json`,
-//! `history.csv`, `displacement.csv`), written whole or not at all.
+//! `history.csv`, `displacement.csv` or `displacement.npy`), written whole or not at all.
 
-use crate::scene::Scene;
+use crate::scene::{OutputFormat, Scene};
 use crate::time::RunError;
 use crate::time::simulation::{NodeValues, Simulation, StepRecord, Unstarted};
 use crate::time::summary::{Summary, Tracker, output_time, push_output_time};
@@ -28,11 +28,14 @@ pub fn run_in_memory(
     Ok((records, summary, sim))
 }
 
-/// Runs a scene and writes `summary.json`, `history.csv` and `displacement.csv` into `out`.
+/// Runs a scene and writes `summary.json`, `history.csv` and the profiles (`displacement.csv`,
+/// or `displacement.npy` with `[output] format = "npy"`) into `out`.
 /// The scene is set up (discretised, its initial data evaluated) before anything is created, so
 /// a refused scene leaves no trace on disk. The files are written into a temporary folder
 /// inside `out` and moved into place only when the run has succeeded, so a failed run leaves
 /// earlier results untouched; folders it created for `out` are removed again when it fails.
+/// A successful run removes the other format's profile file left by an earlier run in `out`
+/// (it belonged to the summary just replaced).
 /// `progress` shows a progress bar on stderr for long runs (with the `progress` feature).
 pub fn run_to_dir(
     name: &str,
@@ -41,16 +44,26 @@ pub fn run_to_dir(
     progress: bool,
 ) -> Result<Summary, RunError> {
     let start = Instant::now();
+    // Again here: a scene's fields are public, so this one may not have been validated.
+    let format = scene.output.format;
+    format.check_available()?;
     let prepared = Simulation::prepare(scene)?;
-    write_whole(
+    let files = ["history.csv", format.file(), "summary.json"];
+    let summary = write_whole(
         out,
-        &RUN_FILES,
+        &files,
         |path, source| RunError::Write { path, source },
         |tmp| write_run(name, scene, prepared, start, tmp, progress),
-    )
+    )?;
+    for other in [OutputFormat::Csv, OutputFormat::Npy] {
+        if other != format {
+            let _ = std::fs::remove_file(out.join(other.file()));
+        }
+    }
+    Ok(summary)
 }
 
-/// The files a run writes (bar or plane).
+/// The files a run writes with the default output (bar or plane).
 pub(crate) const RUN_FILES: [&str; 3] = ["history.csv", "displacement.csv", "summary.json"];
 
 /// Writes `files` into `out` whole or not at all: `write` fills a temporary folder inside
@@ -189,8 +202,8 @@ fn write_run(
 
     // `t = 0` is written before the start-up step moves `u^0` on.
     let sampling = scene.output_sampling();
-    let disp_path = path("displacement.csv");
-    let mut disp = ProfileCsv::new(create(&disp_path)?, disc, sampling);
+    let disp_path = path(sampling.file);
+    let mut disp = Profiles::new(create(&disp_path)?, disc, sampling).map_err(io(&disp_path))?;
     disp.write(0.0, prepared.node_values())
         .map_err(io(&disp_path))?;
     let mut sim = prepared.start()?;
@@ -225,6 +238,57 @@ fn write_run(
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
     std::fs::write(&json_path, json + "\n").map_err(io(&json_path))?;
     Ok(summary)
+}
+
+/// The writer of the profile file in the scene's format.
+enum Profiles {
+    Csv(ProfileCsv),
+    #[cfg(feature = "npy")]
+    Npy(crate::time::npy::ProfileNpy),
+}
+
+impl Profiles {
+    /// Without the `npy` feature an `npy` scene was refused by [`run_to_dir`] before anything
+    /// was created; `Unsupported` here all the same rather than a panic.
+    fn new(
+        file: std::fs::File,
+        disc: &crate::time::simulation::Discretisation,
+        sampling: crate::scene::OutputSampling,
+    ) -> std::io::Result<Self> {
+        match sampling.format {
+            OutputFormat::Csv => Ok(Self::Csv(ProfileCsv::new(file, disc, sampling))),
+            #[cfg(feature = "npy")]
+            OutputFormat::Npy => {
+                let stride = usize::try_from(sampling.node_stride).unwrap_or(usize::MAX);
+                let nodes = written_nodes(stride, disc.nodes)
+                    .map(|i| (i, output_time(disc.x(i))))
+                    .collect();
+                crate::time::npy::ProfileNpy::new(file, sampling.rows, nodes).map(Self::Npy)
+            }
+            #[cfg(not(feature = "npy"))]
+            OutputFormat::Npy => Err(std::io::Error::new(
+                std::io::ErrorKind::Unsupported,
+                "output.format = \"npy\" needs the cargo feature `npy`",
+            )),
+        }
+    }
+
+    /// The rows of one kept step at time `t` (rounded as every output time is).
+    fn write(&mut self, t: f64, values: NodeValues<'_>) -> std::io::Result<()> {
+        match self {
+            Self::Csv(csv) => csv.write(t, values),
+            #[cfg(feature = "npy")]
+            Self::Npy(npy) => npy.write(output_time(t), values),
+        }
+    }
+
+    fn finish(self) -> std::io::Result<()> {
+        match self {
+            Self::Csv(csv) => csv.finish(),
+            #[cfg(feature = "npy")]
+            Self::Npy(npy) => npy.finish(),
+        }
+    }
 }
 
 /// Buffer of `history.csv` (a row a step, about 100 bytes).

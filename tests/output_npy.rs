@@ -1,0 +1,156 @@
+//! `[output] format = "npy"` (cargo feature `npy`): `displacement.npy` is a structured array
+//! `t, x, u, v` of `<f8` holding the same rows as `displacement.csv`, `u` and `v` the
+//! simulation's own bits; its header is the one `numpy.load` parses; summary.json names it.
+#![cfg(feature = "npy")]
+
+mod common;
+use std::path::{Path, PathBuf};
+use viscobar::Simulation;
+use viscobar::time::npy::ProfileRow;
+use viscobar::time::run::run_to_dir;
+use viscobar::time::summary::output_time;
+
+fn fresh_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("viscobar-npy-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// The rows of `dir/displacement.npy` through npyz's reader, after checking its header.
+fn read_npy(dir: &Path, rows: u64) -> Vec<ProfileRow> {
+    let bytes = std::fs::read(dir.join("displacement.npy")).unwrap();
+    let npy = npyz::NpyFile::new(&bytes[..]).unwrap();
+    assert_eq!(npy.shape(), &[rows], "shape");
+    assert_eq!(npy.order(), npyz::Order::C);
+    // The dtype spelled out here, not taken from the library.
+    let f8 = npyz::DType::Plain("<f8".parse().unwrap());
+    let expected = npyz::DType::Record(
+        ["t", "x", "u", "v"]
+            .iter()
+            .map(|n| npyz::Field {
+                name: n.to_string(),
+                dtype: f8.clone(),
+            })
+            .collect(),
+    );
+    assert_eq!(npy.dtype(), expected, "dtype");
+    npy.into_vec::<ProfileRow>().unwrap()
+}
+
+#[test]
+fn displacement_npy_holds_the_simulation_bits_and_the_csv_rows() {
+    // Values of every size (a kink, contact, a displacement crossing zero), thinned in steps
+    // and, in the second case, in nodes.
+    for (extra, tag) in [(None, "all"), (Some("output.nodes=7"), "nodes")] {
+        let mut set = vec!["output.every=7"];
+        set.extend(extra);
+        let csv_scene = common::builtin("impact", &set);
+        set.push("output.format=npy");
+        let scene = common::builtin("impact", &set);
+        let sampling = scene.output_sampling();
+
+        let dir = fresh_dir(tag);
+        run_to_dir("impact", &scene, &dir, false).unwrap();
+        let rows = read_npy(&dir, sampling.rows);
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(summary["output"]["file"], "displacement.npy");
+        assert_eq!(summary["output"]["format"], "npy");
+        assert_eq!(summary["output"]["rows"], sampling.rows);
+        assert!(!dir.join("displacement.csv").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+
+        // The simulation, stepped here: `u`, `v` bit for bit, `t` and `x` rounded as in the CSV.
+        let mut sim = Simulation::new(&scene).unwrap();
+        let nodes = sim.discretisation().nodes;
+        let written: Vec<usize> = (0..nodes)
+            .filter(|&i| sampling.writes_node(i, nodes))
+            .collect();
+        assert_eq!(written.len() as u64, sampling.nodes_written);
+        let (mut u, mut v) = (vec![0.0; nodes], vec![0.0; nodes]);
+        let mut next = rows.iter();
+        let mut check = |t: f64, u: &[f64], v: &[f64], sim: &Simulation| {
+            for &i in &written {
+                let r = next.next().expect("a row a written node");
+                assert_eq!(r.t.to_bits(), output_time(t).to_bits(), "t at {t}");
+                let x = output_time(sim.discretisation().x(i));
+                assert_eq!(r.x.to_bits(), x.to_bits(), "x of node {i}");
+                assert_eq!(r.u.to_bits(), u[i].to_bits(), "u at t = {t}, node {i}");
+                assert_eq!(r.v.to_bits(), v[i].to_bits(), "v at t = {t}, node {i}");
+            }
+        };
+        sim.initial_state_into(&mut u, &mut v);
+        check(0.0, &u, &v, &sim);
+        let steps = scene.steps();
+        for n in 1..=steps {
+            if n > 1 {
+                sim.step().unwrap();
+            }
+            if n.is_multiple_of(7) || n == steps {
+                sim.displacement_into(&mut u);
+                sim.velocity_into(&mut v);
+                check(sim.time(), &u, &v, &sim);
+            }
+        }
+        assert!(next.next().is_none(), "no rows beyond the kept steps");
+
+        // The same scene written as CSV: the same rows, value for value.
+        let dir = fresh_dir(&format!("{tag}-csv"));
+        run_to_dir("impact", &csv_scene, &dir, false).unwrap();
+        let text = std::fs::read_to_string(dir.join("displacement.csv")).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        let mut count = 0;
+        for (line, r) in text.lines().skip(1).zip(&rows) {
+            let f: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+            let bits = |a: &[f64]| a.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&f), bits(&[r.t, r.x, r.u, r.v]), "{line}");
+            count += 1;
+        }
+        assert_eq!(count as u64, sampling.rows, "{tag}: CSV rows");
+    }
+}
+
+#[test]
+fn the_header_is_numpys_format_1_0_text() {
+    let scene = common::builtin("impact", &["output.every=50", "output.format=npy"]);
+    let rows = scene.output_sampling().rows;
+    let dir = fresh_dir("header");
+    run_to_dir("impact", &scene, &dir, false).unwrap();
+    let bytes = std::fs::read(dir.join("displacement.npy")).unwrap();
+    std::fs::remove_dir_all(&dir).unwrap();
+    // NPY format 1.0: magic, version, little-endian u16 header length, a Python dict literal
+    // padded with spaces to a 64-byte boundary and ended by a newline, then the rows.
+    assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
+    let len = usize::from(u16::from_le_bytes([bytes[8], bytes[9]]));
+    assert_eq!((10 + len) % 64, 0, "data aligned");
+    let header = std::str::from_utf8(&bytes[10..10 + len]).unwrap();
+    // npyz writes trailing commas (`[..., ]`, `(N, )`); numpy reads the dict with
+    // `ast.literal_eval`, to which they are the same literal.
+    let dict = format!(
+        "{{'descr': [('t', '<f8'), ('x', '<f8'), ('u', '<f8'), ('v', '<f8'), ], \
+         'fortran_order': False, 'shape': ({rows}, ), }}"
+    );
+    assert_eq!(header.trim_end(), dict);
+    assert!(header.ends_with('\n'));
+    assert_eq!(
+        bytes.len() as u64,
+        10 + len as u64 + 32 * rows,
+        "32 bytes a row"
+    );
+}
+
+#[test]
+fn a_run_in_one_format_removes_the_other_formats_stale_profiles() {
+    let dir = fresh_dir("switch");
+    let csv = common::builtin("impact", &["output.every=50"]);
+    let npy = common::builtin("impact", &["output.every=50", "output.format=npy"]);
+    run_to_dir("impact", &csv, &dir, false).unwrap();
+    assert!(dir.join("displacement.csv").exists());
+    run_to_dir("impact", &npy, &dir, false).unwrap();
+    assert!(dir.join("displacement.npy").exists());
+    assert!(!dir.join("displacement.csv").exists(), "stale CSV removed");
+    run_to_dir("impact", &csv, &dir, false).unwrap();
+    assert!(!dir.join("displacement.npy").exists(), "stale npy removed");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
