@@ -21,8 +21,8 @@
 //! of `ρ̂` and `b̂` entry by entry, of the energy sums (`γ_m Σ|terms|`), of the stored
 //! displacements, of the final combination ([`StepTerms::identity_tolerance`]). The
 //! penetration tolerance is the forward error of the inactive unknowns, `C_II⁻¹` applied to
-//! `|ρ̂_I|` plus its rounding (componentwise where `C` is a Stieltjes matrix, else through
-//! `λ_min(C)`), plus the rounding of the gap and the solver's own law
+//! `|ρ̂_I|` plus its rounding (componentwise where `C` is a Stieltjes matrix, bounded above by
+//! `C⁻¹` on I, else through `λ_min(C)`), plus the rounding of the gap and the solver's own law
 //! ([`StepTerms::violation_tolerance`]). The energy drift is checked as the sum of the
 //! steps' signed residuals, which it is by telescoping, up to the rounding of the two sums.
 //! A run's figure is its worst step by ratio ([`Worst`]). The distance between solvers keeps
@@ -587,8 +587,10 @@ pub struct StepTerms {
     pub combination: f64,
     /// `max(0, −(û_j + a_j))` over the constrained nodes.
     pub violation: f64,
-    /// Forward error of the inactive constrained unknowns: `max_j (C_II⁻¹ (|ρ̂_I| + f_I))_j`
-    /// where `C` is a Stieltjes matrix (`Δt >= Δx/√3` or so), else `‖|ρ̂_I| + f_I‖₂ / λ_min(C)`
+    /// Forward error of the inactive constrained unknowns: `max_j (C_II⁻¹ (|ρ̂_I| + f_I))_j`,
+    /// bounded by `max_j (C⁻¹ v)_j` with `v = |ρ̂_I| + f_I` on I and 0 on A (for a Stieltjes
+    /// matrix `(C⁻¹)_II >= C_II⁻¹ >= 0` entrywise, by the Schur complement), where `C` is a
+    /// Stieltjes matrix (`Δt >= Δx/√3` or so), else `‖|ρ̂_I| + f_I‖₂ / λ_min(C)`
     /// with `λ_min` lowered by the bisection's error bound
     /// ([`crate::linalg::spectrum::reference::STURM_ERROR_ULPS`]); `f` here is the rounding
     /// of `ρ̂` alone.
