@@ -70,8 +70,14 @@ fn impact_contact_interval_and_reaction_match_the_closed_form() {
     // 2 v0 L over 2L; nodal force = -s(0)), at 400 elements: tolerances::impact_contact_errors.
     let (episodes, time_error, mean_error) = impact_contact_errors().unwrap();
     assert_eq!(episodes, 1, "one contact episode");
-    assert!(time_error <= CONTACT_TIME_TOL, "contact times off by {time_error}");
-    assert!(mean_error <= MEAN_REACTION_TOL, "mean reaction off by {mean_error}");
+    assert!(
+        time_error <= CONTACT_TIME_TOL,
+        "contact times off by {time_error}"
+    );
+    assert!(
+        mean_error <= MEAN_REACTION_TOL,
+        "mean reaction off by {mean_error}"
+    );
 }
 
 /// The built-in falling bar's closed form (the scene's own data).

@@ -29,8 +29,8 @@ use viscobar::time::simulation::Simulation;
 // The solver tolerances, defined beside their measurement in the tolerance registry
 // (`viscobar verify --tolerances`, `study::tolerances::solver_worst`).
 use viscobar::study::tolerances::{
-    OSQP_AGREEMENT_TOL, OSQP_GAP_TOL, OSQP_REACTION_TOL, PENALTY_LAW_TOL, SMALL_TOL, osqp_small_problems,
-    solver_cases, solver_worst,
+    OSQP_AGREEMENT_TOL, OSQP_GAP_TOL, OSQP_REACTION_TOL, PENALTY_LAW_TOL, SMALL_TOL,
+    osqp_small_problems, solver_cases, solver_worst,
 };
 /// Penalty against exact, in units of the penalty run's largest penetration `ε r`: the penalty
 /// run is the exact scheme with each obstacle moved by its penetration; a boundary displacement
@@ -485,7 +485,6 @@ fn osqp_runs_write_byte_identical_files() {
 }
 
 // ---- the OSQP solver on its own -----------------------------------------------------------
-
 
 #[test]
 fn osqp_handles_no_constraints_and_reports_reactions_with_the_right_sign() {

@@ -320,6 +320,64 @@ pub fn measured() -> Result<Vec<Measured>, RunError> {
             note,
         });
     }
+    let (mass_sum, _) = mass_sum_worst();
+    let solve = ldlt_family_worst();
+    let backward = crate::study::verify::solve_study(&backward_error_nodes())
+        .iter()
+        .map(|c| c.backward_error)
+        .fold(0.0, f64::max);
+    let (resting, _) = resting_bar_worst()?;
+    let start = start_energy_errors()?
+        .iter()
+        .map(|&(e, dx, _)| e.abs() / dx)
+        .fold(0.0, f64::max);
+    for (name, used_in, tolerance, worst, note) in [
+        (
+            "MASS_SUM_TOL",
+            "tests/matrices.rs",
+            MASS_SUM_TOL,
+            mass_sum,
+            "sums of J + 2 rounded entries, J up to 1000",
+        ),
+        (
+            "SOLVE_TOL",
+            "tests/matrices.rs",
+            SOLVE_TOL,
+            solve,
+            "LDLᵀ on 78 SPD tridiagonal systems, |x| ≤ 1: an a-priori κ ε bound (κ < 1e3), \
+             not yet tightened to the family's own κ",
+        ),
+        (
+            "BACKWARD_ULPS (units of ε)",
+            "tests/matrices.rs",
+            BACKWARD_ULPS,
+            backward,
+            "Higham's γ₃ plus the residual's roundings, step matrices to 1e5 nodes",
+        ),
+        (
+            "RESTING_TOL",
+            "tests/energy_and_contact.rs",
+            RESTING_TOL,
+            resting,
+            "measured exactly 0: every node active puts u on the obstacle exactly, and the \
+             reactions come out with the bits of M·1; the bound keeps round-off's room",
+        ),
+        (
+            "START_ENERGY_ERROR_PER_DX",
+            "tests/energy_and_contact.rs",
+            START_ENERGY_ERROR_PER_DX,
+            start,
+            "first order in dx (the kink of u0): a regression bound",
+        ),
+    ] {
+        v.push(Measured {
+            name: name.into(),
+            used_in,
+            tolerance,
+            worst,
+            note,
+        });
+    }
     let (eig, kappa) = kappa_reference_worst();
     v.push(Measured {
         name: "spectrum::reference::STURM_ERROR_ULPS (eigenvalues, units of ε‖C‖∞)".into(),
@@ -662,8 +720,15 @@ pub fn markdown(measured: &[Measured], stiff: &[StiffCheck], uncovered: &[Uncove
 
 /// The whole registry as Markdown: measured tolerances, the stiff matrix's checks from
 /// `results`, and the rest (the generated block `tolerances` of VERIFICATION.md).
-pub fn registry_markdown(results: &[CaseResult]) -> Result<String, RunError> {
-    let measured = measured()?;
+pub fn registry_markdown(results: &[CaseResult], increment_drift: f64) -> Result<String, RunError> {
+    let mut measured = measured()?;
+    measured.push(Measured {
+        name: "INCREMENT_DRIFT_TOL".into(),
+        used_in: "tests/roundoff.rs",
+        tolerance: INCREMENT_DRIFT_TOL,
+        worst: increment_drift,
+        note: "rigid mode, 26 000 steps at J = 8192 (the run of the round-off table)",
+    });
     // The stiff matrix's constants enter its per-case tolerances, measured by the checks above.
     let covered = [
         ("OSQP_AGREEMENT_REL", "src/study/stiff.rs"),
@@ -966,8 +1031,12 @@ pub fn builtin_falling_bar() -> Result<FallingBar, RunError> {
         .and_then(|d| d.trim().parse::<f64>().ok())
         .map(|l| -l)
         .expect("uniform gravity");
-    Ok(FallingBar::new(s.bar.length, gravity, s.left.gap.expect("Signorini left end"))
-        .expect("the built-in falling bar"))
+    Ok(FallingBar::new(
+        s.bar.length,
+        gravity,
+        s.left.gap.expect("Signorini left end"),
+    )
+    .expect("the built-in falling bar"))
 }
 
 /// The impact scene's contact times are resolved to a few time steps (the kink is smeared over
@@ -996,4 +1065,147 @@ pub fn impact_contact_errors() -> Result<(usize, f64, f64), RunError> {
         .collect();
     let mean = in_contact.iter().sum::<f64>() / in_contact.len() as f64;
     Ok((intervals.len(), time_error, (mean - 1.0).abs()))
+}
+
+// ---- tests/roundoff.rs ------------------------------------------------------------------------
+
+/// Drift allowed for the increment form on the rigid mode (`verify::rigid_drift`): a few
+/// hundred ulps of the final displacement (about 3), i.e. round-off that grows no faster than
+/// the number of steps.
+pub const INCREMENT_DRIFT_TOL: f64 = 1e-9;
+
+// ---- tests/matrices.rs ------------------------------------------------------------------------
+
+/// `1ᵀM1` sums `J + 2` rounded entries: a few ulps of L.
+pub const MASS_SUM_TOL: f64 = 1e-12;
+/// The node counts of the consistent matrices' checks.
+pub const MATRIX_SIZES: [usize; 4] = [2, 3, 10, 1001];
+
+/// `1ᵀM1` against its closed form: `L` for the consistent mass (relative, [`MATRIX_SIZES`],
+/// `L = 1.7`) and `(4J + 6)/(3J + 3) L` for the talk's printed one (`L = 1`, 11 to 1001
+/// nodes): the worst error, and the smallest printed total over `L` (which must exceed 4/3's
+/// neighbourhood, 1.3).
+pub fn mass_sum_worst() -> (f64, f64) {
+    use crate::bar::matrices::{MatrixVariant, mass};
+    let mut worst = 0.0f64;
+    for nodes in MATRIX_SIZES {
+        let length = 1.7;
+        let dx = length / (nodes - 1) as f64;
+        let m = mass(MatrixVariant::Consistent, nodes, dx);
+        let total: f64 = m.mul(&vec![1.0; nodes]).iter().sum();
+        worst = worst.max((total - length).abs() / length);
+    }
+    let mut smallest_printed = f64::INFINITY;
+    for nodes in [11usize, 101, 1001] {
+        let dx = 1.0 / (nodes - 1) as f64;
+        let j = (nodes - 2) as f64;
+        let m = mass(MatrixVariant::TalkPrinted, nodes, dx);
+        let total: f64 = m.mul(&vec![1.0; nodes]).iter().sum();
+        worst = worst.max((total - (4.0 * j + 6.0) / (3.0 * j + 3.0)).abs());
+        smallest_printed = smallest_printed.min(total);
+    }
+    (worst, smallest_printed)
+}
+
+/// Backward-stable solve on SPD tridiagonal matrices of condition number below 1e3: `x` of
+/// size ≤ 1 to a few ε κ.
+pub const SOLVE_TOL: f64 = 1e-12;
+
+/// `Ldlt` on the family of `tests/matrices.rs` (n = 1 … 39, two shifts, off-diagonals of both
+/// signs, not all diagonally dominant): the worst `|x̂ − x|` with `b = A x`.
+pub fn ldlt_family_worst() -> f64 {
+    use crate::linalg::ldlt::Ldlt;
+    let mut worst = 0.0f64;
+    for n in 1..40usize {
+        for shift in [0.05, 1.0] {
+            let diag: Vec<f64> = (0..n)
+                .map(|i| 2.0 + shift + 0.1 * (i as f64).sin())
+                .collect();
+            let off: Vec<f64> = (0..n.saturating_sub(1))
+                .map(|i| if i % 3 == 0 { 0.9 } else { -1.0 })
+                .collect();
+            let a = SymTridiag::new(diag, off);
+            let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).cos()).collect();
+            let mut b = a.mul(&x);
+            match Ldlt::factor(&a) {
+                Ok(f) => f.solve_in_place(&mut b),
+                Err(_) => return f64::INFINITY, // SPD: a refused factorisation fails the check
+            }
+            for i in 0..n {
+                worst = worst.max((b[i] - x[i]).abs());
+            }
+        }
+    }
+    worst
+}
+
+/// Normwise backward error of the solve, in units of ε: Gaussian elimination on a tridiagonal
+/// SPD matrix gives `(A + ΔA) x̂ = b` with `|ΔA| ≤ γ₃ |A|` (for tridiagonal SPD `|L||D||Lᵀ| = |A|`;
+/// Higham, *Accuracy and Stability*, Thm 9.3 and 10.5), and evaluating `b − A x̂` adds at most
+/// four roundings of `|A||x̂| + |b|`.
+pub const BACKWARD_ULPS: f64 = 8.0;
+
+/// The node counts of the backward-error check: every small count and the study's.
+pub fn backward_error_nodes() -> Vec<usize> {
+    (2..=24)
+        .chain(crate::study::verify::SOLVE_STUDY_NODES)
+        .collect()
+}
+
+// ---- tests/energy_and_contact.rs ---------------------------------------------------------------
+
+/// Round-off of the solves for the bar resting on the obstacle (condition number of C about 3
+/// at dt ~ dx): `u` of size 0.25, reactions of size dx.
+pub const RESTING_TOL: f64 = 1e-12;
+
+/// The bar resting on a flat obstacle under a uniform load (`distributed` with `u0 = −0.25`,
+/// gap 0.25, load −1): the worst `|u + 0.25|` and `|r − M·1|` at the end, and whether every
+/// node was in contact at every step.
+pub fn resting_bar_worst() -> Result<(f64, bool), RunError> {
+    let (_, scene) = scene::load(
+        "distributed",
+        &[
+            "initial.velocity=\"0\"".into(),
+            "initial.displacement=\"-0.25\"".into(),
+            "obstacle.gap=0.25".into(),
+            "load.density=\"-1\"".into(),
+        ],
+    )?;
+    let (records, _, sim) = run_in_memory("resting", &scene)?;
+    let disc = sim.discretisation();
+    let m_one = disc.mass.mul(&vec![1.0; disc.unknowns()]);
+    let mut worst = 0.0f64;
+    for u in sim.displacement() {
+        worst = worst.max((u + 0.25).abs());
+    }
+    for (r, m) in sim.reactions().iter().zip(&m_one) {
+        worst = worst.max((r - m).abs());
+    }
+    let all_in_contact = records.iter().all(|r| r.contact_nodes == disc.nodes);
+    Ok((worst, all_in_contact))
+}
+
+/// `(E^{1/2} − 1/8)/dx` on clamped-impact: first order (the kink of `u0` at `x = 1`), 15 %
+/// over the value that the start-up makes at every level (`start_energy_errors`).
+pub const START_ENERGY_ERROR_PER_DX: f64 = 0.25;
+
+/// Clamped-impact at 400 and 800 elements with `Δt = Δx`: per level, `(E^{1/2} − 1/8, dx,
+/// E_final / E^{1/2} − 1)`.
+pub fn start_energy_errors() -> Result<Vec<(f64, f64, f64)>, RunError> {
+    let mut out = Vec::new();
+    for elements in [400u64, 800] {
+        let dt = 1.0 / elements as f64;
+        let (_, scene) = scene::load(
+            "clamped-impact",
+            &[
+                format!("mesh.elements={elements}"),
+                format!("time.step={dt}"),
+            ],
+        )?;
+        let (records, _, _) = run_in_memory("clamped-impact", &scene)?;
+        let e0 = records[0].energy;
+        let e_final = records.last().map_or(e0, |r| r.energy);
+        out.push((e0 - 0.125, scene.dx(), e_final / e0 - 1.0));
+    }
+    Ok(out)
 }
