@@ -378,6 +378,15 @@ pub fn measured() -> Result<Vec<Measured>, RunError> {
             note,
         });
     }
+    let (tie, _, _) = exact_tie()?;
+    v.push(Measured {
+        name: "TIE_TOL".into(),
+        used_in: "tests/exact_solver.rs",
+        tolerance: TIE_TOL,
+        worst: tie,
+        note: "measured exactly 0 on this tie (not shown to be 0 by construction: other \
+               candidates differ by round-off, which the bound allows)",
+    });
     let (eig, kappa) = kappa_reference_worst();
     v.push(Measured {
         name: "spectrum::reference::STURM_ERROR_ULPS (eigenvalues, units of ε‖C‖∞)".into(),
@@ -1208,4 +1217,47 @@ pub fn start_energy_errors() -> Result<Vec<(f64, f64, f64)>, RunError> {
         out.push((e0 - 0.125, scene.dx(), e_final / e0 - 1.0));
     }
     Ok(out)
+}
+
+// ---- tests/exact_solver.rs ----------------------------------------------------------------------
+
+/// Round-off level of the exact solver's tie (entries of size 1, condition number 12).
+pub const TIE_TOL: f64 = 1e-14;
+
+/// The exact solver on a tie: `C = tridiag(−1, 2, −1)` of size 3, `b = C·1`, bounds `z_0, z_2 >=
+/// 1`, so every active set gives `z = 1` with zero reactions in exact arithmetic. Three calls:
+/// the worst `|z − 1|` and `r` (`r` must be `>= 0`), whether the bounds held exactly and the
+/// reactions were not negative, and whether every call gave the first call's bits.
+pub fn exact_tie() -> Result<(f64, bool, bool), RunError> {
+    use crate::step::StepSolver;
+    use crate::step::exact::ExactSolver;
+    let c = SymTridiag::new(vec![2.0, 2.0, 2.0], vec![-1.0, -1.0]);
+    let z_free = [1.0, 1.0, 1.0];
+    let b = c.mul(&z_free);
+    let mut solver = ExactSolver::new(&c, &[0, 2])?;
+    let (mut worst, mut signs, mut same) = (0.0f64, true, true);
+    let mut first: Option<(Vec<f64>, Vec<f64>)> = None;
+    for call in 0..3 {
+        let (mut z, mut r) = (vec![0.0; 3], vec![0.0; 2]);
+        solver
+            .solve(&b, &[1.0, 1.0], &mut z, &mut r)
+            .map_err(|failure| RunError::Step {
+                step: call,
+                time: 0.0,
+                solver: "exact".into(),
+                failure,
+            })?;
+        for i in 0..3 {
+            worst = worst.max((z[i] - z_free[i]).abs());
+        }
+        for v in &r {
+            worst = worst.max(v.abs());
+        }
+        signs &= z[0] >= 1.0 && z[2] >= 1.0 && r.iter().all(|v| *v >= 0.0);
+        match &first {
+            None => first = Some((z, r)),
+            Some((z1, r1)) => same &= z1 == &z && r1 == &r,
+        }
+    }
+    Ok((worst, signs, same))
 }
