@@ -691,12 +691,12 @@ pub fn markdown(measured: &[Measured], stiff: &[StiffCheck], uncovered: &[Uncove
         let _ = writeln!(
             md,
             "| `{}` | {} | {} | {} | {}{flag} | {} |",
-            m.name,
+            m.name.replace('|', "\\|"),
             m.used_in,
             sci(m.tolerance),
             sci(m.worst),
             sci(m.ratio()),
-            m.note
+            m.note.replace('|', "\\|")
         );
     }
     md.push_str(
