@@ -5,8 +5,8 @@ use viscobar::study::verify::SolveCase;
 
 // Defined beside their measurement in the tolerance registry (`viscobar verify --tolerances`).
 use viscobar::study::tolerances::{
-    BACKWARD_ULPS, MASS_SUM_TOL, MATRIX_SIZES as SIZES, SOLVE_TOL, backward_error_nodes,
-    ldlt_family_worst, mass_sum_worst,
+    BACKWARD_ULPS, MASS_SUM_TOL, MATRIX_SIZES as SIZES, SOLVE_TOL, ldlt_family_worst,
+    mass_sum_worst,
 };
 
 fn is_bitwise_symmetric(a: &nalgebra::DMatrix<f64>) -> bool {
@@ -100,7 +100,7 @@ fn factorisation_solves_spd_tridiagonal_systems() {
 /// for speed in a one-off probe (not in the tree), measured 31 ε on these matrices.
 #[test]
 fn factorisation_is_backward_stable_on_the_step_matrices() {
-    use viscobar::study::verify::{SOLVE_STUDY_CASES, solve_study};
+    use viscobar::study::verify::{SOLVE_STUDY_CASES, backward_error_nodes, solve_study};
     let nodes = backward_error_nodes();
     let cases = solve_study(&nodes);
     assert_eq!(

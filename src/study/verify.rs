@@ -405,8 +405,22 @@ pub fn tolerances_section(
     results: &[crate::study::stiff::CaseResult],
     increment_drift: f64,
 ) -> Result<Section, RunError> {
+    let backward_ulps = solve_study(&backward_error_nodes())
+        .iter()
+        .map(|c| c.backward_error)
+        .fold(0.0, f64::max);
     Ok(Section {
         id: "tolerances",
-        markdown: crate::study::tolerances::registry_markdown(results, increment_drift)?,
+        markdown: crate::study::tolerances::registry_markdown(
+            results,
+            increment_drift,
+            backward_ulps,
+        )?,
     })
+}
+
+/// The node counts of `tests/matrices.rs`'s backward-error check (`BACKWARD_ULPS`): every small
+/// count and the solve study's.
+pub fn backward_error_nodes() -> Vec<usize> {
+    (2..=24).chain(SOLVE_STUDY_NODES).collect()
 }
