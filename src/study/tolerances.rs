@@ -603,8 +603,8 @@ fn reason(name: &str, file: &str) -> &'static str {
         }
         ("UNIT_ROUNDOFF", _) => "the unit round-off ε/2, a constant of the a-posteriori bounds",
         ("RESIDUAL_ROUNDINGS" | "SUM_TERM_ROUNDINGS" | "COMBINATION_ROUNDINGS", _) => {
-            "a count of roundings in the stiff matrix's a-posteriori tolerances (measured by \
-             its checks above)"
+            "a count of roundings in the stiff matrix's a-posteriori bounds, not a tolerance \
+             compared with a measured value (the bounds it enters are measured by the checks above)"
         }
         _ if name.contains("BAND") || name.contains("ORDER") => {
             "a two-sided band around a measured order (VERIFICATION.md gives the measured order)"
@@ -733,6 +733,7 @@ pub fn registry_markdown(
     backward_ulps: f64,
 ) -> Result<String, RunError> {
     let mut measured = measured()?;
+    measured.extend(plane_measured()?);
     measured.push(Measured {
         name: "BACKWARD_ULPS (units of ε)".into(),
         used_in: "tests/matrices.rs",
@@ -1302,4 +1303,182 @@ pub fn exact_tie() -> Result<(f64, bool, bool), RunError> {
         }
     }
     Ok((worst, signs, same))
+}
+
+// ---- tests/plane.rs, tests/plane_contact.rs, tests/plane_cli.rs, tests/plane_contact_cli.rs ----
+
+/// The plane's energy identity (with the contact term): exact algebra, round-off only,
+/// relative to the largest of its terms (rows of 18 entries; the `K`-forms from strains).
+pub const PLANE_IDENTITY_TOL: f64 = 1e-12;
+/// Without load the plane's energy never rises (viscous term ≥ 0), up to round-off.
+pub const PLANE_ENERGY_RISE_TOL: f64 = 1e-13;
+/// The bar (with and without contact) as a special case of the plane body: the same equations
+/// and LCP, different factorisations: round-off only, relative to max |u| and max r.
+pub const PLANE_BAR_CASE_TOL: f64 = 1e-12;
+/// Penetration and `|r·gap|` of the plane's exact contact solver, relative to the gaps' scale:
+/// the rounding of `u` from a backward-stable solve.
+pub const PLANE_GAP_TOL: f64 = 1e-12;
+/// Plane exact against OSQP (`eps = 1e-10`, polished), relative to max |u| and max r: the
+/// issue's requirement.
+pub const PLANE_OSQP_AGREEMENT_TOL: f64 = 1e-7;
+/// Normal compliance at `ε = 1e-6` against the exact run, relative to max |u|: O(ε) plus the
+/// reference's round-off.
+pub const PLANE_PENALTY_AGREEMENT: f64 = 1e-3;
+
+/// Worst values of what the plane tolerances guard, over every plane scene the tests run.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PlaneWorst {
+    /// Identity residual (every identity scene, steps after the first).
+    pub identity: f64,
+    /// Energy rise of the unforced scenes (`max_energy_rise`).
+    pub energy_rise: f64,
+    /// Bar case: max of `|ux − u|/max|u|`, `|uy|/max|u|`, `|r − ω r|/max r` over both sets.
+    pub bar_case: f64,
+    /// Contact scenes: max of penetration / scale and `|r·gap|` / (scale · total reaction).
+    pub gap: f64,
+    /// OSQP against exact, relative (displacement and reaction).
+    pub osqp_agreement: f64,
+    /// Penalty at the smaller ε against exact, relative displacement.
+    pub penalty_agreement: f64,
+}
+
+fn plane_run_error(e: crate::study::converge::ConvergeError) -> RunError {
+    match e {
+        crate::study::converge::ConvergeError::Run(r) => r,
+        crate::study::converge::ConvergeError::Scene(s) => RunError::Scene(s),
+        other => RunError::SolverSetup {
+            solver: crate::plane::run::SOLVER_NAME.into(),
+            reason: other.to_string(),
+        },
+    }
+}
+
+/// [`PlaneWorst`] over the scenes of `tests/plane.rs` and `tests/plane_contact.rs`.
+pub fn plane_worst() -> Result<PlaneWorst, RunError> {
+    use crate::plane::contact::ContactMethod;
+    use crate::plane::run::run_plane_in_memory;
+    use crate::study::plane_checks::{
+        bar_case, bar_case_scenes, bar_contact_case_scenes, identity_scenes,
+    };
+    use crate::study::plane_contact::{
+        CONTACT_SCENES, PENALTY_EPSILONS, agreement, osqp_method, plane_error, plane_scene,
+    };
+    let mut w = PlaneWorst::default();
+    for (name, scene) in identity_scenes() {
+        let (records, summary, _) = run_plane_in_memory(&name, &scene)
+            .map_err(plane_error)
+            .map_err(plane_run_error)?;
+        for r in records.iter().skip(1) {
+            w.identity = w.identity.max(r.identity_residual);
+        }
+        if let Some(rise) = summary.max_energy_rise {
+            w.energy_rise = w.energy_rise.max(rise);
+        }
+        for r in &records {
+            let c = &r.contact;
+            if c.gap_scale > 0.0 {
+                w.gap = w.gap.max(c.penetration / c.gap_scale);
+                if c.total_reaction > 0.0 {
+                    w.gap = w
+                        .gap
+                        .max(c.complementarity / (c.gap_scale * c.total_reaction));
+                }
+            }
+        }
+    }
+    for (_, bar) in bar_case_scenes()
+        .into_iter()
+        .chain(bar_contact_case_scenes())
+    {
+        let c = bar_case(&bar).map_err(plane_run_error)?;
+        w.bar_case = w
+            .bar_case
+            .max(c.max_ux_deviation / c.max_u)
+            .max(c.max_uy / c.max_u);
+        if c.max_reaction > 0.0 {
+            w.bar_case = w.bar_case.max(c.max_reaction_deviation / c.max_reaction);
+        }
+    }
+    let smallest_epsilon = PENALTY_EPSILONS
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    for name in CONTACT_SCENES {
+        let scene = plane_scene(name, &[]).map_err(plane_run_error)?;
+        let a = agreement(&scene, osqp_method()).map_err(plane_run_error)?;
+        w.osqp_agreement = w
+            .osqp_agreement
+            .max(a.max_u_deviation / a.max_u)
+            .max(a.max_reaction_deviation / a.max_reaction);
+        if name == "plane-tilted-drop" {
+            let p = agreement(
+                &scene,
+                ContactMethod::Penalty {
+                    epsilon: smallest_epsilon,
+                },
+            )
+            .map_err(plane_run_error)?;
+            w.penalty_agreement = p.max_u_deviation / p.max_u;
+        }
+    }
+    Ok(w)
+}
+
+/// The registry's rows of the plane tolerances.
+pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
+    let w = plane_worst()?;
+    let rows = [
+        (
+            "PLANE_IDENTITY_TOL",
+            "tests/plane.rs, plane_contact.rs, plane_cli.rs, plane_contact_cli.rs",
+            PLANE_IDENTITY_TOL,
+            w.identity,
+            "round-off of the identity's sums (built-in plane scenes and the manufactured one)",
+        ),
+        (
+            "PLANE_ENERGY_RISE_TOL",
+            "tests/plane.rs",
+            PLANE_ENERGY_RISE_TOL,
+            w.energy_rise,
+            "a rise is round-off only (negative or 0 worst: never rises)",
+        ),
+        (
+            "PLANE_BAR_CASE_TOL",
+            "tests/plane.rs, plane_contact.rs",
+            PLANE_BAR_CASE_TOL,
+            w.bar_case,
+            "the bar's and the plane's factorisations of the same equations",
+        ),
+        (
+            "PLANE_GAP_TOL",
+            "tests/plane_contact.rs, plane_contact_cli.rs",
+            PLANE_GAP_TOL,
+            w.gap,
+            "0 by construction: active gaps are set exactly, inactive reactions are 0",
+        ),
+        (
+            "PLANE_OSQP_AGREEMENT_TOL",
+            "tests/plane_contact.rs",
+            PLANE_OSQP_AGREEMENT_TOL,
+            w.osqp_agreement,
+            "the issue's stated requirement (1e-7); not yet tightened",
+        ),
+        (
+            "PLANE_PENALTY_AGREEMENT",
+            "tests/plane_contact.rs",
+            PLANE_PENALTY_AGREEMENT,
+            w.penalty_agreement,
+            "O(ε) at ε = 1e-6",
+        ),
+    ];
+    Ok(rows
+        .into_iter()
+        .map(|(name, used_in, tolerance, worst, note)| Measured {
+            name: name.into(),
+            used_in,
+            tolerance,
+            worst,
+            note,
+        })
+        .collect())
 }
