@@ -609,7 +609,8 @@ fn verify(
         if stiff {
             Ok(vec![viscobar::study::verify::stiff_section(&results)])
         } else {
-            viscobar::study::verify::tolerances_section(&results)
+            viscobar::study::verify::rigid_drift()
+                .and_then(|(drift, _)| viscobar::study::verify::tolerances_section(&results, drift))
                 .map(|s| vec![s])
                 .map_err(Into::into)
         }

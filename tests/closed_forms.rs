@@ -12,7 +12,9 @@ use viscobar::study::accuracy::{error_against, observed_order};
 // Error bounds at the scenes' own meshes: 1.25x the measured L2 error, defined beside their
 // measurement in the tolerance registry (`viscobar verify --tolerances`).
 use viscobar::study::tolerances::{
-    CLAMPED_IMPACT_L2_BOUND, FALLING_BAR_L2_BOUND, IMPACT_L2_BOUND, falling_bar_quadrature,
+    CLAMPED_IMPACT_L2_BOUND, CONTACT_TIME_TOL, FALLING_BAR_L2_BOUND, FALLING_BAR_ROUNDOFF, FD_STEP,
+    IMPACT_L2_BOUND, MEAN_REACTION_TOL, builtin_falling_bar, falling_bar_identities_worst,
+    falling_bar_quadrature, falling_bar_reaction_fd_ratio, impact_contact_errors,
 };
 
 fn study(name: &str, levels: u32) -> (Vec<f64>, Vec<f64>) {
@@ -64,103 +66,41 @@ fn clamped_impact_error_is_bounded_and_decreases_at_the_kink_rate() {
 
 #[test]
 fn impact_contact_interval_and_reaction_match_the_closed_form() {
-    // Contact on [t1, t1 + 2L] = [0.1, 2.1] with reaction v0 = 1 (nodal force = -s(0)).
-    let scene = common::builtin("impact", &["mesh.elements=400", "time.step=0.0025"]);
-    let (records, summary, _) = viscobar::time::run::run_in_memory("impact", &scene).unwrap();
-    let intervals = &summary.contact_intervals["left"];
-    assert_eq!(intervals.len(), 1, "one contact episode: {intervals:?}");
-    let [start, end] = intervals[0];
-    // The contact times are resolved to a few time steps (the kink is smeared over a few cells).
-    const CONTACT_TIME_TOL: f64 = 0.02;
+    // Contact on [t1, t1 + 2L] = [0.1, 2.1] with mean reaction v0 = 1 (the momentum change
+    // 2 v0 L over 2L; nodal force = -s(0)), at 400 elements: tolerances::impact_contact_errors.
+    let (episodes, time_error, mean_error) = impact_contact_errors().unwrap();
+    assert_eq!(episodes, 1, "one contact episode");
     assert!(
-        (start - 0.1).abs() <= CONTACT_TIME_TOL && (end - 2.1).abs() <= CONTACT_TIME_TOL,
-        "{start} {end}"
+        time_error <= CONTACT_TIME_TOL,
+        "contact times off by {time_error}"
     );
-    // Mean reaction over the contact interval equals the momentum change 2 v0 L / (2L) = v0.
-    let in_contact: Vec<f64> = records
-        .iter()
-        .filter(|r| r.gap[0] <= 1e-12)
-        .map(|r| r.reaction[0])
-        .collect();
-    let mean = in_contact.iter().sum::<f64>() / in_contact.len() as f64;
-    const MEAN_REACTION_TOL: f64 = 0.02;
     assert!(
-        (mean - 1.0).abs() <= MEAN_REACTION_TOL,
-        "mean reaction {mean}"
+        mean_error <= MEAN_REACTION_TOL,
+        "mean reaction off by {mean_error}"
     );
 }
 
 /// The built-in falling bar's closed form (the scene's own data).
 fn falling_bar() -> FallingBar {
-    let scene = common::builtin("falling-bar", &[]);
-    let gravity = -scene.load.density.as_ref().unwrap().parse::<f64>().unwrap();
-    FallingBar::new(scene.bar.length, gravity, scene.left.gap.unwrap()).expect("V1/(gL) = 3")
-}
-
-/// The closed form is built from polynomials of size ≤ 1: its identities hold to round-off.
-const FALLING_BAR_ROUNDOFF: f64 = 1e-12;
-
-/// Deterministic sample points in `[0, 1)` (a Weyl sequence), so the tests do not need a seed.
-fn weyl(i: usize, a: f64) -> f64 {
-    (i as f64 * a).fract()
+    builtin_falling_bar().unwrap()
 }
 
 #[test]
 fn falling_bar_closed_form_solves_the_wave_equation_with_its_boundary_conditions() {
     let fb = falling_bar();
-    let (l, g, a0) = (fb.length, fb.gravity, fb.gap);
     let p = fb.period();
-    let u = |x: f64, t: f64| fb.displacement(x, t);
     // Data: V1 = 3gL, period 16, contact on [3, 5] and [11, 13] (the scene's description).
     assert_eq!((fb.impact_speed(), fb.fall_time(), p), (0.375, 3.0, 16.0));
     let contact = fb.contact_intervals(2.0 * p).unwrap();
     assert_eq!(contact[..2], [[3.0, 5.0], [11.0, 13.0]]);
     assert_eq!(contact.len(), 4);
-    let in_contact = |t: f64| contact.iter().any(|iv| iv[0] <= t && t <= iv[1]);
-    for i in 1..4000 {
-        // Two periods, so periodicity and the time reversal at T/2 are crossed.
-        let t = 2.0 * p * weyl(i, 0.618_033_988_749_894_9);
-        let k = 0.5 * l * weyl(i, 0.414_213_562_373_095_1);
-        // Interior: the characteristic diamond identity holds exactly for every weak solution of
-        // u_tt − u_xx = −g, kinks and impacts included.
-        let x = k + (l - 2.0 * k) * weyl(i, 0.732_050_807_568_877_3);
-        let diamond = u(x, t + k) + u(x, t - k) - u(x + k, t) - u(x - k, t) + g * k * k;
-        assert!(
-            diamond.abs() <= FALLING_BAR_ROUNDOFF,
-            "x {x} t {t} k {k}: {diamond:e}"
-        );
-        // Free end x = L: the half diamond (even reflection, u_x(L) = 0).
-        let free = u(l, t + k) + u(l, t - k) - 2.0 * u(l - k, t) + g * k * k;
-        assert!(
-            free.abs() <= FALLING_BAR_ROUNDOFF,
-            "x = L, t {t} k {k}: {free:e}"
-        );
-        // Left end: on the obstacle with a positive reaction in contact, above it otherwise,
-        // and free (half diamond) in flight.
-        let gap = u(0.0, t) + a0;
-        if in_contact(t) {
-            assert!(gap.abs() <= FALLING_BAR_ROUNDOFF && fb.reaction(t) >= fb.impact_speed());
-        } else {
-            assert!(gap > 0.0 && fb.reaction(t) == 0.0, "t {t}: gap {gap:e}");
-            let kf = k.min(t);
-            if !contact.iter().any(|iv| iv[0] < t + kf && t - kf < iv[1]) {
-                let half = u(0.0, t + kf) + u(0.0, t - kf) - 2.0 * u(kf, t) + g * kf * kf;
-                assert!(half.abs() <= FALLING_BAR_ROUNDOFF, "x = 0, t {t}: {half:e}");
-            }
-        }
-    }
-    // Released at rest from u = 0 (u = −g t²/2 until the impact).
-    for i in 0..=100 {
-        let x = l * i as f64 / 100.0;
-        assert!((u(x, 1e-3) + 0.5 * g * 1e-6).abs() <= FALLING_BAR_ROUNDOFF);
-    }
+    // The diamond identities, the ends and the release at 4000 points over two periods (the
+    // registry's measurement, which also checks the contact phases' reaction and gap signs).
+    let worst = falling_bar_identities_worst(&fb).unwrap();
+    assert!(worst <= FALLING_BAR_ROUNDOFF, "worst residual {worst:e}");
 }
 
-/// Central differences of step [`FD_STEP`] for `u_t`, `u_x` and `−u_x(0)`; the closed form is
-/// piecewise quadratic, so they are exact away from the kinks up to round-off `1e-16/FD_STEP`.
-const FD_STEP: f64 = 1e-7;
-/// Round-off of a difference quotient of step [`FD_STEP`]: a few ulps of `|u| ≤ 1` over it.
-const FD_ROUNDOFF: f64 = 1e-8;
+// FD_STEP and FD_ROUNDOFF (difference quotients of the closed form): in the registry.
 
 #[test]
 fn falling_bar_closed_form_is_continuous_conserves_energy_and_has_its_reaction() {
@@ -177,17 +117,10 @@ fn falling_bar_closed_form_is_continuous_conserves_energy_and_has_its_reaction()
         q.energy_worst <= q.energy_tol && q.mass_worst <= q.mass_tol,
         "{q:?}"
     );
-    for i in 0..=320 {
-        let t = 0.05 * i as f64 + 0.0123; // off the phase boundaries, two periods
-        // The reaction −u_x(0) (one-sided: u is linear in x near 0 within a phase, slope g).
-        let one_sided = -(u(FD_STEP, t) - u(0.0, t)) / FD_STEP;
-        assert!(
-            (one_sided - fb.reaction(t)).abs() <= g * FD_STEP + FD_ROUNDOFF
-                || fb.reaction(t) == 0.0,
-            "t {t}: reaction {} against {one_sided}",
-            fb.reaction(t)
-        );
-    }
+    // The reaction −u_x(0) by a one-sided difference (u is linear in x near 0 within a phase,
+    // slope g), within g·FD_STEP + FD_ROUNDOFF.
+    let fd = falling_bar_reaction_fd_ratio(&fb);
+    assert!(fd <= 1.0, "reaction difference over its bound {fd:e}");
     // Continuous across the phase boundaries: impact, release, mid-flight, second contact.
     let (t1, p) = (fb.fall_time(), fb.period());
     for tb in [t1, t1 + 2.0 * l, 0.5 * p, p - t1 - 2.0 * l, p - t1, p] {

@@ -9,17 +9,12 @@ use viscobar::study::plane_checks::{
     observed_order,
 };
 
-/// The bar's `IDENTITY_TOL` (tests/energy_and_contact.rs): the identity is exact algebra, only
-/// round-off remains, relative to the largest of its terms. The plane's rows hold 18 entries
-/// against the bar's 3, but its `K`-forms are evaluated from strains (exact for rigid motions),
-/// as the bar's are in difference form; the measured residuals (VERIFICATION.md) stay well
-/// below it.
-const IDENTITY_TOL: f64 = 1e-12;
-/// The bar's `ENERGY_RISE_TOL`: without load the energy never rises, up to round-off.
-const ENERGY_RISE_TOL: f64 = 1e-13;
-/// The bar as a special case: the two schemes are the same equations (each plane x-equation
-/// is the bar's times `∫ψ_j dy`), solved by different factorisations: round-off only.
-const BAR_CASE_TOL: f64 = 1e-12;
+// The identity, energy-rise and bar-case tolerances: in the registry (study::tolerances), which
+// measures their worst values over these scenes (`verify --tolerances`).
+use viscobar::study::tolerances::{
+    PLANE_BAR_CASE_TOL as BAR_CASE_TOL, PLANE_ENERGY_RISE_TOL as ENERGY_RISE_TOL,
+    PLANE_IDENTITY_TOL as IDENTITY_TOL,
+};
 /// The bars of the special case move by 0.1 or more: the check compares motion, not rest.
 const BAR_CASE_MIN_MOTION: f64 = 0.05;
 /// Observed order of the manufactured solution: 2 (Q1 in L2, the scheme in time) ± this.

@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The bar's `IDENTITY_TOL`, as in tests/plane.rs: only round-off remains.
-const IDENTITY_TOL: f64 = 1e-12;
+// The plane identity's tolerance: in the registry (study::tolerances), measured there.
+use viscobar::study::tolerances::PLANE_IDENTITY_TOL as IDENTITY_TOL;
 /// A drawn figure is more than its headers: the smallest plausible PNG or SVG of a mesh.
 const MIN_FIGURE_BYTES: u64 = 1000;
 

@@ -5,10 +5,13 @@
 use viscobar::plane::run::run_plane_in_memory;
 use viscobar::study::plane_checks::{bar_case, bar_contact_case_scenes, identity_scenes};
 
-/// The bar with contact as a special case: the same equations and the same complementarity
-/// problem (the plane's LCP on the edge's `ny + 1` normals has the bar's solution times the
-/// trapezoid shares), solved by different factorisations: round-off only.
-const BAR_CASE_TOL: f64 = 1e-12;
+// The tolerances of this file: in the registry (study::tolerances), which measures their worst
+// values over these scenes (`verify --tolerances`).
+use viscobar::study::tolerances::{
+    PLANE_BAR_CASE_TOL as BAR_CASE_TOL, PLANE_GAP_TOL as GAP_TOL,
+    PLANE_IDENTITY_TOL as IDENTITY_TOL, PLANE_OSQP_AGREEMENT_TOL as OSQP_AGREEMENT_TOL,
+    PLANE_PENALTY_AGREEMENT as PENALTY_AGREEMENT,
+};
 
 #[test]
 fn the_bar_with_contact_is_an_exact_special_case_of_the_plane_body() {
@@ -33,15 +36,6 @@ fn the_bar_with_contact_is_an_exact_special_case_of_the_plane_body() {
         );
     }
 }
-
-/// The bar's `IDENTITY_TOL`: the identity with the contact term is exact algebra (the scheme
-/// times `δ/2`), only round-off remains, relative to the largest of its terms.
-const IDENTITY_TOL: f64 = 1e-12;
-/// No penetration and complementarity beyond round-off: a gap `g − u·n` at an active node is
-/// the rounding of `u` from a backward-stable solve, a few ulps of the gaps' scale times the
-/// growth of the solve; 1e-12 of that scale leaves a margin over the measured values
-/// (VERIFICATION.md, "Plane contact").
-const GAP_TOL: f64 = 1e-12;
 
 #[test]
 fn contact_conditions_and_energy_identity_hold_at_every_node_and_step_of_every_plane_scene() {
@@ -104,11 +98,6 @@ fn contact_conditions_and_energy_identity_hold_at_every_node_and_step_of_every_p
     assert!(with_contact >= 2);
 }
 
-/// Exact against OSQP: OSQP's answer meets its stopping test at `eps = 1e-10` (polished: the
-/// active set's exact solution), so states agree to that tolerance times the growth over the
-/// run; the issue asks for 1e-7, relative to the largest displacement or reaction.
-const OSQP_AGREEMENT_TOL: f64 = 1e-7;
-
 #[test]
 fn exact_and_osqp_agree_on_the_two_dimensional_contact_scenes() {
     use viscobar::study::plane_contact::{CONTACT_SCENES, agreement, osqp_method, plane_scene};
@@ -158,7 +147,6 @@ fn the_tilted_drop_converges_against_a_finer_exact_run() {
 /// the exact run is O(ε) (measured ratio between ε = 1e-4 and 1e-6 in VERIFICATION.md); at
 /// least a factor 10 of the 100 must show, and ε = 1e-6 must agree to 1e-3 relative.
 const PENALTY_MIN_RATIO: f64 = 10.0;
-const PENALTY_AGREEMENT: f64 = 1e-3;
 
 #[test]
 fn the_penalty_tends_to_the_exact_solution_as_epsilon_decreases() {

@@ -5,10 +5,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The bar's `IDENTITY_TOL`: only round-off remains.
-const IDENTITY_TOL: f64 = 1e-12;
-/// Penetration and `|r·gap|` over the gaps' scale: round-off (tests/plane_contact.rs).
-const GAP_TOL: f64 = 1e-12;
+// The plane identity's and gap's tolerances: in the registry (study::tolerances), measured there.
+use viscobar::study::tolerances::{PLANE_GAP_TOL as GAP_TOL, PLANE_IDENTITY_TOL as IDENTITY_TOL};
 
 fn viscobar(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_viscobar"))

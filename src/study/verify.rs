@@ -29,6 +29,8 @@ pub const RIGID_STEPS: usize = 26_000;
 /// Errors are those of the runs and of the α-sweep (both carry their exit code).
 pub fn sections() -> Result<Vec<Section>, crate::study::converge::ConvergeError> {
     let stiff = crate::study::stiff_runs::run_all(crate::study::stiff::Size::Full);
+    // One rigid-mode run for the round-off table and the registry's INCREMENT_DRIFT_TOL.
+    let drift = rigid_drift()?;
     Ok(vec![
         matrices_section(),
         solve_section(),
@@ -45,10 +47,10 @@ pub fn sections() -> Result<Vec<Section>, crate::study::converge::ConvergeError>
                 &crate::study::viscous_contact::study(CONVERGENCE_LEVELS)?,
             ),
         },
-        roundoff_section()?,
+        roundoff_section(drift),
         viscosity_section()?,
         stiff_section(&stiff),
-        tolerances_section(&stiff)?,
+        tolerances_section(&stiff, drift.0)?,
         mass_variants_section()?,
         Section {
             id: "plane",
@@ -302,17 +304,22 @@ fn falling_bar_section() -> Result<Section, crate::study::converge::ConvergeErro
     })
 }
 
-fn roundoff_section() -> Result<Section, RunError> {
-    let (ours, talk) = rigid_mode_drift(RIGID_ELEMENTS, RIGID_STEPS)?;
+/// The rigid-mode drift `(increment form, talk form)` at [`RIGID_ELEMENTS`], [`RIGID_STEPS`]
+/// (`tests/roundoff.rs` runs the same).
+pub fn rigid_drift() -> Result<(f64, f64), RunError> {
+    rigid_mode_drift(RIGID_ELEMENTS, RIGID_STEPS)
+}
+
+fn roundoff_section((ours, talk): (f64, f64)) -> Section {
     let md = format!(
         "| formulation | max_i abs(u_i − t) after {RIGID_STEPS} steps, J = {} |\n|---|---|\n\
          | increment z = u^(n+1) − u^n (viscobar) | {ours:.2e} |\n| talk form C u^(n+1) = F̃^n | {talk:.2e} |\n",
         RIGID_ELEMENTS - 1
     );
-    Ok(Section {
+    Section {
         id: "roundoff",
         markdown: md,
-    })
+    }
 }
 
 /// The whole output of `viscobar verify`.
@@ -392,12 +399,28 @@ fn mass_variants_section() -> Result<Section, crate::study::converge::ConvergeEr
 }
 
 /// The tolerance registry (`viscobar verify --tolerances`, `study::tolerances`), with the stiff
-/// matrix's checks read from `results`.
+/// matrix's checks read from `results` and the rigid-mode drift `increment_drift` of
+/// [`rigid_drift`].
 pub fn tolerances_section(
     results: &[crate::study::stiff::CaseResult],
+    increment_drift: f64,
 ) -> Result<Section, RunError> {
+    let backward_ulps = solve_study(&backward_error_nodes())
+        .iter()
+        .map(|c| c.backward_error)
+        .fold(0.0, f64::max);
     Ok(Section {
         id: "tolerances",
-        markdown: crate::study::tolerances::registry_markdown(results)?,
+        markdown: crate::study::tolerances::registry_markdown(
+            results,
+            increment_drift,
+            backward_ulps,
+        )?,
     })
+}
+
+/// The node counts of `tests/matrices.rs`'s backward-error check (`BACKWARD_ULPS`): every small
+/// count and the solve study's.
+pub fn backward_error_nodes() -> Vec<usize> {
+    (2..=24).chain(SOLVE_STUDY_NODES).collect()
 }
