@@ -59,9 +59,10 @@ pub fn osqp_method() -> ContactMethod {
     ContactMethod::Osqp(OsqpSettings::default())
 }
 
-/// Runs `scene` with the exact solver and with `method` side by side.
+/// Runs `scene` with the exact solver (whatever its `[solver]` table names) and with `method`
+/// side by side.
 pub fn agreement(scene: &PlaneScene, method: ContactMethod) -> Result<Agreement, ConvergeError> {
-    let mut e = PlaneSimulation::new(scene).map_err(plane_error)?;
+    let mut e = PlaneSimulation::with_method(scene, ContactMethod::Exact).map_err(plane_error)?;
     let mut o = PlaneSimulation::with_method(scene, method).map_err(plane_error)?;
     let mut a = Agreement {
         method: method.name(),
@@ -133,7 +134,7 @@ pub const CONVERGENCE_END: f64 = 0.6;
 pub const CONVERGENCE_LEVELS: [u32; 3] = [0, 1, 2];
 pub const CONVERGENCE_REFERENCE: u32 = 3;
 
-/// Runs `scene` refined to each of `levels` and to `reference`, and measures each level at its
+/// Runs `scene` (exact solver) refined to each of `levels` and to `reference`, and measures each level at its
 /// nodes and steps against the reference (whose grid holds every coarser node: uniform rows,
 /// or the same grading, doubled).
 pub fn convergence(
@@ -143,7 +144,7 @@ pub fn convergence(
 ) -> Result<Vec<ContactLevel>, ConvergeError> {
     // The reference's displacement at the steps that are multiples of 2^(reference − 0).
     let fine = scene.refined(reference);
-    let mut sim = PlaneSimulation::new(&fine).map_err(plane_error)?;
+    let mut sim = PlaneSimulation::with_method(&fine, ContactMethod::Exact).map_err(plane_error)?;
     let stride = 1usize << reference;
     let mut kept = vec![sim.displacement()];
     for n in 1..fine.steps() {
@@ -160,7 +161,8 @@ pub fn convergence(
     let mut out = Vec::new();
     for &level in levels {
         let s = scene.refined(level);
-        let mut sim = PlaneSimulation::new(&s).map_err(plane_error)?;
+        let mut sim =
+            PlaneSimulation::with_method(&s, ContactMethod::Exact).map_err(plane_error)?;
         let grid = sim.discretisation().grid.clone();
         let (f, every) = (1usize << (reference - level), 1usize << level);
         let mut max_error = 0.0f64;
