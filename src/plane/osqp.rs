@@ -193,15 +193,10 @@ impl PlaneOsqp {
             Status::Solved(s) => (s, false),
             Status::SolvedInaccurate(s) if self.settings.accept_inaccurate => (s, true),
             other => {
-                use crate::step::OsqpStatus as S;
-                let status = match other {
-                    Status::SolvedInaccurate(_) => S::SolvedInaccurate,
-                    Status::MaxIterationsReached(_) => S::MaxIterationsReached,
-                    Status::PrimalInfeasible(_) => S::PrimalInfeasible,
-                    Status::DualInfeasible(_) => S::DualInfeasible,
-                    _ => S::Unknown,
-                };
-                return Err(StepFailure::Osqp { status, iterations });
+                return Err(StepFailure::Osqp {
+                    status: crate::step::osqp::status_of(&other),
+                    iterations,
+                });
             }
         };
         z.copy_from_slice(solution.x());

@@ -194,7 +194,7 @@ pub fn raw_problem(
 }
 
 /// OSQP's status, as its C library spells it.
-fn status_of(status: &Status<'_>) -> OsqpStatus {
+pub(crate) fn status_of(status: &Status<'_>) -> OsqpStatus {
     match status {
         Status::SolvedInaccurate(_) => OsqpStatus::SolvedInaccurate,
         Status::MaxIterationsReached(_) => OsqpStatus::MaxIterationsReached,

@@ -109,3 +109,41 @@ pub(crate) fn write_figure(path: &Path, fig: &impl Drawing) -> Result<(), Figure
     }
     result
 }
+
+/// A horizontal colour bar over `0 … top` on `area`, labelled `label`: 200 cells, each
+/// coloured by `colour` at its right end (so a map that is white at 0 shows no white cell).
+pub(crate) fn colour_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    top: f64,
+    label: &str,
+    colour: impl Fn(f64) -> RGBColor,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    let mut chart = ChartBuilder::on(area)
+        .margin_left(40)
+        .margin_right(40)
+        .margin_bottom(8)
+        .x_label_area_size(30)
+        .build_cartesian_2d(0.0..top, 0.0..1.0)?;
+    chart
+        .configure_mesh()
+        .disable_y_axis()
+        .disable_mesh()
+        .x_labels(6)
+        .x_label_formatter(&|v| format!("{v:.2e}"))
+        .x_label_style(("sans-serif", 12))
+        .axis_desc_style(("sans-serif", 13))
+        .x_desc(label)
+        .draw()?;
+    let cells = 200;
+    chart.draw_series((0..cells).map(|k| {
+        let (a, b) = (
+            top * k as f64 / cells as f64,
+            top * (k + 1) as f64 / cells as f64,
+        );
+        Rectangle::new([(a, 0.0), (b, 1.0)], colour(b).filled())
+    }))?;
+    Ok(())
+}

@@ -9,7 +9,7 @@
 use crate::plane::PlaneError;
 use crate::plane::simulation::PlaneSimulation;
 use crate::scene::plane::{EDGE_NAMES, PlaneScene};
-use crate::study::figure_writer::{DrawResult, Drawing, FigureError, write_figure};
+use crate::study::figure_writer::{DrawResult, Drawing, FigureError, colour_bar, write_figure};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
@@ -161,28 +161,9 @@ impl Drawing for ContactPressureFigure {
                 ))?;
             }
         }
-        let mut chart = ChartBuilder::on(&bar)
-            .margin_left(40)
-            .margin_right(40)
-            .margin_bottom(8)
-            .x_label_area_size(30)
-            .build_cartesian_2d(0.0..top, 0.0..1.0)?;
-        chart
-            .configure_mesh()
-            .disable_y_axis()
-            .disable_mesh()
-            .x_labels(6)
-            .x_label_formatter(&|v| format!("{v:.2e}"))
-            .x_label_style(("sans-serif", 12))
-            .axis_desc_style(("sans-serif", 13))
-            .x_desc("contact pressure (white: no contact)")
-            .draw()?;
-        let n = 200;
-        chart.draw_series((0..n).map(|k| {
-            let (a, b) = (top * k as f64 / n as f64, top * (k + 1) as f64 / n as f64);
-            Rectangle::new([(a, 0.0), (b, 1.0)], colour(b, top).filled())
-        }))?;
-        Ok(())
+        colour_bar(&bar, top, "contact pressure (white: no contact)", |v| {
+            colour(v, top)
+        })
     }
 }
 

@@ -13,7 +13,9 @@ use crate::plane::PlaneError;
 use crate::plane::mesh::Grid;
 use crate::plane::simulation::PlaneSimulation;
 use crate::scene::plane::PlaneScene;
-use crate::study::figure_writer::{DrawResult, Drawing, FigureError, register_font, write_figure};
+use crate::study::figure_writer::{
+    DrawResult, Drawing, FigureError, colour_bar, register_font, write_figure,
+};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
@@ -258,32 +260,8 @@ impl Drawing for PlaneFigure {
             )))?;
         }
         // Colour bar: 0 … max von Mises stress.
-        let mut chart = ChartBuilder::on(&bar)
-            .margin_left(40)
-            .margin_right(40)
-            .margin_bottom(8)
-            .x_label_area_size(30)
-            .build_cartesian_2d(0.0..self.max_stress.max(f64::MIN_POSITIVE), 0.0..1.0)?;
-        chart
-            .configure_mesh()
-            .disable_y_axis()
-            .disable_mesh()
-            .x_labels(6)
-            .x_label_formatter(&|v| format!("{v:.2e}"))
-            .x_label_style(("sans-serif", 12))
-            .axis_desc_style(("sans-serif", 13))
-            .x_desc("von Mises stress")
-            .draw()?;
-        let steps = 200;
         let top = self.max_stress.max(f64::MIN_POSITIVE);
-        chart.draw_series((0..steps).map(|k| {
-            let (a, b) = (
-                top * k as f64 / steps as f64,
-                top * (k + 1) as f64 / steps as f64,
-            );
-            Rectangle::new([(a, 0.0), (b, 1.0)], colour(a, top).filled())
-        }))?;
-        Ok(())
+        colour_bar(&bar, top, "von Mises stress", |v| colour(v, top))
     }
 }
 
