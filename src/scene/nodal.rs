@@ -8,7 +8,7 @@
 //! (the same `f64` operations in the same order at each point).
 
 use crate::scene::SceneError;
-use crate::scene::expr::{BinOp, Expression, Func1, Func2, Node, pow};
+use crate::scene::expr::{BinOp, CmpOp, Expression, Func1, Func2, Node, pow};
 
 /// Nodes evaluated together: a few scratch arrays of this many doubles (2 KiB each) stay in
 /// the L1 cache, and the walk of the tree per block costs little next to a block's work.
@@ -19,8 +19,12 @@ pub const BLOCK: usize = 256;
 pub struct NodalEvaluator {
     expr: Expression,
     xs: Vec<f64>,
-    /// Scratch arrays of one block, one per level of the tree that holds an intermediate result.
-    pool: Vec<Vec<f64>>,
+    program: Program,
+    /// The program's scratch arrays, `stride` doubles each.
+    scratch: Vec<f64>,
+    stride: usize,
+    /// Values of the program's subtrees of `t` alone at the current call.
+    params: Vec<f64>,
 }
 
 /// Scratch arrays the evaluation of `node` needs besides its output.
@@ -191,10 +195,18 @@ pub fn eval_block(expr: &Expression, xs: &[f64], t: f64, out: &mut [f64], pool: 
 }
 
 impl NodalEvaluator {
-    /// Prepares `expr` for evaluation at the nodes `xs`.
+    /// Prepares `expr` for evaluation at the nodes `xs`: compiles it into a [`Program`] once.
     pub fn new(expr: Expression, xs: Vec<f64>) -> Self {
-        let pool = vec![vec![0.0; xs.len().min(BLOCK)]; scratch(expr.root())];
-        Self { expr, xs, pool }
+        let program = Program::compile(expr.root());
+        let stride = xs.len().clamp(1, BLOCK);
+        Self {
+            scratch: vec![0.0; program.regs * stride],
+            params: vec![0.0; program.params.len()],
+            program,
+            stride,
+            expr,
+            xs,
+        }
     }
 
     pub fn expression(&self) -> &Expression {
@@ -204,17 +216,278 @@ impl NodalEvaluator {
     /// `out[i] = f(x_i, t)`; an error names the field, the expression and the first node where
     /// the value is not a finite number (as [`Expression::eval`] would).
     pub fn eval_into(&mut self, t: f64, out: &mut [f64]) -> Result<(), SceneError> {
-        let root = self.expr.root();
+        // Subtrees of `t` alone: once per call, the bits of the tree walk at any node.
+        for (p, node) in self.params.iter_mut().zip(&self.program.params) {
+            *p = node.eval(0.0, 0.0, t);
+        }
         for (start, (xs, out)) in (0..)
             .step_by(BLOCK)
             .zip(self.xs.chunks(BLOCK).zip(out.chunks_mut(BLOCK)))
         {
-            eval_into(root, xs, t, out, &mut self.pool);
-            if let Some(i) = out.iter().position(|v| !v.is_finite()) {
+            self.program
+                .run(xs, &self.params, out, &mut self.scratch, self.stride);
+            // `|` rather than `any`: no early exit, so the check vectorises.
+            if out.iter().fold(false, |bad, v| bad | !v.is_finite()) {
+                let i = out.iter().position(|v| !v.is_finite()).unwrap_or(0);
                 return self.expr.eval(self.xs[start + i], t).map(|_| ());
             }
         }
         Ok(())
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The compiled form
+
+/// Where an operand is read over one block: the instruction's own output array (in place),
+/// a higher scratch array, `x`, a constant, or a subtree of `t` alone evaluated once per call.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Src {
+    Dst,
+    Reg(usize),
+    X,
+    Const(f64),
+    Param(usize),
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Fn2 {
+    Bin(BinOp),
+    Cmp(CmpOp),
+    Call(Func2),
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Fn1 {
+    Neg,
+    /// `a^2` as one product, as [`pow`] computes it.
+    Square,
+    Call(Func1),
+}
+
+/// One loop over a block. Array 0 is the output; array `r > 0` is scratch array `r − 1`. An
+/// instruction writing array `d` reads only `d` itself and arrays above it (the compiler hands
+/// out arrays as a stack), so the borrows split at `d`.
+#[derive(Clone, Copy, Debug)]
+enum Instr {
+    /// `d = a`.
+    Load { dst: usize, a: Src },
+    /// `d = f(a, b)`.
+    Binary { f: Fn2, dst: usize, a: Src, b: Src },
+    /// `d = f(d)`.
+    Unary { f: Fn1, dst: usize },
+    /// `d = if(d, a, b)`.
+    If { dst: usize, a: Src, b: Src },
+}
+
+/// An expression compiled once at set-up into a flat list of loops over a block: no walk of
+/// the tree per block, constant subtrees folded, subtrees of `t` alone evaluated once per
+/// call as scalars, `x` and scalars read in place. Every point sees the same `f64` operations
+/// in the same order as [`Node::eval`], so the values are its bits.
+#[derive(Clone, Debug)]
+struct Program {
+    code: Vec<Instr>,
+    /// The subtrees of `t` alone, by parameter index.
+    params: Vec<Node>,
+    /// Scratch arrays needed besides the output.
+    regs: usize,
+}
+
+impl Program {
+    fn compile(root: &Node) -> Self {
+        let mut p = Program {
+            code: Vec::new(),
+            params: Vec::new(),
+            regs: 0,
+        };
+        p.into_reg(root, 0);
+        p
+    }
+
+    /// `node` as an operand read in place, when it needs no array of its own.
+    fn leaf(&mut self, node: &Node) -> Option<Src> {
+        match node {
+            Node::X => return Some(Src::X),
+            // A bar expression is evaluated at `y = 0`, as `Expression::eval` does.
+            Node::Y => return Some(Src::Const(0.0)),
+            _ => {}
+        }
+        // `uses` counts `y` as `x`, so a subtree reading `y` is never hoisted.
+        match node.uses() {
+            (true, _) => None,
+            (false, false) => Some(Src::Const(node.eval(0.0, 0.0, 0.0))),
+            (false, true) => {
+                self.params.push(node.clone());
+                Some(Src::Param(self.params.len() - 1))
+            }
+        }
+    }
+
+    /// Emits the loops that leave `node` in array `dst`, using arrays above it.
+    fn into_reg(&mut self, node: &Node, dst: usize) {
+        self.regs = self.regs.max(dst);
+        if let Some(a) = self.leaf(node) {
+            self.code.push(Instr::Load { dst, a });
+            return;
+        }
+        let unary = |p: &mut Self, a: &Node, f: Fn1| {
+            p.into_reg(a, dst);
+            p.code.push(Instr::Unary { f, dst });
+        };
+        match node {
+            Node::Neg(a) => unary(self, a, Fn1::Neg),
+            Node::Call1(f, a) => unary(self, a, Fn1::Call(*f)),
+            Node::Bin(BinOp::Pow, a, b)
+                if b.uses() == (false, false) && b.eval(0.0, 0.0, 0.0) == 2.0 =>
+            {
+                unary(self, a, Fn1::Square)
+            }
+            Node::Bin(op, a, b) => self.binary(Fn2::Bin(*op), a, b, dst),
+            Node::Cmp(op, a, b) => self.binary(Fn2::Cmp(*op), a, b, dst),
+            Node::Call2(f, a, b) => self.binary(Fn2::Call(*f), a, b, dst),
+            Node::If(c, a, b) => {
+                self.into_reg(c, dst);
+                let a = self.operand(a, dst + 1);
+                let b = self.operand(b, dst + 2);
+                self.code.push(Instr::If { dst, a, b });
+            }
+            Node::Num(_) | Node::X | Node::Y | Node::T => unreachable!("leaves are loaded"),
+        }
+    }
+
+    /// `node` in place, or computed into array `reg`.
+    fn operand(&mut self, node: &Node, reg: usize) -> Src {
+        self.leaf(node).unwrap_or_else(|| {
+            self.into_reg(node, reg);
+            Src::Reg(reg)
+        })
+    }
+
+    fn binary(&mut self, f: Fn2, a: &Node, b: &Node, dst: usize) {
+        let (la, lb) = (self.leaf(a), self.leaf(b));
+        let (a, b) = match (la, lb) {
+            (Some(a), Some(b)) => (a, b),
+            (None, Some(b)) => {
+                self.into_reg(a, dst);
+                (Src::Dst, b)
+            }
+            (Some(a), None) => {
+                self.into_reg(b, dst);
+                (a, Src::Dst)
+            }
+            (None, None) => {
+                self.into_reg(a, dst);
+                self.into_reg(b, dst + 1);
+                (Src::Dst, Src::Reg(dst + 1))
+            }
+        };
+        self.code.push(Instr::Binary { f, dst, a, b });
+    }
+
+    /// Runs the program over one block `xs` into `out`, with `scratch` holding [`Program::regs`]
+    /// arrays of `stride >= xs.len()` doubles.
+    fn run(&self, xs: &[f64], params: &[f64], out: &mut [f64], scratch: &mut [f64], stride: usize) {
+        let n = xs.len();
+        for ins in &self.code {
+            let dst = match *ins {
+                Instr::Load { dst, .. }
+                | Instr::Binary { dst, .. }
+                | Instr::Unary { dst, .. }
+                | Instr::If { dst, .. } => dst,
+            };
+            // The output array and the arrays above it (array `r` at `(r − dst − 1) stride`).
+            let (d, above): (&mut [f64], &[f64]) = if dst == 0 {
+                (&mut *out, &*scratch)
+            } else {
+                let (d, above) = scratch[(dst - 1) * stride..].split_at_mut(stride);
+                (d, above)
+            };
+            let d = &mut d[..n];
+            let val = |s: Src| match s {
+                Src::Dst => Val::Dst,
+                Src::Reg(r) => Val::Array(&above[(r - dst - 1) * stride..][..n]),
+                Src::X => Val::Array(xs),
+                Src::Const(c) => Val::Scalar(c),
+                Src::Param(p) => Val::Scalar(params[p]),
+            };
+            match *ins {
+                Instr::Load { a, .. } => match val(a) {
+                    Val::Dst => {}
+                    Val::Array(a) => d.copy_from_slice(a),
+                    Val::Scalar(c) => d.fill(c),
+                },
+                Instr::Binary { f, a, b, .. } => binary(f, d, val(a), val(b)),
+                Instr::Unary { f, .. } => unary(f, d),
+                Instr::If { a, b, .. } => {
+                    let (a, b) = (val(a), val(b));
+                    for (i, o) in d.iter_mut().enumerate() {
+                        let at = |v: &Val<'_>| match v {
+                            Val::Dst => unreachable!("branches are not the condition's array"),
+                            Val::Array(a) => a[i],
+                            Val::Scalar(c) => *c,
+                        };
+                        *o = if o.is_nan() {
+                            f64::NAN
+                        } else if *o != 0.0 {
+                            at(&a)
+                        } else {
+                            at(&b)
+                        };
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// An operand over one block.
+#[derive(Clone, Copy)]
+enum Val<'a> {
+    /// The output array itself.
+    Dst,
+    Array(&'a [f64]),
+    Scalar(f64),
+}
+
+/// `d = f(a, b)`, one loop per kind of operand (so each loop vectorises where `f` does).
+#[inline(always)]
+fn zip2(d: &mut [f64], a: Val<'_>, b: Val<'_>, f: impl Fn(f64, f64) -> f64) {
+    use Val::*;
+    match (a, b) {
+        (Dst, Dst) => d.iter_mut().for_each(|o| *o = f(*o, *o)),
+        (Dst, Array(b)) => d.iter_mut().zip(b).for_each(|(o, &b)| *o = f(*o, b)),
+        (Dst, Scalar(c)) => d.iter_mut().for_each(|o| *o = f(*o, c)),
+        (Array(a), Dst) => d.iter_mut().zip(a).for_each(|(o, &a)| *o = f(a, *o)),
+        (Scalar(c), Dst) => d.iter_mut().for_each(|o| *o = f(c, *o)),
+        (Array(a), Array(b)) => d
+            .iter_mut()
+            .zip(a.iter().zip(b))
+            .for_each(|(o, (&a, &b))| *o = f(a, b)),
+        (Array(a), Scalar(c)) => d.iter_mut().zip(a).for_each(|(o, &a)| *o = f(a, c)),
+        (Scalar(c), Array(b)) => d.iter_mut().zip(b).for_each(|(o, &b)| *o = f(c, b)),
+        (Scalar(a), Scalar(b)) => d.fill(f(a, b)),
+    }
+}
+
+fn binary(f: Fn2, d: &mut [f64], a: Val<'_>, b: Val<'_>) {
+    match f {
+        Fn2::Bin(BinOp::Add) => zip2(d, a, b, |a, b| a + b),
+        Fn2::Bin(BinOp::Sub) => zip2(d, a, b, |a, b| a - b),
+        Fn2::Bin(BinOp::Mul) => zip2(d, a, b, |a, b| a * b),
+        Fn2::Bin(BinOp::Div) => zip2(d, a, b, |a, b| a / b),
+        Fn2::Bin(BinOp::Pow) => zip2(d, a, b, pow),
+        Fn2::Cmp(op) => zip2(d, a, b, |a, b| op.apply(a, b)),
+        Fn2::Call(Func2::Min) => zip2(d, a, b, f64::min),
+        Fn2::Call(Func2::Max) => zip2(d, a, b, f64::max),
+        Fn2::Call(Func2::Atan2) => zip2(d, a, b, f64::atan2),
+    }
+}
+
+fn unary(f: Fn1, d: &mut [f64]) {
+    match f {
+        Fn1::Neg => d.iter_mut().for_each(|v| *v = -*v),
+        Fn1::Square => d.iter_mut().for_each(|v| *v *= *v),
+        Fn1::Call(f) => apply1(f, d),
     }
 }
 
