@@ -257,6 +257,17 @@ enum Fn2 {
     Call(Func2),
 }
 
+/// A sign or a square applied in the loop of the [`Instr::Binary`] before it (one pass over
+/// the block instead of two or three, e.g. `-(x - t)^2`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Post {
+    None,
+    Neg,
+    Square,
+    /// `−(v²)`.
+    NegSquare,
+}
+
 #[derive(Clone, Copy, Debug)]
 enum Fn1 {
     Neg,
@@ -272,8 +283,14 @@ enum Fn1 {
 enum Instr {
     /// `d = a`.
     Load { dst: usize, a: Src },
-    /// `d = f(a, b)`.
-    Binary { f: Fn2, dst: usize, a: Src, b: Src },
+    /// `d = post(f(a, b))`.
+    Binary {
+        f: Fn2,
+        dst: usize,
+        a: Src,
+        b: Src,
+        post: Post,
+    },
     /// `d = f(d)`.
     Unary { f: Fn1, dst: usize },
     /// `d = if(d, a, b)`.
@@ -332,6 +349,20 @@ impl Program {
         }
         let unary = |p: &mut Self, a: &Node, f: Fn1| {
             p.into_reg(a, dst);
+            if let Some(Instr::Binary { dst: d, post, .. }) = p.code.last_mut()
+                && *d == dst
+            {
+                let fused = match (*post, f) {
+                    (Post::None, Fn1::Neg) => Some(Post::Neg),
+                    (Post::None, Fn1::Square) => Some(Post::Square),
+                    (Post::Square, Fn1::Neg) => Some(Post::NegSquare),
+                    _ => None,
+                };
+                if let Some(fused) = fused {
+                    *post = fused;
+                    return;
+                }
+            }
             p.code.push(Instr::Unary { f, dst });
         };
         match node {
@@ -381,7 +412,13 @@ impl Program {
                 (Src::Dst, Src::Reg(dst + 1))
             }
         };
-        self.code.push(Instr::Binary { f, dst, a, b });
+        self.code.push(Instr::Binary {
+            f,
+            dst,
+            a,
+            b,
+            post: Post::None,
+        });
     }
 
     /// Runs the program over one block `xs` into `out`, with `scratch` holding [`Program::regs`]
@@ -416,7 +453,15 @@ impl Program {
                     Val::Array(a) => d.copy_from_slice(a),
                     Val::Scalar(c) => d.fill(c),
                 },
-                Instr::Binary { f, a, b, .. } => binary(f, d, val(a), val(b)),
+                Instr::Binary { f, a, b, post, .. } => {
+                    let (a, b) = (val(a), val(b));
+                    match post {
+                        Post::None => binary(f, d, a, b, |v| v),
+                        Post::Neg => binary(f, d, a, b, |v| -v),
+                        Post::Square => binary(f, d, a, b, |v| v * v),
+                        Post::NegSquare => binary(f, d, a, b, |v| -(v * v)),
+                    }
+                }
                 Instr::Unary { f, .. } => unary(f, d),
                 Instr::If { a, b, .. } => {
                     let (a, b) = (val(a), val(b));
@@ -469,17 +514,19 @@ fn zip2(d: &mut [f64], a: Val<'_>, b: Val<'_>, f: impl Fn(f64, f64) -> f64) {
     }
 }
 
-fn binary(f: Fn2, d: &mut [f64], a: Val<'_>, b: Val<'_>) {
+/// `d = post(f(a, b))`.
+#[inline(always)]
+fn binary(f: Fn2, d: &mut [f64], a: Val<'_>, b: Val<'_>, post: impl Fn(f64) -> f64 + Copy) {
     match f {
-        Fn2::Bin(BinOp::Add) => zip2(d, a, b, |a, b| a + b),
-        Fn2::Bin(BinOp::Sub) => zip2(d, a, b, |a, b| a - b),
-        Fn2::Bin(BinOp::Mul) => zip2(d, a, b, |a, b| a * b),
-        Fn2::Bin(BinOp::Div) => zip2(d, a, b, |a, b| a / b),
-        Fn2::Bin(BinOp::Pow) => zip2(d, a, b, pow),
-        Fn2::Cmp(op) => zip2(d, a, b, |a, b| op.apply(a, b)),
-        Fn2::Call(Func2::Min) => zip2(d, a, b, f64::min),
-        Fn2::Call(Func2::Max) => zip2(d, a, b, f64::max),
-        Fn2::Call(Func2::Atan2) => zip2(d, a, b, f64::atan2),
+        Fn2::Bin(BinOp::Add) => zip2(d, a, b, |a, b| post(a + b)),
+        Fn2::Bin(BinOp::Sub) => zip2(d, a, b, |a, b| post(a - b)),
+        Fn2::Bin(BinOp::Mul) => zip2(d, a, b, |a, b| post(a * b)),
+        Fn2::Bin(BinOp::Div) => zip2(d, a, b, |a, b| post(a / b)),
+        Fn2::Bin(BinOp::Pow) => zip2(d, a, b, |a, b| post(pow(a, b))),
+        Fn2::Cmp(op) => zip2(d, a, b, |a, b| post(op.apply(a, b))),
+        Fn2::Call(Func2::Min) => zip2(d, a, b, |a, b| post(a.min(b))),
+        Fn2::Call(Func2::Max) => zip2(d, a, b, |a, b| post(a.max(b))),
+        Fn2::Call(Func2::Atan2) => zip2(d, a, b, |a, b| post(a.atan2(b))),
     }
 }
 
