@@ -1,10 +1,14 @@
 //! An expression evaluated over a whole array of nodes one operation at a time: each node of
 //! the tree becomes one loop over the array, so the interpreter's dispatch is paid once per
 //! operation instead of once per operation and node. The array is taken in blocks of
-//! [`BLOCK`] nodes, the whole tree over one block before the next, so the intermediate arrays
-//! stay in the L1 cache; a number, `x`, `y` or `t` as the right operand of an operation is read
-//! in place rather than filled into an array. The buffers are sized at set-up, so an
-//! evaluation allocates nothing; the values are those of [`Expression::eval`] bit for bit
+//! [`BLOCK`] nodes, the whole expression over one block before the next, so the intermediate
+//! arrays stay in the L1 cache.
+//!
+//! [`NodalEvaluator`] compiles the tree once at set-up into a [`Program`], a flat list of
+//! loops: constant subtrees folded, subtrees of `t` alone evaluated once per call as scalars,
+//! `x` and scalars read in place, a sign or square fused into the loop before it. The
+//! set-up's [`eval_block`] walks the tree per block. Buffers are sized at set-up, so an
+//! evaluation allocates nothing; both give the values of [`Expression::eval`] bit for bit
 //! (the same `f64` operations in the same order at each point).
 
 use crate::scene::SceneError;
@@ -19,6 +23,13 @@ pub const BLOCK: usize = 256;
 pub struct NodalEvaluator {
     expr: Expression,
     xs: Vec<f64>,
+    /// Boxed: a simulation's load holds it beside smaller variants.
+    compiled: Box<Compiled>,
+}
+
+/// A [`Program`] and its buffers.
+#[derive(Clone, Debug)]
+struct Compiled {
     program: Program,
     /// The program's scratch arrays, `stride` doubles each.
     scratch: Vec<f64>,
@@ -200,10 +211,12 @@ impl NodalEvaluator {
         let program = Program::compile(expr.root());
         let stride = xs.len().clamp(1, BLOCK);
         Self {
-            scratch: vec![0.0; program.regs * stride],
-            params: vec![0.0; program.params.len()],
-            program,
-            stride,
+            compiled: Box::new(Compiled {
+                scratch: vec![0.0; program.regs * stride],
+                params: vec![0.0; program.params.len()],
+                program,
+                stride,
+            }),
             expr,
             xs,
         }
@@ -217,15 +230,15 @@ impl NodalEvaluator {
     /// the value is not a finite number (as [`Expression::eval`] would).
     pub fn eval_into(&mut self, t: f64, out: &mut [f64]) -> Result<(), SceneError> {
         // Subtrees of `t` alone: once per call, the bits of the tree walk at any node.
-        for (p, node) in self.params.iter_mut().zip(&self.program.params) {
+        let c = &mut *self.compiled;
+        for (p, node) in c.params.iter_mut().zip(&c.program.params) {
             *p = node.eval(0.0, 0.0, t);
         }
         for (start, (xs, out)) in (0..)
             .step_by(BLOCK)
             .zip(self.xs.chunks(BLOCK).zip(out.chunks_mut(BLOCK)))
         {
-            self.program
-                .run(xs, &self.params, out, &mut self.scratch, self.stride);
+            c.program.run(xs, &c.params, out, &mut c.scratch, c.stride);
             // `|` rather than `any`: no early exit, so the check vectorises.
             if out.iter().fold(false, |bad, v| bad | !v.is_finite()) {
                 let i = out.iter().position(|v| !v.is_finite()).unwrap_or(0);
@@ -317,7 +330,7 @@ impl Program {
             params: Vec::new(),
             regs: 0,
         };
-        p.into_reg(root, 0);
+        p.emit(root, 0);
         p
     }
 
@@ -341,14 +354,14 @@ impl Program {
     }
 
     /// Emits the loops that leave `node` in array `dst`, using arrays above it.
-    fn into_reg(&mut self, node: &Node, dst: usize) {
+    fn emit(&mut self, node: &Node, dst: usize) {
         self.regs = self.regs.max(dst);
         if let Some(a) = self.leaf(node) {
             self.code.push(Instr::Load { dst, a });
             return;
         }
         let unary = |p: &mut Self, a: &Node, f: Fn1| {
-            p.into_reg(a, dst);
+            p.emit(a, dst);
             if let Some(Instr::Binary { dst: d, post, .. }) = p.code.last_mut()
                 && *d == dst
             {
@@ -377,7 +390,7 @@ impl Program {
             Node::Cmp(op, a, b) => self.binary(Fn2::Cmp(*op), a, b, dst),
             Node::Call2(f, a, b) => self.binary(Fn2::Call(*f), a, b, dst),
             Node::If(c, a, b) => {
-                self.into_reg(c, dst);
+                self.emit(c, dst);
                 let a = self.operand(a, dst + 1);
                 let b = self.operand(b, dst + 2);
                 self.code.push(Instr::If { dst, a, b });
@@ -389,7 +402,7 @@ impl Program {
     /// `node` in place, or computed into array `reg`.
     fn operand(&mut self, node: &Node, reg: usize) -> Src {
         self.leaf(node).unwrap_or_else(|| {
-            self.into_reg(node, reg);
+            self.emit(node, reg);
             Src::Reg(reg)
         })
     }
@@ -399,16 +412,16 @@ impl Program {
         let (a, b) = match (la, lb) {
             (Some(a), Some(b)) => (a, b),
             (None, Some(b)) => {
-                self.into_reg(a, dst);
+                self.emit(a, dst);
                 (Src::Dst, b)
             }
             (Some(a), None) => {
-                self.into_reg(b, dst);
+                self.emit(b, dst);
                 (a, Src::Dst)
             }
             (None, None) => {
-                self.into_reg(a, dst);
-                self.into_reg(b, dst + 1);
+                self.emit(a, dst);
+                self.emit(b, dst + 1);
                 (Src::Dst, Src::Reg(dst + 1))
             }
         };
@@ -579,6 +592,12 @@ mod tests {
             "x - t + (x / 3) ^ 3 - 2 ^ x + (t - x) * 3 - (x < t) + (t >= x) + min(x, 0.5)",
             "atan2(t, x) + max(-x, t) + if(x, t, x - t) + (1 - x)/(x*x + t + 1)",
             "-(x^2) + (x*x + 1)^t + 2^2 + t^x",
+            // Hoisted and folded subtrees, fused signs and squares, leaves alone.
+            "x^(1+1) + if(t < 1, x, -x) * (t*t + 1) - (x*x + t)^(2*t)",
+            "exp(-(x - t)^2) - (x*t)^2 + -(x + t) + sin(t)*x + cos(2*t)",
+            "t",
+            "2",
+            "x",
         ] {
             let e = Expression::parse("load.density", text, true).unwrap();
             let mut n = NodalEvaluator::new(e.clone(), xs.clone());
@@ -597,11 +616,25 @@ mod tests {
     }
 
     #[test]
+    fn the_mixed_load_compiles_to_six_loops_with_t_read_once_per_call() {
+        let e = Expression::parse("load.density", "0.1*sin(x*t)*exp(-(x-t)^2)", true).unwrap();
+        let p = Program::compile(e.root());
+        // x*t, sin, 0.1*·, −(x − t)², exp, the product; one scratch array.
+        assert_eq!(p.code.len(), 6, "{:?}", p.code);
+        assert_eq!((p.params.len(), p.regs), (2, 1));
+    }
+
+    #[test]
     fn a_non_finite_value_is_reported_at_its_node() {
         let e = Expression::parse("load.density", "1/(x - t)", true).unwrap();
         let mut n = NodalEvaluator::new(e, vec![0.0, 0.5, 1.0]);
         let mut out = vec![0.0; 3];
         let err = n.eval_into(0.5, &mut out).unwrap_err().to_string();
         assert!(err.contains("load.density") && err.contains("0.5"), "{err}");
+        // A hoisted subtree of `t` that is infinite makes the value infinite at every node.
+        let e = Expression::parse("load.density", "x + 1/(t - 0.5)", true).unwrap();
+        let mut n = NodalEvaluator::new(e.clone(), vec![0.0, 0.5, 1.0]);
+        let err = n.eval_into(0.5, &mut out).unwrap_err().to_string();
+        assert_eq!(err, e.eval(0.0, 0.5).unwrap_err().to_string());
     }
 }
