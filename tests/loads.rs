@@ -140,3 +140,50 @@ fn a_load_that_is_not_finite_is_named_with_its_node() {
     };
     assert!(err.contains("load.density") && err.contains("0.5"), "{err}");
 }
+
+/// Counts the allocations of this thread (tests/no_alloc.rs runs the built-in scenes, whose
+/// loads all separate; this one watches the node-array path).
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
+unsafe impl std::alloc::GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
+        unsafe { std::alloc::System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        unsafe { std::alloc::System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn steps_with_a_load_that_does_not_separate_do_not_allocate() {
+    for text in [
+        "0.1*sin(x*t)*exp(-(x-t)^2)",
+        "if(x < t, atan2(x, t), min(x, -t)) + (t*t + 1)^x",
+    ] {
+        // Several blocks of the node-array evaluator and a partial one.
+        let scene = common::builtin(
+            "both-ends",
+            &[&format!("load.density=\"{text}\""), "mesh.elements=700"],
+        );
+        let mut sim = Simulation::new(&scene).unwrap();
+        sim.step().unwrap(); // warm-up outside the count
+        let before = ALLOCATIONS.with(std::cell::Cell::get);
+        for _ in 0..20 {
+            sim.step().unwrap();
+        }
+        let count = ALLOCATIONS.with(std::cell::Cell::get) - before;
+        assert_eq!(count, 0, "{text}: {count} allocations in 20 steps");
+    }
+}
