@@ -310,7 +310,15 @@ pub fn measured() -> Result<Vec<Measured>, RunError> {
             "OSQP_AGREEMENT_TOL",
             OSQP_AGREEMENT_TOL,
             osqp.agreement,
-            "the issue's stated requirement (1e-7); not yet tightened",
+            "the issue's stated requirement (1e-7), kept as the outer contract; the check that \
+             can fail is the per-run bound of the next row",
+        ),
+        (
+            "OSQP |u − u_exact| / (steps · (AGREEMENT_ULPS_PER_STEP ε max|u| + audited ‖C⁻¹ρ‖∞))",
+            1.0,
+            osqp.agreement_ratio,
+            "a posteriori: two backward-stable solves per step, plus OSQP's own residual, \
+             accumulated linearly",
         ),
         (
             "PENALTY_LAW_TOL",
@@ -806,8 +814,27 @@ pub const OSQP_REACTION_TOL: f64 = AUDIT_MARGIN * OSQP_DEFAULT_EPS * 1e3;
 /// Penalty law `ε r = max(0, −gap)` in the recorded gap `u^{n+1} + a`: rounding of
 /// `u^n + z + a` (each below 3 in magnitude) on top of the solver's own round-off.
 pub const PENALTY_LAW_TOL: f64 = 1e-14;
-/// OSQP against exact, max over nodes and steps of the displacement: the issue's requirement.
+/// OSQP against exact, max over nodes and steps of the displacement: the issue's requirement,
+/// kept as the outer contract; the check that can fail is [`osqp_agreement_bound`].
 pub const OSQP_AGREEMENT_TOL: f64 = 1e-7;
+/// Per step, in units of `ε max |u|`: how far two solves of one step's active-set system may
+/// differ (exact's LDLᵀ and polished OSQP's KKT solve, both backward stable, κ(C) of a few at
+/// Δt ≈ Δx; measured up to 1.1 on the built-in scenes).
+pub const AGREEMENT_ULPS_PER_STEP: f64 = 16.0;
+
+/// The agreement bound of one OSQP run, a posteriori: per step, the two solves' round-off
+/// [`AGREEMENT_ULPS_PER_STEP`] `ε max |u|` plus OSQP's own audited stationarity residual in
+/// displacement (`‖C⁻¹ρ‖∞`, the step's error for its active set), accumulated linearly over the
+/// steps (the scheme is stable: it does not amplify a perturbation). 0 without an audit (an
+/// OSQP run always audits: any difference then fails).
+pub fn osqp_agreement_bound(cmp: &Comparison) -> f64 {
+    let Some(audit) = cmp.summary.audit.as_ref() else {
+        return 0.0;
+    };
+    let per_step = AGREEMENT_ULPS_PER_STEP * f64::EPSILON * cmp.agreement.max_displacement
+        + audit.stationarity_displacement.max;
+    cmp.agreement.steps as f64 * per_step
+}
 
 /// The OSQP identity tolerance of one run, a posteriori: the run's own worst stationarity
 /// residual over the audit's tolerance scales the a-priori [`OSQP_IDENTITY_TOL`] (the identity
@@ -857,6 +884,8 @@ pub struct SolverWorst {
     pub law: f64,
     /// `max |u − u_exact|` over nodes and steps.
     pub agreement: f64,
+    /// OSQP: that over the run's [`osqp_agreement_bound`].
+    pub agreement_ratio: f64,
 }
 
 impl SolverWorst {
@@ -868,6 +897,7 @@ impl SolverWorst {
             complementarity_ratio: self.complementarity_ratio.max(o.complementarity_ratio),
             law: self.law.max(o.law),
             agreement: self.agreement.max(o.agreement),
+            agreement_ratio: self.agreement_ratio.max(o.agreement_ratio),
         }
     }
 }
@@ -885,6 +915,17 @@ pub fn solver_worst(scene: &Scene, cmp: &Comparison) -> SolverWorst {
         agreement: cmp.agreement.max_difference,
         ..SolverWorst::default()
     };
+    if method == SolverMethod::Osqp {
+        let bound = osqp_agreement_bound(cmp);
+        let difference = cmp.agreement.max_difference;
+        w.agreement_ratio = if bound > 0.0 {
+            difference / bound
+        } else if difference > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        };
+    }
     let mut max_reaction = 0.0f64;
     for r in &cmp.records {
         w.identity_ratio = w.identity_ratio.max(r.identity_residual / identity_tol);
