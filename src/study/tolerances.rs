@@ -442,6 +442,14 @@ pub fn measured() -> Result<Vec<Measured>, RunError> {
             "impact's release time at 100, 200, 400 elements; 0.02 at the coarsest",
         ),
         (
+            "SEPARATION_TOL",
+            "tests/loads.rs",
+            SEPARATION_TOL,
+            separation_worst()?,
+            "six fixed separable loads at three steps (the test draws more at random): the \
+             regrouped sum's roundings",
+        ),
+        (
             "ENERGY_ROUNDOFF_TOL",
             "tests/diagnostics.rs",
             ENERGY_ROUNDOFF_TOL,
@@ -1350,6 +1358,87 @@ pub fn thinned_energy_worst() -> Result<f64, RunError> {
             if rb.measured {
                 worst = worst.max(thinned_energy_error(ra.energy, rb.energy));
             }
+        }
+    }
+    Ok(worst)
+}
+
+// ---- tests/loads.rs ---------------------------------------------------------------------------
+
+/// The separated load path against the plain one, relative to `Σ_k |f_k| M|g_k| + M|l|`: the
+/// split regroups at most `MAX_TERMS` = 8 terms, each combined by at most a few roundings along
+/// the sums and products of the tree (the regrouped sum may cancel where the tree did not).
+pub const SEPARATION_TOL: f64 = 64.0 * f64::EPSILON;
+/// Elements of the loads' comparison (`modal` with `Δt = Δx`).
+pub const LOAD_ELEMENTS: u64 = 40;
+/// Separable loads of the registry's measurement: the talk's two and sums, products and
+/// quotients of the generator's factors (`tests/loads.rs` draws more at random).
+pub const SEPARABLE_LOADS: [&str; 6] = [
+    "sin(t*sqrt(2))*cos(2*x)",
+    "-0.5 + 0.8*sin(3*t)*cos(pi*x/2)",
+    "(sin(1.3*x) + exp(-0.7*t))*(cos(2.1*t) - x)",
+    "((1 + x^2)/(1.5 + x))/(2 + cos(0.9*t)) - sin(2.5*t)*exp(-1.1*x)",
+    "(t - sin(0.6*x))*(x + cos(1.7*t)) + 2.2*(1 + t^2)/(0.8 + t)",
+    "-((exp(-2*x) - t)*(sin(0.5*t) + x)) + cos(2.9*x)",
+];
+
+/// The load vector at step `n` of `modal` with load `text` ([`LOAD_ELEMENTS`]): the
+/// simulation's (separated where it can) and the plain `M l(x, t)`, and the scale
+/// `Σ_k |f_k(t)| M|g_k| + M|l|` of the separation's round-off.
+pub fn load_vectors(text: &str, n: usize) -> Result<[Vec<f64>; 3], RunError> {
+    use crate::bar::matrices::{MatrixVariant, mass};
+    use crate::scene::Expression;
+    let (_, scene) = scene::load(
+        "modal",
+        &[
+            format!("load.density=\"{text}\""),
+            format!("mesh.elements={LOAD_ELEMENTS}"),
+            format!("time.step={}", 1.0 / LOAD_ELEMENTS as f64),
+        ],
+    )?;
+    let mut sim = crate::time::simulation::Simulation::new(&scene)?;
+    let disc = sim.discretisation().clone();
+    let t = n as f64 * disc.dt;
+    let fast = sim.load_vector(n)?.to_vec();
+    let expr = Expression::parse("load.density", text, true)?;
+    let eval = |e: &Expression, x: f64, t: f64| -> Result<f64, RunError> { Ok(e.eval(x, t)?) };
+    let m = mass(MatrixVariant::Consistent, disc.nodes, disc.dx);
+    let xs: Vec<f64> = (0..disc.nodes).map(|i| disc.x(i)).collect();
+    let l = xs
+        .iter()
+        .map(|&x| eval(&expr, x, t))
+        .collect::<Result<Vec<f64>, RunError>>()?;
+    let plain = m.mul(&l);
+    let mut scale = m.mul(&l.iter().map(|v| v.abs()).collect::<Vec<_>>());
+    for term in expr.separate().unwrap_or_default() {
+        let f = eval(&term.time, 0.0, t)?.abs();
+        let g = xs
+            .iter()
+            .map(|&x| eval(&term.space, x, 0.0).map(f64::abs))
+            .collect::<Result<Vec<f64>, RunError>>()?;
+        for (s, mg) in scale.iter_mut().zip(m.mul(&g)) {
+            *s += f * mg;
+        }
+    }
+    Ok([fast, plain, scale])
+}
+
+/// `max_i |fast_i − plain_i| / scale_i` of [`load_vectors`] (0 where both are 0).
+pub fn separation_error([fast, plain, scale]: &[Vec<f64>; 3]) -> f64 {
+    (0..fast.len())
+        .map(|i| {
+            let d = (fast[i] - plain[i]).abs();
+            if d == 0.0 { 0.0 } else { d / scale[i] }
+        })
+        .fold(0.0, f64::max)
+}
+
+/// [`separation_error`] over [`SEPARABLE_LOADS`] at steps 0, 17, 79.
+pub fn separation_worst() -> Result<f64, RunError> {
+    let mut worst = 0.0f64;
+    for text in SEPARABLE_LOADS {
+        for n in [0usize, 17, 79] {
+            worst = worst.max(separation_error(&load_vectors(text, n)?));
         }
     }
     Ok(worst)
