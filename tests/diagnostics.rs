@@ -29,7 +29,7 @@ fn thinning_leaves_the_trajectory_unchanged_and_measured_steps_close_the_identit
             );
             assert_eq!(
                 rb.measured,
-                rb.step as u64 % THINNING == 0 || rb.step == steps,
+                (rb.step as u64).is_multiple_of(THINNING) || rb.step == steps,
                 "{name}: {}",
                 rb.step
             );
