@@ -8,15 +8,14 @@ use common::{ENERGY_RISE_TOL, IDENTITY_TOL};
 use viscobar::Simulation;
 use viscobar::scene::builtin_names;
 
-/// A measured energy after unmeasured steps is computed from `u^{n−1} = u^n − w` rather than
-/// carried over: it differs from the every-step value by round-off in `E` (values of order 1).
-const ENERGY_ROUNDOFF_TOL: f64 = 1e-13;
+// Defined beside its measurement in the tolerance registry (`verify --tolerances`).
+use viscobar::study::tolerances::{ENERGY_ROUNDOFF_TOL, THINNING, thinned_energy_error};
 
 #[test]
 fn thinning_leaves_the_trajectory_unchanged_and_measured_steps_close_the_identity() {
     for name in builtin_names() {
         let every = common::builtin(name, &[]);
-        let thinned = common::builtin(name, &["output.diagnostics_every=7"]);
+        let thinned = common::builtin(name, &[&format!("output.diagnostics_every={THINNING}")]);
         let mut a = Simulation::new(&every).unwrap();
         let mut b = Simulation::new(&thinned).unwrap();
         let steps = every.steps();
@@ -30,7 +29,7 @@ fn thinning_leaves_the_trajectory_unchanged_and_measured_steps_close_the_identit
             );
             assert_eq!(
                 rb.measured,
-                rb.step % 7 == 0 || rb.step == steps,
+                (rb.step as u64).is_multiple_of(THINNING) || rb.step == steps,
                 "{name}: {}",
                 rb.step
             );
@@ -49,7 +48,7 @@ fn thinning_leaves_the_trajectory_unchanged_and_measured_steps_close_the_identit
                     rb.step
                 );
                 assert!(
-                    (ra.energy - rb.energy).abs() <= ENERGY_ROUNDOFF_TOL * ra.energy.max(1.0),
+                    thinned_energy_error(ra.energy, rb.energy) <= ENERGY_ROUNDOFF_TOL,
                     "{name}: step {}: {} vs {}",
                     rb.step,
                     ra.energy,

@@ -310,7 +310,15 @@ pub fn measured() -> Result<Vec<Measured>, RunError> {
             "OSQP_AGREEMENT_TOL",
             OSQP_AGREEMENT_TOL,
             osqp.agreement,
-            "the issue's stated requirement (1e-7); not yet tightened",
+            "the issue's stated requirement (1e-7), kept as the outer contract; the check that \
+             can fail is the per-run bound of the next row",
+        ),
+        (
+            "OSQP |u − u_exact| / (steps · (AGREEMENT_ULPS_PER_STEP ε max|u| + audited ‖C⁻¹ρ‖∞))",
+            1.0,
+            osqp.agreement_ratio,
+            "a posteriori: two backward-stable solves per step, plus OSQP's own residual, \
+             accumulated linearly",
         ),
         (
             "PENALTY_LAW_TOL",
@@ -328,7 +336,16 @@ pub fn measured() -> Result<Vec<Measured>, RunError> {
         });
     }
     let (mass_sum, _) = mass_sum_worst();
-    let solve = ldlt_family_worst();
+    let (solve, _) = ldlt_family_worst();
+    let too_few = |e: crate::bar::matrices::TooFewElements| {
+        invalid(
+            "mesh.elements",
+            e.to_string(),
+            "enough for the mass variant",
+        )
+    };
+    let variants = mass_variant_worst().map_err(too_few)?;
+    let (entries, _) = documented_entries_worst().map_err(too_few)?;
     let (resting, _) = resting_bar_worst()?;
     let start = start_energy_errors()?
         .iter()
@@ -343,12 +360,35 @@ pub fn measured() -> Result<Vec<Measured>, RunError> {
             "sums of J + 2 rounded entries, J up to 1000",
         ),
         (
-            "SOLVE_TOL",
+            "SOLVE_ULPS: |x̂ − x|∞ / (SOLVE_ULPS ε ‖A‖∞ ‖x‖₂ / λ_min)",
             "tests/matrices.rs",
-            SOLVE_TOL,
+            1.0,
             solve,
-            "LDLᵀ on 78 SPD tridiagonal systems, |x| ≤ 1: an a-priori κ ε bound (κ < 1e3), \
-             not yet tightened to the family's own κ",
+            "LDLᵀ on 78 SPD tridiagonal systems: Higham's backward error 4u|A| plus forming \
+             b = Ax, times each system's own ‖A⁻¹‖₂",
+        ),
+        (
+            "VARIANT_SUM_TOL",
+            "tests/matrices.rs",
+            VARIANT_SUM_TOL,
+            variants.sum,
+            "1ᵀM1 and xᵀM1 of every mass variant, J + 2 rounded entries, J up to 1000",
+        ),
+        (
+            "EIGEN_TOL_ULPS (units of ε‖M‖∞)",
+            "tests/matrices.rs",
+            EIGEN_TOL_ULPS,
+            variants.kernel_ulps,
+            "exactly 0: the massless nodes' rows and columns are exactly 0 (asserted \
+             bitwise), which the dense QR keeps apart; the bound is its backward error had they \
+             not been (n ≤ 65)",
+        ),
+        (
+            "ENTRY_TOL",
+            "tests/matrices.rs",
+            ENTRY_TOL,
+            entries,
+            "lumped and redistributed entries at Δx = 0.1 against the documented ones",
         ),
         (
             "RESTING_TOL",
@@ -364,6 +404,59 @@ pub fn measured() -> Result<Vec<Measured>, RunError> {
             START_ENERGY_ERROR_PER_DX,
             start,
             "first order in dx (the kink of u0): a regression bound",
+        ),
+    ] {
+        v.push(Measured {
+            name: name.into(),
+            used_in,
+            tolerance,
+            worst,
+            note,
+        });
+    }
+    let start_worst = start_up_motion()?
+        .iter()
+        .filter(|(mass, _, _)| *mass == MassVariant::Redistributed)
+        .map(|&(_, moved, scale)| moved / scale)
+        .fold(0.0, f64::max);
+    for (name, used_in, tolerance, worst, note) in [
+        (
+            "DROP_TOL",
+            "tests/mass.rs",
+            DROP_TOL,
+            mass_study_drop_worst()?,
+            "impact at α = 0, every mass variant and level: sums over a few hundred steps",
+        ),
+        (
+            "START_TOL",
+            "tests/mass.rs",
+            START_TOL,
+            start_worst,
+            "measured exactly 0: the massless end's projected first step comes out with the \
+             bits of w = 0 (not shown to be 0 by construction; the bound keeps the solve's \
+             round-off room)",
+        ),
+        (
+            "RELEASE_TOL",
+            "tests/episodes.rs",
+            RELEASE_TOL,
+            release_errors()?.into_iter().fold(0.0, f64::max),
+            "impact's release time at 100, 200, 400 elements; 0.02 at the coarsest",
+        ),
+        (
+            "SEPARATION_TOL",
+            "tests/loads.rs",
+            SEPARATION_TOL,
+            separation_worst()?,
+            "six fixed separable loads at three steps (the test draws more at random): the \
+             regrouped sum's roundings",
+        ),
+        (
+            "ENERGY_ROUNDOFF_TOL",
+            "tests/diagnostics.rs",
+            ENERGY_ROUNDOFF_TOL,
+            thinned_energy_worst()?,
+            "every built-in scene, energies recomputed after thinned steps: round-off of E",
         ),
     ] {
         v.push(Measured {
@@ -606,6 +699,27 @@ fn reason(name: &str, file: &str) -> &'static str {
             "a count of roundings in the stiff matrix's a-posteriori bounds, not a tolerance \
              compared with a measured value (the bounds it enters are measured by the checks above)"
         }
+        ("X_ROUNDING_TOL", _) => {
+            "exactly 0 by construction where it is checked: the written x is rounded to 12 \
+             significant digits and the bar's length L = 1 has fewer, so the last node's J·Δx \
+             (within an ulp of 1) is written as 1 exactly (measured 0)"
+        }
+        ("EQUAL_ERROR_RTOL", _) => {
+            "not measured yet: one-sided (exact's L2 error ≤ OSQP's · (1 + tol)) on the \
+             converge study; by the triangle inequality the errors differ by at most \
+             ‖u_exact − u_osqp‖, which osqp_agreement_bound bounds per run, but the study's rows \
+             do not expose that distance; its ratio would be far below 1e-3"
+        }
+        ("AGREEMENT_TOL" | "EXACT_KKT_TOL", _) => {
+            "not measured yet: proptests on random SPD tridiagonal problems (κ < 1e4); the \
+             registry needs a seeded sample of the same generator and a bound in the problem's \
+             own ε ‖C‖ (its ratio would be far below 1e-3)"
+        }
+        ("DENSE_INVERSE_TOL", _) => {
+            "not measured yet: a slack on a proven inequality, checked on random dense \
+             inverses; what it guards, ‖A⁻¹‖/κ − 1, is negative unless the inequality is tight, \
+             where the dense LU's n ε κ(A) applies (its ratio would be far below 1e-3)"
+        }
         _ if name.contains("BAND") || name.contains("ORDER") => {
             "a two-sided band around a measured order (VERIFICATION.md gives the measured order)"
         }
@@ -776,8 +890,27 @@ pub const OSQP_REACTION_TOL: f64 = AUDIT_MARGIN * OSQP_DEFAULT_EPS * 1e3;
 /// Penalty law `ε r = max(0, −gap)` in the recorded gap `u^{n+1} + a`: rounding of
 /// `u^n + z + a` (each below 3 in magnitude) on top of the solver's own round-off.
 pub const PENALTY_LAW_TOL: f64 = 1e-14;
-/// OSQP against exact, max over nodes and steps of the displacement: the issue's requirement.
+/// OSQP against exact, max over nodes and steps of the displacement: the issue's requirement,
+/// kept as the outer contract; the check that can fail is [`osqp_agreement_bound`].
 pub const OSQP_AGREEMENT_TOL: f64 = 1e-7;
+/// Per step, in units of `ε max |u|`: how far two solves of one step's active-set system may
+/// differ (exact's LDLᵀ and polished OSQP's KKT solve, both backward stable, κ(C) of a few at
+/// Δt ≈ Δx; measured up to 2.5 on the built-in scenes).
+pub const AGREEMENT_ULPS_PER_STEP: f64 = 16.0;
+
+/// The agreement bound of one OSQP run, a posteriori: per step, the two solves' round-off
+/// [`AGREEMENT_ULPS_PER_STEP`] `ε max |u|` plus OSQP's own audited stationarity residual in
+/// displacement (`‖C⁻¹ρ‖∞`, the step's error for its active set), accumulated linearly over the
+/// steps (the scheme is stable: it does not amplify a perturbation). 0 without an audit (an
+/// OSQP run always audits: any difference then fails).
+pub fn osqp_agreement_bound(cmp: &Comparison) -> f64 {
+    let Some(audit) = cmp.summary.audit.as_ref() else {
+        return 0.0;
+    };
+    let per_step = AGREEMENT_ULPS_PER_STEP * f64::EPSILON * cmp.agreement.max_displacement
+        + audit.stationarity_displacement.max;
+    cmp.agreement.steps as f64 * per_step
+}
 
 /// The OSQP identity tolerance of one run, a posteriori: the run's own worst stationarity
 /// residual over the audit's tolerance scales the a-priori [`OSQP_IDENTITY_TOL`] (the identity
@@ -827,6 +960,8 @@ pub struct SolverWorst {
     pub law: f64,
     /// `max |u − u_exact|` over nodes and steps.
     pub agreement: f64,
+    /// OSQP: that over the run's [`osqp_agreement_bound`].
+    pub agreement_ratio: f64,
 }
 
 impl SolverWorst {
@@ -838,6 +973,7 @@ impl SolverWorst {
             complementarity_ratio: self.complementarity_ratio.max(o.complementarity_ratio),
             law: self.law.max(o.law),
             agreement: self.agreement.max(o.agreement),
+            agreement_ratio: self.agreement_ratio.max(o.agreement_ratio),
         }
     }
 }
@@ -855,6 +991,17 @@ pub fn solver_worst(scene: &Scene, cmp: &Comparison) -> SolverWorst {
         agreement: cmp.agreement.max_difference,
         ..SolverWorst::default()
     };
+    if method == SolverMethod::Osqp {
+        let bound = osqp_agreement_bound(cmp);
+        let difference = cmp.agreement.max_difference;
+        w.agreement_ratio = if bound > 0.0 {
+            difference / bound
+        } else if difference > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        };
+    }
     let mut max_reaction = 0.0f64;
     for r in &cmp.records {
         w.identity_ratio = w.identity_ratio.max(r.identity_residual / identity_tol);
@@ -1126,6 +1273,200 @@ pub fn impact_contact_errors() -> Result<(usize, f64, f64), RunError> {
     Ok((intervals.len(), time_error, mean_error))
 }
 
+// ---- tests/mass.rs, tests/episodes.rs, tests/diagnostics.rs ------------------------------------
+
+/// `E before − E after` against the summed contact term on `impact` at α = 0 (no load, no
+/// viscosity: the identity makes them equal): round-off of a few hundred steps' sums.
+pub const DROP_TOL: f64 = 1e-12;
+
+/// The mass study's rows on `impact` at α = 0: the worst `|energy drop − contact term|`.
+pub fn drop_worst(rows: &[crate::study::mass_variants::MassRow]) -> f64 {
+    rows.iter()
+        .filter(|r| r.scene == "impact" && r.alpha == 0.0)
+        .map(|r| (r.energy_drop - r.contact_dissipation).abs())
+        .fold(0.0, f64::max)
+}
+
+/// [`drop_worst`] of a fresh mass study (a few seconds).
+pub fn mass_study_drop_worst() -> Result<f64, RunError> {
+    use crate::study::mass_variants::{MassStudyError, mass_study};
+    let rows = mass_study().map_err(|e| match e {
+        MassStudyError::Run(r) => r,
+        other => invalid(
+            "mass study",
+            other.to_string(),
+            "a complete contact episode",
+        ),
+    })?;
+    Ok(drop_worst(&rows))
+}
+
+/// The redistributed mass's massless end after the start-up, relative to the bar's largest
+/// first step: `z = C⁻¹(C w) = w` up to the solve's round-off, a few ε κ(C) with κ(C) about
+/// 10 here.
+pub const START_TOL: f64 = 1e-14;
+
+/// `one-end` (at rest in the shape `0.3 cos 2x`) with each mass variant: `(variant, |u¹₀ − u⁰₀|,
+/// max_i |u¹_i − u⁰_i|)`, the first step of the left end and of the bar.
+pub fn start_up_motion() -> Result<Vec<(MassVariant, f64, f64)>, RunError> {
+    let mut out = Vec::new();
+    for mass in MassVariant::ALL {
+        let (_, scene) = scene::load("one-end", &[format!("bar.mass={}", mass.name())])?;
+        let sim = crate::time::simulation::Simulation::new(&scene)?;
+        let (u0, _) = sim.initial_state();
+        let u1 = sim.displacement();
+        let moved = (u1[0] - u0[0]).abs();
+        let scale = u1
+            .iter()
+            .zip(&u0)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        out.push((mass, moved, scale));
+    }
+    Ok(out)
+}
+
+/// The release time of `impact` (exact 2.1) at Δx = 0.01, 0.005, 0.0025 (Δt = Δx): the
+/// contact-time error is 0.02 on the coarsest of them (VERIFICATION.md), a quarter more.
+pub const RELEASE_TOL: f64 = 0.025;
+/// The meshes of `tests/episodes.rs`'s impact check.
+pub const RELEASE_ELEMENTS: [u64; 3] = [100, 200, 400];
+
+/// The release time's error of an `impact` contact episode, `|end − 2.1|`.
+pub fn release_error(e: &crate::time::ContactEpisode) -> f64 {
+    (e.end - 2.1).abs()
+}
+
+/// [`release_error`] of each of `impact`'s left-end contact episodes at [`RELEASE_ELEMENTS`].
+pub fn release_errors() -> Result<Vec<f64>, RunError> {
+    let mut out = Vec::new();
+    for elements in RELEASE_ELEMENTS {
+        let (_, scene) = scene::load(
+            "impact",
+            &[
+                format!("mesh.elements={elements}"),
+                format!("time.step={}", 1.0 / elements as f64),
+            ],
+        )?;
+        let (_, summary, _) = run_in_memory("impact", &scene)?;
+        for e in summary.contact_episodes.get("left").into_iter().flatten() {
+            out.push(release_error(e));
+        }
+    }
+    Ok(out)
+}
+
+/// A measured energy after unmeasured steps is computed from `u^{n−1} = u^n − w` rather than
+/// carried over: it differs from the every-step value by round-off in `E`, relative to
+/// `max(E, 1)`.
+pub const ENERGY_ROUNDOFF_TOL: f64 = 1e-13;
+/// The thinning of `tests/diagnostics.rs` (`output.diagnostics_every`).
+pub const THINNING: u64 = 7;
+
+/// `|E_every − E_thinned| / max(E_every, 1)`, the quantity [`ENERGY_ROUNDOFF_TOL`] bounds.
+pub fn thinned_energy_error(every: f64, thinned: f64) -> f64 {
+    (every - thinned).abs() / every.max(1.0)
+}
+
+/// [`thinned_energy_error`] over every built-in scene's measured steps, thinned by
+/// [`THINNING`] against every step.
+pub fn thinned_energy_worst() -> Result<f64, RunError> {
+    use crate::time::simulation::Simulation;
+    let mut worst = 0.0f64;
+    for name in builtin_names() {
+        let (_, every) = scene::load(name, &[])?;
+        let (_, thinned) = scene::load(name, &[format!("output.diagnostics_every={THINNING}")])?;
+        let (mut a, mut b) = (Simulation::new(&every)?, Simulation::new(&thinned)?);
+        for _ in 1..every.steps() {
+            let (ra, rb) = (a.step()?, b.step()?);
+            if rb.measured {
+                worst = worst.max(thinned_energy_error(ra.energy, rb.energy));
+            }
+        }
+    }
+    Ok(worst)
+}
+
+// ---- tests/loads.rs ---------------------------------------------------------------------------
+
+/// The separated load path against the plain one, relative to `Σ_k |f_k| M|g_k| + M|l|`: the
+/// split regroups at most `MAX_TERMS` = 8 terms, each combined by at most a few roundings along
+/// the sums and products of the tree (the regrouped sum may cancel where the tree did not).
+pub const SEPARATION_TOL: f64 = 64.0 * f64::EPSILON;
+/// Elements of the loads' comparison (`modal` with `Δt = Δx`).
+pub const LOAD_ELEMENTS: u64 = 40;
+/// Separable loads of the registry's measurement: the talk's two and sums, products and
+/// quotients of the generator's factors (`tests/loads.rs` draws more at random).
+pub const SEPARABLE_LOADS: [&str; 6] = [
+    "sin(t*sqrt(2))*cos(2*x)",
+    "-0.5 + 0.8*sin(3*t)*cos(pi*x/2)",
+    "(sin(1.3*x) + exp(-0.7*t))*(cos(2.1*t) - x)",
+    "((1 + x^2)/(1.5 + x))/(2 + cos(0.9*t)) - sin(2.5*t)*exp(-1.1*x)",
+    "(t - sin(0.6*x))*(x + cos(1.7*t)) + 2.2*(1 + t^2)/(0.8 + t)",
+    "-((exp(-2*x) - t)*(sin(0.5*t) + x)) + cos(2.9*x)",
+];
+
+/// The load vector at step `n` of `modal` with load `text` ([`LOAD_ELEMENTS`]): the
+/// simulation's (separated where it can) and the plain `M l(x, t)`, and the scale
+/// `Σ_k |f_k(t)| M|g_k| + M|l|` of the separation's round-off.
+pub fn load_vectors(text: &str, n: usize) -> Result<[Vec<f64>; 3], RunError> {
+    use crate::bar::matrices::{MatrixVariant, mass};
+    use crate::scene::Expression;
+    let (_, scene) = scene::load(
+        "modal",
+        &[
+            format!("load.density=\"{text}\""),
+            format!("mesh.elements={LOAD_ELEMENTS}"),
+            format!("time.step={}", 1.0 / LOAD_ELEMENTS as f64),
+        ],
+    )?;
+    let mut sim = crate::time::simulation::Simulation::new(&scene)?;
+    let disc = sim.discretisation().clone();
+    let t = n as f64 * disc.dt;
+    let fast = sim.load_vector(n)?.to_vec();
+    let expr = Expression::parse("load.density", text, true)?;
+    let eval = |e: &Expression, x: f64, t: f64| -> Result<f64, RunError> { Ok(e.eval(x, t)?) };
+    let m = mass(MatrixVariant::Consistent, disc.nodes, disc.dx);
+    let xs: Vec<f64> = (0..disc.nodes).map(|i| disc.x(i)).collect();
+    let l = xs
+        .iter()
+        .map(|&x| eval(&expr, x, t))
+        .collect::<Result<Vec<f64>, RunError>>()?;
+    let plain = m.mul(&l);
+    let mut scale = m.mul(&l.iter().map(|v| v.abs()).collect::<Vec<_>>());
+    for term in expr.separate().unwrap_or_default() {
+        let f = eval(&term.time, 0.0, t)?.abs();
+        let g = xs
+            .iter()
+            .map(|&x| eval(&term.space, x, 0.0).map(f64::abs))
+            .collect::<Result<Vec<f64>, RunError>>()?;
+        for (s, mg) in scale.iter_mut().zip(m.mul(&g)) {
+            *s += f * mg;
+        }
+    }
+    Ok([fast, plain, scale])
+}
+
+/// `max_i |fast_i − plain_i| / scale_i` of [`load_vectors`] (0 where both are 0).
+pub fn separation_error([fast, plain, scale]: &[Vec<f64>; 3]) -> f64 {
+    (0..fast.len())
+        .map(|i| {
+            let d = (fast[i] - plain[i]).abs();
+            if d == 0.0 { 0.0 } else { d / scale[i] }
+        })
+        .fold(0.0, f64::max)
+}
+
+/// [`separation_error`] over [`SEPARABLE_LOADS`] at steps 0, 17, 79.
+pub fn separation_worst() -> Result<f64, RunError> {
+    let mut worst = 0.0f64;
+    for text in SEPARABLE_LOADS {
+        for n in [0usize, 17, 79] {
+            worst = worst.max(separation_error(&load_vectors(text, n)?));
+        }
+    }
+    Ok(worst)
+}
+
 // ---- tests/roundoff.rs ------------------------------------------------------------------------
 
 /// Drift allowed for the increment form on the rigid mode (`verify::rigid_drift`): a few
@@ -1166,15 +1507,19 @@ pub fn mass_sum_worst() -> (f64, f64) {
     (worst, smallest_printed)
 }
 
-/// Backward-stable solve on SPD tridiagonal matrices of condition number below 1e3: `x` of
-/// size ≤ 1 to a few ε κ.
-pub const SOLVE_TOL: f64 = 1e-12;
+/// Forward error of the solve in units of `ε ‖A‖∞ ‖x‖₂ / λ_min(A)` (the family's own κ): LDLᵀ
+/// with its substitutions is backward stable with `|ΔA| ≤ 4u |L||D||Lᵀ| = 4u |A|` on SPD
+/// tridiagonal matrices (Higham, *Accuracy and Stability*, Thm 9.14; `D > 0`), forming
+/// `b = A x` adds `γ₃ |A||x|`, and `‖|A|‖₂ ≤ ‖A‖∞`: `7u = 3.5ε`, rounded up.
+pub const SOLVE_ULPS: f64 = 4.0;
 
 /// `Ldlt` on the family of `tests/matrices.rs` (n = 1 … 39, two shifts, off-diagonals of both
-/// signs, not all diagonally dominant): the worst `|x̂ − x|` with `b = A x`.
-pub fn ldlt_family_worst() -> f64 {
+/// signs, not all diagonally dominant), `b = A x`: the worst `|x̂ − x|∞` over its own bound
+/// `SOLVE_ULPS ε ‖A‖∞ ‖x‖₂ / λ_min(A)` (λ_min by bisection), and the worst `|x̂ − x|∞`.
+pub fn ldlt_family_worst() -> (f64, f64) {
     use crate::linalg::ldlt::Ldlt;
-    let mut worst = 0.0f64;
+    use crate::linalg::spectrum::smallest_eigenvalue_spd;
+    let (mut ratio, mut worst) = (0.0f64, 0.0f64);
     for n in 1..40usize {
         for shift in [0.05, 1.0] {
             let diag: Vec<f64> = (0..n)
@@ -1188,14 +1533,133 @@ pub fn ldlt_family_worst() -> f64 {
             let mut b = a.mul(&x);
             match Ldlt::factor(&a) {
                 Ok(f) => f.solve_in_place(&mut b),
-                Err(_) => return f64::INFINITY, // SPD: a refused factorisation fails the check
+                Err(_) => return (f64::INFINITY, f64::INFINITY), // SPD: a refusal fails
             }
-            for i in 0..n {
-                worst = worst.max((b[i] - x[i]).abs());
+            let lambda_min = smallest_eigenvalue_spd(&a);
+            let x_norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let bound = SOLVE_ULPS * f64::EPSILON * a.inf_norm() * x_norm / lambda_min;
+            let error = (0..n).map(|i| (b[i] - x[i]).abs()).fold(0.0, f64::max);
+            worst = worst.max(error);
+            ratio = ratio.max(if bound > 0.0 {
+                error / bound
+            } else {
+                f64::INFINITY
+            });
+        }
+    }
+    (ratio, worst)
+}
+
+/// `1ᵀM1` and `xᵀM1` of the mass variants sum `J + 2` rounded entries of size Δx (times
+/// x ≤ L): a few ulps of `L` and `L²` per entry, far below the `Δx²/6` a lost moment
+/// correction would leave.
+pub const VARIANT_SUM_TOL: f64 = 1e-12;
+/// A kernel eigenvalue of a mass variant's dense copy (n ≤ 65): the QR algorithm is backward
+/// stable to a few `ε‖M‖`; eigenvalues within this many `ε‖M‖∞` of 0 count as the kernel.
+pub const EIGEN_TOL_ULPS: f64 = 64.0;
+/// An entry of the lumped and redistributed matrices at Δx = 0.1 (entries ≤ 0.2) against its
+/// documented value: one or two roundings of an entry of size 0.2, i.e. a few `ε · 0.2`.
+pub const ENTRY_TOL: f64 = 1e-15;
+/// The bar length of the mass variants' checks.
+pub const VARIANT_LENGTH: f64 = 1.7;
+
+/// Every (variant, Signorini ends, elements) the mass variants' checks build: all element
+/// counts from the least the variant allows to 64, and a long bar.
+pub fn mass_variant_cases() -> Vec<(MassVariant, [bool; 2], usize)> {
+    let mut v = Vec::new();
+    for variant in MassVariant::ALL {
+        for ends in [[false, false], [true, false], [false, true], [true, true]] {
+            let from = match (variant, ends.iter().filter(|e| **e).count()) {
+                (MassVariant::Redistributed, 1) => scene::REDISTRIBUTED_MIN_ELEMENTS_ONE_END,
+                (MassVariant::Redistributed, 2) => scene::REDISTRIBUTED_MIN_ELEMENTS_TWO_ENDS,
+                _ => 1,
+            } as usize;
+            for elements in (from..=64).chain([1000]) {
+                v.push((variant, ends, elements));
             }
         }
     }
-    worst
+    v
+}
+
+/// Worst values over [`mass_variant_cases`] of what the mass variants' tolerances guard.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct VariantWorst {
+    /// `max(|1ᵀM1 − L|/L, |xᵀM1 − L²/2|/(L²/2))`.
+    pub sum: f64,
+    /// The kernel eigenvalues (the massless nodes' count, smallest in magnitude) and the
+    /// negative part of the smallest eigenvalue, in units of `ε‖M‖∞` (dense copies, n ≤ 65).
+    pub kernel_ulps: f64,
+    /// The smallest other eigenvalue in the same units (must exceed [`EIGEN_TOL_ULPS`]).
+    pub smallest_other_ulps: f64,
+}
+
+/// [`VariantWorst`] over [`mass_variant_cases`].
+pub fn mass_variant_worst() -> Result<VariantWorst, crate::bar::matrices::TooFewElements> {
+    use crate::bar::matrices::mass_matrix;
+    let mut w = VariantWorst {
+        smallest_other_ulps: f64::INFINITY,
+        ..VariantWorst::default()
+    };
+    for (variant, ends, elements) in mass_variant_cases() {
+        let nodes = elements + 1;
+        let dx = VARIANT_LENGTH / elements as f64;
+        let m = mass_matrix(variant, ends, nodes, dx)?;
+        let m1 = m.mul(&vec![1.0; nodes]);
+        let total: f64 = m1.iter().sum();
+        let moment: f64 = m1.iter().enumerate().map(|(i, v)| i as f64 * dx * v).sum();
+        let half_square = VARIANT_LENGTH * VARIANT_LENGTH / 2.0;
+        w.sum = w
+            .sum
+            .max((total - VARIANT_LENGTH).abs() / VARIANT_LENGTH)
+            .max((moment - half_square).abs() / half_square);
+        if nodes <= 65 {
+            let unit = f64::EPSILON * m.inf_norm();
+            let mut eig: Vec<f64> = m
+                .to_dense()
+                .symmetric_eigenvalues()
+                .iter()
+                .copied()
+                .collect();
+            eig.sort_by(|a, b| a.abs().total_cmp(&b.abs()));
+            let kernel = if variant == MassVariant::Redistributed {
+                ends.iter().filter(|e| **e).count()
+            } else {
+                0
+            };
+            for e in &eig[..kernel] {
+                w.kernel_ulps = w.kernel_ulps.max(e.abs() / unit);
+            }
+            for e in &eig[kernel..] {
+                w.kernel_ulps = w.kernel_ulps.max(-e / unit);
+                w.smallest_other_ulps = w.smallest_other_ulps.min(e.abs() / unit);
+            }
+        }
+    }
+    Ok(w)
+}
+
+/// The documented entries at 10 elements (Δx = 0.1): lumped `diag(Δx/2, Δx, …, Δx/2)`;
+/// redistributed from a Signorini end at the left, row sums `(0, 2Δx, Δx/2, Δx, Δx)` and
+/// `Δx/2` at the free end, diagonals `11Δx/6` and `Δx/6` at nodes 1 and 2: the worst
+/// `|entry − documented|`, and whether the lumped off-diagonals are exactly 0.
+pub fn documented_entries_worst() -> Result<(f64, bool), crate::bar::matrices::TooFewElements> {
+    use crate::bar::matrices::mass_matrix;
+    let elements = 10;
+    let dx = 1.0 / elements as f64;
+    let l = mass_matrix(MassVariant::Lumped, [true, true], elements + 1, dx)?;
+    let mut pairs = vec![(l.diag[0], dx / 2.0), (l.diag[elements], dx / 2.0)];
+    pairs.extend(l.diag[1..elements].iter().map(|d| (*d, dx)));
+    let r = mass_matrix(MassVariant::Redistributed, [true, false], elements + 1, dx)?;
+    let sums = r.row_sums();
+    for (i, want) in [0.0, 2.0 * dx, dx / 2.0, dx, dx].into_iter().enumerate() {
+        pairs.push((sums[i], want));
+    }
+    pairs.push((sums[elements], dx / 2.0));
+    pairs.push((r.diag[1], 11.0 * dx / 6.0));
+    pairs.push((r.diag[2], dx / 6.0));
+    let worst = pairs.iter().map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    Ok((worst, l.off.iter().all(|e| *e == 0.0)))
 }
 
 /// Normwise backward error of the solve, in units of ε: Gaussian elimination on a tridiagonal
@@ -1315,15 +1779,40 @@ pub const PLANE_ENERGY_RISE_TOL: f64 = 1e-13;
 /// The bar (with and without contact) as a special case of the plane body: the same equations
 /// and LCP, different factorisations: round-off only, relative to max |u| and max r.
 pub const PLANE_BAR_CASE_TOL: f64 = 1e-12;
-/// Penetration and `|r·gap|` of the plane's exact contact solver, relative to the gaps' scale:
-/// the rounding of `u` from a backward-stable solve.
-pub const PLANE_GAP_TOL: f64 = 1e-12;
+/// Penetration and `|r·gap|` of the plane's exact contact solver, relative to the gaps' scale
+/// (and `−dissipation` relative to the energy): the gap `g − u_n` is one subtraction of terms
+/// of that scale after a backward-stable solve that puts `u_n` on `g`: a few ulps, 8 ε.
+pub const PLANE_GAP_TOL: f64 = 8.0 * f64::EPSILON;
 /// Plane exact against OSQP (`eps = 1e-10`, polished), relative to max |u| and max r: the
-/// issue's requirement.
+/// issue's requirement, kept as the outer contract; the check that can fail is
+/// [`plane_osqp_agreement_ratio`].
 pub const PLANE_OSQP_AGREEMENT_TOL: f64 = 1e-7;
-/// Normal compliance at `ε = 1e-6` against the exact run, relative to max |u|: O(ε) plus the
-/// reference's round-off.
-pub const PLANE_PENALTY_AGREEMENT: f64 = 1e-3;
+/// Normal compliance against the exact run: the penetration `ε r` perturbs the motion by up to
+/// twice itself where the wave reflects, and the release delayed by O(ε) can double that again
+/// (the bar's `PENALTY_AGREEMENT_FACTOR`, one contact episode): `|u − u_exact| ≤ 4 ε r_max`.
+pub const PLANE_PENALTY_FACTOR: f64 = 4.0;
+
+/// Plane OSQP against exact over its a-posteriori bound: per step, two backward-stable solves of
+/// the step's active-set system differ by [`AGREEMENT_ULPS_PER_STEP`] ε relative (the bar's
+/// constant; OSQP polished), accumulated linearly over the steps; the worst of the
+/// displacement (relative to max |u|) and the reaction (relative to max r).
+pub fn plane_osqp_agreement_ratio(a: &crate::study::plane_contact::Agreement) -> f64 {
+    let bound = a.steps as f64 * AGREEMENT_ULPS_PER_STEP * f64::EPSILON;
+    let relative = |d: f64, scale: f64| if scale > 0.0 { d / scale } else { d };
+    relative(a.max_u_deviation, a.max_u).max(relative(a.max_reaction_deviation, a.max_reaction))
+        / bound
+}
+
+/// Plane normal compliance at `epsilon` against exact: `max |u − u_exact|` over
+/// `PLANE_PENALTY_FACTOR ε r_max` (`r_max` of the exact run).
+pub fn plane_penalty_ratio(a: &crate::study::plane_contact::Agreement, epsilon: f64) -> f64 {
+    let bound = PLANE_PENALTY_FACTOR * epsilon * a.max_reaction;
+    if bound > 0.0 {
+        a.max_u_deviation / bound
+    } else {
+        f64::INFINITY
+    }
+}
 
 /// Worst values of what the plane tolerances guard, over every plane scene the tests run.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -1338,8 +1827,10 @@ pub struct PlaneWorst {
     pub gap: f64,
     /// OSQP against exact, relative (displacement and reaction).
     pub osqp_agreement: f64,
-    /// Penalty at the smaller ε against exact, relative displacement.
-    pub penalty_agreement: f64,
+    /// That over its bound ([`plane_osqp_agreement_ratio`]).
+    pub osqp_agreement_ratio: f64,
+    /// Penalty at the smaller ε against exact, over its bound ([`plane_penalty_ratio`]).
+    pub penalty_ratio: f64,
 }
 
 fn plane_run_error(e: crate::study::converge::ConvergeError) -> RunError {
@@ -1365,9 +1856,10 @@ pub fn plane_worst() -> Result<PlaneWorst, RunError> {
     };
     let mut w = PlaneWorst::default();
     for (name, scene) in identity_scenes() {
-        let (records, summary, _) = run_plane_in_memory(&name, &scene)
+        let (records, summary, sim) = run_plane_in_memory(&name, &scene)
             .map_err(plane_error)
             .map_err(plane_run_error)?;
+        let sim_has_contact = sim.contact().is_some();
         for r in records.iter().skip(1) {
             w.identity = w.identity.max(r.identity_residual);
         }
@@ -1376,6 +1868,9 @@ pub fn plane_worst() -> Result<PlaneWorst, RunError> {
         }
         for r in &records {
             let c = &r.contact;
+            if sim_has_contact && r.energy > 0.0 {
+                w.gap = w.gap.max(-c.dissipation / r.energy);
+            }
             if c.gap_scale > 0.0 {
                 w.gap = w.gap.max(c.penetration / c.gap_scale);
                 if c.total_reaction > 0.0 {
@@ -1410,6 +1905,7 @@ pub fn plane_worst() -> Result<PlaneWorst, RunError> {
             .osqp_agreement
             .max(a.max_u_deviation / a.max_u)
             .max(a.max_reaction_deviation / a.max_reaction);
+        w.osqp_agreement_ratio = w.osqp_agreement_ratio.max(plane_osqp_agreement_ratio(&a));
         if name == "plane-tilted-drop" {
             let p = agreement(
                 &scene,
@@ -1418,7 +1914,7 @@ pub fn plane_worst() -> Result<PlaneWorst, RunError> {
                 },
             )
             .map_err(plane_run_error)?;
-            w.penalty_agreement = p.max_u_deviation / p.max_u;
+            w.penalty_ratio = plane_penalty_ratio(&p, smallest_epsilon);
         }
     }
     Ok(w)
@@ -1454,21 +1950,30 @@ pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
             "tests/plane_contact.rs, plane_contact_cli.rs",
             PLANE_GAP_TOL,
             w.gap,
-            "round-off of `u` at the active nodes of a backward-stable solve; not yet tightened",
+            "8 ε: the gap's subtraction after a backward-stable solve (also −dissipation / E)",
         ),
         (
             "PLANE_OSQP_AGREEMENT_TOL",
             "tests/plane_contact.rs",
             PLANE_OSQP_AGREEMENT_TOL,
             w.osqp_agreement,
-            "the issue's stated requirement (1e-7); not yet tightened",
+            "the issue's stated requirement (1e-7), kept as the outer contract; the check that \
+             can fail is the per-run bound of the next row",
         ),
         (
-            "PLANE_PENALTY_AGREEMENT",
+            "plane OSQP relative |Δu|, |Δr| / (steps · AGREEMENT_ULPS_PER_STEP ε)",
             "tests/plane_contact.rs",
-            PLANE_PENALTY_AGREEMENT,
-            w.penalty_agreement,
-            "O(ε) at ε = 1e-6 (a regression bound); not yet tightened",
+            1.0,
+            w.osqp_agreement_ratio,
+            "two backward-stable solves per step (OSQP polished), accumulated linearly",
+        ),
+        (
+            "plane penalty |u − u_exact| / (PLANE_PENALTY_FACTOR ε r_max), ε = 1e-6",
+            "tests/plane_contact.rs",
+            1.0,
+            w.penalty_ratio,
+            "the penetration ε r, doubled at a reflection and again by the delayed release \
+             (plane-tilted-drop, one episode)",
         ),
     ];
     Ok(rows
