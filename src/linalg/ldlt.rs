@@ -666,8 +666,11 @@ mod tests {
             assert_eq!(f.inv_twist.to_bits(), inv_twist.to_bits(), "{what}: twist");
         };
         for n in (1usize..=14).chain([100, 101, 1000, 4097]) {
-            for (d, e, end) in [(4.0, 1.0, 2.0), (2.0 + 1e-4, -1.0, 1.0 + 5e-5), (1.0, 0.25, 0.6)]
-            {
+            for (d, e, end) in [
+                (4.0, 1.0, 2.0),
+                (2.0 + 1e-4, -1.0, 1.0 + 5e-5),
+                (1.0, 0.25, 0.6),
+            ] {
                 let mut diag = vec![d; n];
                 if n > 1 {
                     diag[0] = end;
@@ -678,7 +681,11 @@ mod tests {
                 if n > 6 {
                     diag[n / 2] *= 1.5;
                     a = SymTridiag::new(diag.clone(), vec![e; n - 1]);
-                    check(&a, &Ldlt::factor(&a).unwrap(), &format!("n {n}, d {d}, bump"));
+                    check(
+                        &a,
+                        &Ldlt::factor(&a).unwrap(),
+                        &format!("n {n}, d {d}, bump"),
+                    );
                 }
                 if n > 20 {
                     // Identity rows inside a stationary stretch, on each side of the twist.

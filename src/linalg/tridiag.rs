@@ -21,9 +21,7 @@ fn row_sums(diag: &[f64], off: &[f64]) -> Vec<f64> {
         1 => s.push((0.0 + diag[0]) + 0.0),
         _ => {
             s.push((0.0 + diag[0]) + off[0]);
-            s.extend(
-                (off.windows(2).zip(&diag[1..n - 1])).map(|(lr, d)| (lr[0] + d) + lr[1]),
-            );
+            s.extend((off.windows(2).zip(&diag[1..n - 1])).map(|(lr, d)| (lr[0] + d) + lr[1]));
             s.push((off[n - 2] + diag[n - 1]) + 0.0);
         }
     }

@@ -344,7 +344,9 @@ impl XFields {
     /// The texts, unpadded.
     fn texts(&self) -> Vec<Vec<u8>> {
         fn unpadded<const W: usize>(xs: &[([u8; W], u8)]) -> Vec<Vec<u8>> {
-            xs.iter().map(|(f, len)| f[..usize::from(*len)].to_vec()).collect()
+            xs.iter()
+                .map(|(f, len)| f[..usize::from(*len)].to_vec())
+                .collect()
         }
         match self {
             Self::Narrow(xs) => unpadded(xs),
