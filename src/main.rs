@@ -20,7 +20,8 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Run a scene, bar or plane (built-in name or TOML file), and write summary.json,
-    /// history.csv and displacement.csv.
+    /// history.csv and displacement.csv (a bar scene with `[output] format = "npy"`:
+    /// displacement.npy).
     Run {
         /// A built-in scene (a name from `viscobar scenes`) or the path of a TOML scene file.
         scene: String,
@@ -363,12 +364,13 @@ fn run_any(name: &str, out: Option<PathBuf>, set: &[String], figure: bool) -> Re
             let summary = viscobar::plane::run::run_plane_to_dir(&scene_name, &plane, &out)
                 .map_err(|e| fail(e.to_string(), e.exit_code()))?;
             println!(
-                "{}: {} steps of {} unknowns ({} nodes) with `{}` in {:.3} s ({:.1} ns per \
-                 unknown-step); max identity residual {:.1e}; results in {}",
+                "{}: {} steps of {} unknowns ({} nodes) with `{}` steps and a `{}` factor of C in {:.3} s \
+                 ({:.1} ns per unknown-step); max identity residual {:.1e}; results in {}",
                 summary.scene,
                 summary.steps,
                 summary.unknowns,
                 summary.nodes,
+                summary.method,
                 summary.solver,
                 summary.wall_time_s,
                 summary.ns_per_unknown_step,

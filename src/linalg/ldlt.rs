@@ -83,9 +83,49 @@ impl Value for Cell<f64> {
     }
 }
 
+/// Detects where a factorisation sweep has become stationary. Row `k` of a sweep is a
+/// function of the entries it reads (`inputs`) and of the state the previous row carries (its
+/// multiplier, its odd node's quotients, its reduced off-diagonal). When a row (not the first,
+/// whose pivot has no previous term) leaves the same state as the row before it and the next
+/// row reads the same entries, the next row repeats it bit for bit, and so on by induction: on
+/// a uniform stretch of the matrix, once the pivots have converged, the sweep copies rows
+/// instead of dividing (the same bits, a fraction of the set-up's work).
+#[derive(Default)]
+struct Steady {
+    /// The inputs of the last row computed and the state it left, as bits.
+    inputs: [u64; 5],
+    state: [u64; 5],
+    /// That state equals the one the row before it left, and the row is not the first.
+    repeating: bool,
+}
+
+impl Steady {
+    /// Whether row `k`, reading `inputs`, repeats row `k − 1` (the last row recorded or
+    /// repeated).
+    #[inline(always)]
+    fn repeats(&self, k: usize, inputs: [f64; 5]) -> bool {
+        k >= 2 && self.repeating && inputs.map(f64::to_bits) == self.inputs
+    }
+
+    /// Row `k` computed from `inputs`, leaving `state`.
+    #[inline(always)]
+    fn record(&mut self, k: usize, inputs: [f64; 5], state: [f64; 5]) {
+        let state = state.map(f64::to_bits);
+        self.repeating = k >= 1 && state == self.state;
+        self.inputs = inputs.map(f64::to_bits);
+        self.state = state;
+    }
+}
+
 impl Ldlt {
     pub fn factor(a: &SymTridiag) -> Result<Self, NotPositiveDefinite> {
-        Self::factor_by(a.dim(), |i| a.diag[i], |i| a.off[i], [None, None])
+        Self::factor_by(
+            a.dim(),
+            |i| a.diag[i],
+            |i| a.off[i],
+            (&a.diag, &a.off, &[]),
+            [None, None],
+        )
     }
 
     /// The factorisation of `a` with the rows and columns of `nodes` replaced by identity ones
@@ -147,12 +187,14 @@ impl Ldlt {
                         a.off[i]
                     }
                 },
+                (&a.diag, &a.off, nodes),
                 halves,
             ),
             RowChange::AddToDiagonal(s) => Self::factor_by(
                 n,
                 |i| if changed(i) { a.diag[i] + s } else { a.diag[i] },
                 |i| a.off[i],
+                (&a.diag, &a.off, nodes),
                 halves,
             ),
         }
@@ -160,12 +202,44 @@ impl Ldlt {
 
     /// The factorisation of the matrix with diagonal `d(i)` and off-diagonal `e(i) = A_i,i+1`;
     /// a half given in `reuse` (`[top, bottom]`, computed from the same entries) is taken as is.
+    ///
+    /// `raw = (diag, off, changed)`: `d(i) = diag[i]` and `e(i) = off[i]` except at the rows
+    /// `changed` (`d(c)`, `e(c − 1)`, `e(c)` may differ there), for the stationary stretches'
+    /// fast check.
     fn factor_by(
         n: usize,
         d: impl Fn(usize) -> f64,
         e: impl Fn(usize) -> f64,
+        raw: (&[f64], &[f64], &[usize]),
         reuse: [Option<Arc<Vec<[f64; 5]>>>; 2],
     ) -> Result<Self, NotPositiveDefinite> {
+        let (rd, re, changed) = raw;
+        // Entries `lo..=hi` of the diagonal and the off-diagonal are the arrays' own.
+        let raw_ok = |lo: usize, hi: usize| changed.iter().all(|&c| c < lo || c > hi);
+        let same = |a: f64, b: f64| a.to_bits() == b.to_bits();
+        // Whether top row `r` (r >= 3) reads the entries row `r − 1` read, shifted by two.
+        let top_repeats = |r: usize| {
+            let i = 2 * r;
+            i + 2 < n
+                && raw_ok(i - 3, i + 2)
+                && same(rd[i], rd[i - 2])
+                && same(re[i - 1], re[i - 3])
+                && same(re[i], re[i - 2])
+                && same(re[i + 1], re[i - 1])
+                && same(rd[i + 1], rd[i - 1])
+        };
+        // The same for bottom row `r` against row `r + 1`, swept before it.
+        let bottom_repeats = |r: usize| {
+            let i = 2 * r;
+            i >= 2
+                && i + 3 < n
+                && raw_ok(i - 2, i + 3)
+                && same(rd[i], rd[i + 2])
+                && same(re[i - 2], re[i])
+                && same(re[i - 1], re[i + 1])
+                && same(re[i], re[i + 2])
+                && same(rd[i - 1], rd[i + 1])
+        };
         let [reuse_top, reuse_bottom] = reuse;
         let check = |index: usize, pivot: f64| {
             if pivot > 0.0 && pivot.is_finite() {
@@ -207,11 +281,32 @@ impl Ldlt {
         let top = match reuse_top {
             Some(top) => top,
             None => {
-                let mut top = Vec::with_capacity(twist);
+                let mut top: Vec<[f64; 5]> = Vec::with_capacity(twist);
                 let (mut l_prev, mut odd_prev, mut off_prev) = (0.0, [0.0; 3], 0.0);
-                for r in 0..twist {
+                let mut steady = Steady::default();
+                let mut r = 0;
+                while r < twist {
                     // `2r + 1 < n` for every top row.
                     let i = 2 * r;
+                    let inputs = [
+                        d(i),
+                        if r > 0 { e(i - 1) } else { 0.0 },
+                        e(i),
+                        if i + 2 < n { e(i + 1) } else { f64::NAN },
+                        d(i + 1),
+                    ];
+                    if steady.repeats(r, inputs) {
+                        // Row r repeats row r − 1; so do the rows after it that read the
+                        // same entries (checked on the matrix's own arrays, away from the
+                        // changed rows).
+                        let mut end = r + 1;
+                        while end < twist && top_repeats(end) {
+                            end += 1;
+                        }
+                        top.resize(end, top[r - 1]);
+                        r = end;
+                        continue;
+                    }
                     let cur = odd(r);
                     let mut diag = d(i);
                     if r > 0 {
@@ -228,7 +323,9 @@ impl Ldlt {
                     l_prev = off / p;
                     let [f1, f2, inv_d] = cur;
                     top.push([l_prev, 1.0 / p, f1, f2, inv_d]);
+                    steady.record(r, inputs, [l_prev, f1, f2, inv_d, off]);
                     (odd_prev, off_prev) = (cur, off);
+                    r += 1;
                 }
                 Arc::new(top)
             }
@@ -246,8 +343,28 @@ impl Ldlt {
                     [0.0; 3]
                 };
                 let mut off_next = 0.0;
-                for r in (twist + 1..nu).rev() {
+                let mut steady = Steady::default();
+                // Row `r = ν − 1 − k`, the `k`-th of the sweep.
+                let mut k = 0;
+                while k + twist + 1 < nu {
+                    let r = nu - 1 - k;
                     let i = 2 * r;
+                    let inputs = [
+                        d(i),
+                        e(i - 2),
+                        e(i - 1),
+                        if i + 1 < n { e(i) } else { f64::NAN },
+                        d(i - 1),
+                    ];
+                    if steady.repeats(k, inputs) {
+                        let mut end = k + 1;
+                        while end + twist + 1 < nu && bottom_repeats(nu - 1 - end) {
+                            end += 1;
+                        }
+                        bottom.resize(end, bottom[k - 1]);
+                        k = end;
+                        continue;
+                    }
                     let lo = odd(r - 1);
                     let mut diag = d(i);
                     diag -= e(i - 1) * lo[1];
@@ -264,7 +381,9 @@ impl Ldlt {
                     l_next = off / p;
                     let [f1, f2, inv_d] = lo;
                     bottom.push([l_next, 1.0 / p, f1, f2, inv_d]);
+                    steady.record(k, inputs, [l_next, f1, f2, inv_d, off]);
                     (odd_next, off_next) = (lo, off);
+                    k += 1;
                 }
                 Arc::new(bottom)
             }
@@ -531,6 +650,79 @@ mod tests {
             assert_eq!(bits(&f.top), bits(&top), "n {n}: top");
             assert_eq!(bits(&f.bottom), bits(&bottom), "n {n}: bottom");
             assert_eq!(f.inv_twist.to_bits(), inv_twist.to_bits(), "n {n}: twist");
+        }
+    }
+
+    /// On matrices whose interior is uniform (where the sweeps become stationary and copy
+    /// rows), also with a bump in the middle, identity rows or a shifted diagonal at the ends,
+    /// and a step-matrix-like stiff case that converges slowly: the bits of the formulas.
+    #[test]
+    fn stationary_sweeps_equal_the_formulas_bit_for_bit() {
+        let bits = |h: &[[f64; 5]]| h.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let check = |a: &SymTridiag, f: &Ldlt, what: &str| {
+            let (top, bottom, inv_twist) = by_the_formulas(a);
+            assert_eq!(bits(&f.top), bits(&top), "{what}: top");
+            assert_eq!(bits(&f.bottom), bits(&bottom), "{what}: bottom");
+            assert_eq!(f.inv_twist.to_bits(), inv_twist.to_bits(), "{what}: twist");
+        };
+        for n in (1usize..=14).chain([100, 101, 1000, 4097]) {
+            for (d, e, end) in [
+                (4.0, 1.0, 2.0),
+                (2.0 + 1e-4, -1.0, 1.0 + 5e-5),
+                (1.0, 0.25, 0.6),
+            ] {
+                let mut diag = vec![d; n];
+                if n > 1 {
+                    diag[0] = end;
+                    diag[n - 1] = end;
+                }
+                let mut a = SymTridiag::new(diag.clone(), vec![e; n.saturating_sub(1)]);
+                check(&a, &Ldlt::factor(&a).unwrap(), &format!("n {n}, d {d}"));
+                if n > 6 {
+                    diag[n / 2] *= 1.5;
+                    a = SymTridiag::new(diag.clone(), vec![e; n - 1]);
+                    check(
+                        &a,
+                        &Ldlt::factor(&a).unwrap(),
+                        &format!("n {n}, d {d}, bump"),
+                    );
+                }
+                if n > 20 {
+                    // Identity rows inside a stationary stretch, on each side of the twist.
+                    let inner = [n / 3, n / 2 + 3];
+                    let (mut di, mut off) = (diag.clone(), vec![e; n - 1]);
+                    for c in inner {
+                        (di[c], off[c - 1], off[c]) = (1.0, 0.0, 0.0);
+                    }
+                    let f = Ldlt::factor_with_rows_changed(&a, &inner, RowChange::Identity, &[])
+                        .unwrap();
+                    check(&SymTridiag::new(di, off), &f, &format!("n {n}, inner"));
+                }
+                if n >= 2 {
+                    let ends = [0, n - 1];
+                    let mut di = diag.clone();
+                    let mut off = vec![e; n - 1];
+                    (di[0], di[n - 1], off[0], off[n - 2]) = (1.0, 1.0, 0.0, 0.0);
+                    let f = Ldlt::factor_with_rows_changed(&a, &ends, RowChange::Identity, &[])
+                        .unwrap();
+                    check(&SymTridiag::new(di, off), &f, &format!("n {n}, identity"));
+                    let mut ds = diag.clone();
+                    ds[0] += 3.0;
+                    ds[n - 1] += 3.0;
+                    let f = Ldlt::factor_with_rows_changed(
+                        &a,
+                        &ends,
+                        RowChange::AddToDiagonal(3.0),
+                        &[],
+                    )
+                    .unwrap();
+                    check(
+                        &SymTridiag::new(ds, vec![e; n - 1]),
+                        &f,
+                        &format!("n {n}, shift"),
+                    );
+                }
+            }
         }
     }
 

@@ -316,8 +316,8 @@ struct ProfileCsv {
     /// The written nodes: every `stride`-th and the last of `nodes`.
     stride: usize,
     nodes: usize,
-    /// Each written node's `x,` padded to [`FIELD_BYTES`], and its length.
-    xs: Vec<([u8; FIELD_BYTES], u8)>,
+    /// Each written node's `x,` padded to a field, and its length.
+    xs: XFields,
     /// Rows whose `t` or `x` text is longer than a field (a time or a bar beyond 1e22, written
     /// in full by `Display`) go through this slow path instead.
     long_fields: bool,
@@ -328,6 +328,32 @@ struct ProfileCsv {
 /// Room for the text of a rounded `t` or `x` and its comma: 12 digits, a point, up to 10
 /// leading zeros (`0.0000000000123456789012,`) and a sign fit.
 const FIELD_BYTES: usize = 32;
+
+/// The field of an `x` text when every one fits it (`3.14140097137,` or `0.000191747598,`
+/// do): half the memory of the wide fields, which a longer text (`0.0000314159265359,`)
+/// switches to.
+const NARROW_FIELD_BYTES: usize = 16;
+
+/// The `x,` texts of the written nodes, padded to fields of one width.
+enum XFields {
+    Narrow(Vec<([u8; NARROW_FIELD_BYTES], u8)>),
+    Wide(Vec<([u8; FIELD_BYTES], u8)>),
+}
+
+impl XFields {
+    /// The texts, unpadded.
+    fn texts(&self) -> Vec<Vec<u8>> {
+        fn unpadded<const W: usize>(xs: &[([u8; W], u8)]) -> Vec<Vec<u8>> {
+            xs.iter()
+                .map(|(f, len)| f[..usize::from(*len)].to_vec())
+                .collect()
+        }
+        match self {
+            Self::Narrow(xs) => unpadded(xs),
+            Self::Wide(xs) => unpadded(xs),
+        }
+    }
+}
 
 impl ProfileCsv {
     fn new(
@@ -342,13 +368,24 @@ impl ProfileCsv {
             push_output_time(disc.x(i), text);
             text.push(b',');
         };
-        let mut xs = Vec::with_capacity(usize::try_from(sampling.nodes_written).unwrap_or(0));
+        let capacity = usize::try_from(sampling.nodes_written).unwrap_or(0);
+        let mut xs = XFields::Narrow(Vec::with_capacity(capacity));
         let mut long_fields = false;
         let mut text = Vec::with_capacity(FIELD_BYTES);
         for i in written_nodes(stride, nodes) {
             x_text(i, &mut text);
             long_fields |= text.len() > FIELD_BYTES;
-            xs.push(field(&text));
+            if let XFields::Narrow(narrow) = &xs
+                && text.len() > NARROW_FIELD_BYTES
+            {
+                let mut wide = Vec::with_capacity(capacity);
+                wide.extend(narrow.iter().map(|(f, len)| field(&f[..usize::from(*len)])));
+                xs = XFields::Wide(wide);
+            }
+            match &mut xs {
+                XFields::Narrow(xs) => xs.push(field(&text)),
+                XFields::Wide(xs) => xs.push(field(&text)),
+            }
         }
         let long_xs = if long_fields {
             (written_nodes(stride, nodes).map(|i| {
@@ -384,18 +421,35 @@ impl ProfileCsv {
             return self.write_long(&t_text, values);
         }
         let (t_field, t_len) = field(&t_text);
-        let t_len = usize::from(t_len);
+        let t = (&t_field, usize::from(t_len));
+        // Taken out for the loop (`Vec::new` allocates nothing) and put back.
+        let xs = std::mem::replace(&mut self.xs, XFields::Narrow(Vec::new()));
+        let result = match &xs {
+            XFields::Narrow(xs) => self.rows(t, xs, values),
+            XFields::Wide(xs) => self.rows(t, xs, values),
+        };
+        self.xs = xs;
+        result
+    }
+
+    /// The rows of [`ProfileCsv::write`] with `x` fields of `W` bytes.
+    fn rows<const W: usize>(
+        &mut self,
+        (t_field, t_len): (&[u8; FIELD_BYTES], usize),
+        xs: &[([u8; W], u8)],
+        values: NodeValues<'_>,
+    ) -> std::io::Result<()> {
         let (mut bu, mut bv) = (zmij::Buffer::new(), zmij::Buffer::new());
-        for (i, (x_field, x_len)) in written_nodes(self.stride, self.nodes).zip(&self.xs) {
+        for (i, (x_field, x_len)) in written_nodes(self.stride, self.nodes).zip(xs) {
             let (u, v) = values.at(i);
             if self.len > PROFILE_CHUNK_BYTES - PROFILE_ROW_MAX_BYTES {
                 self.file.write_all(&self.chunk[..self.len])?;
                 self.len = 0;
             }
             let row = &mut self.chunk[self.len..self.len + PROFILE_ROW_MAX_BYTES];
-            row[..FIELD_BYTES].copy_from_slice(&t_field);
+            row[..FIELD_BYTES].copy_from_slice(t_field);
             let mut at = t_len;
-            row[at..at + FIELD_BYTES].copy_from_slice(x_field);
+            row[at..at + W].copy_from_slice(x_field);
             at += usize::from(*x_len);
             let u = bu.format(u).as_bytes();
             row[at..at + u.len()].copy_from_slice(u);
@@ -415,11 +469,7 @@ impl ProfileCsv {
     fn write_long(&mut self, t_text: &[u8], values: NodeValues<'_>) -> std::io::Result<()> {
         if self.long_xs.is_empty() {
             // Only `t` is long: the short `x` texts, unpadded.
-            self.long_xs = self
-                .xs
-                .iter()
-                .map(|(f, len)| f[..usize::from(*len)].to_vec())
-                .collect();
+            self.long_xs = self.xs.texts();
             self.long_fields = true;
         }
         self.file.write_all(&self.chunk[..self.len])?;
@@ -449,9 +499,9 @@ impl ProfileCsv {
 }
 
 /// `text` padded to a field, with its length (`text` no longer than a field).
-fn field(text: &[u8]) -> ([u8; FIELD_BYTES], u8) {
-    let mut f = [0; FIELD_BYTES];
-    let len = text.len().min(FIELD_BYTES);
+fn field<const W: usize>(text: &[u8]) -> ([u8; W], u8) {
+    let mut f = [0; W];
+    let len = text.len().min(W);
     f[..len].copy_from_slice(&text[..len]);
     (f, len as u8)
 }

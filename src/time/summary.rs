@@ -80,7 +80,15 @@ fn floor_log10(a: f64) -> i32 {
 /// most 15 digits, and any other such decimal on its grid is far beyond an ulp away); they
 /// differ only in layout. In Żmij's fixed-point range (`1e-5 <= |t| < 1e16`) the layouts agree
 /// but for Żmij's `.0` on whole numbers, which is dropped; elsewhere `Display` writes the text.
+///
+/// On [`rounded_digits`]' fast path the text is written from the integer digits directly:
+/// the shortest digits of `digits / 10^k` are those digits without their trailing zeros (the
+/// argument above), which `Display` lays out without an exponent.
 pub fn push_output_time(t: f64, out: &mut Vec<u8>) {
+    if let Some((digits, k)) = rounded_digits(t) {
+        push_decimal(digits, k, out);
+        return;
+    }
     let t = output_time(t);
     if t.is_finite() {
         let mut buffer = zmij::Buffer::new();
@@ -91,6 +99,42 @@ pub fn push_output_time(t: f64, out: &mut Vec<u8>) {
         }
     }
     out.extend_from_slice(t.to_string().as_bytes());
+}
+
+/// `digits / 10^k` in plain decimal notation, trailing zeros dropped (`digits != 0`,
+/// `|digits| < 10^15`, so at most 15 digits).
+fn push_decimal(digits: i64, k: u32, out: &mut Vec<u8>) {
+    let (mut m, mut k) = (digits.unsigned_abs(), k as usize);
+    while k > 0 && m.is_multiple_of(10) {
+        m /= 10;
+        k -= 1;
+    }
+    let mut buf = [0u8; 20];
+    let mut start = buf.len();
+    loop {
+        start -= 1;
+        buf[start] = b'0' + (m % 10) as u8;
+        m /= 10;
+        if m == 0 {
+            break;
+        }
+    }
+    let text = &buf[start..];
+    if digits < 0 {
+        out.push(b'-');
+    }
+    if k == 0 {
+        out.extend_from_slice(text);
+    } else if text.len() > k {
+        let (int, frac) = text.split_at(text.len() - k);
+        out.extend_from_slice(int);
+        out.push(b'.');
+        out.extend_from_slice(frac);
+    } else {
+        out.extend_from_slice(b"0.");
+        out.resize(out.len() + (k - text.len()), b'0');
+        out.extend_from_slice(text);
+    }
 }
 
 fn serialize_time<S: serde::Serializer>(t: &f64, s: S) -> Result<S::Ok, S::Error> {
