@@ -20,11 +20,18 @@
 //! `|½ δ·ρ̂|` plus worst-case (first-order, `γ_k`) bounds on every rounding the run made:
 //! of `ρ̂` and `b̂` entry by entry, of the energy sums (`γ_m Σ|terms|`), of the stored
 //! displacements, of the final combination ([`StepTerms::identity_tolerance`]). The
-//! penetration tolerance is the forward error of the inactive unknowns, `C_II⁻¹` applied to
-//! `|ρ̂_I|` plus its rounding (componentwise where `C` is a Stieltjes matrix, bounded above by
-//! `C⁻¹` on I, else through `λ_min(C)`), plus the rounding of the gap and the solver's own law
-//! ([`StepTerms::violation_tolerance`]). The energy drift is checked as the sum of the
-//! steps' signed residuals, which it is by telescoping, up to the rounding of the two sums.
+//! penetration tolerance is taken node by node from what the solver tests on the `z` it
+//! returns: the exact solvers put a node with a reaction on its bound bit for bit and test
+//! (block pivoting, the end enumeration without an active end) or do not test (the end
+//! enumeration with one) the others, so the computed gap can be negative only by the rounding
+//! of the bound and of `û + z` (`γ_2`), plus the block pivoting's tie threshold, or the
+//! forward error on the chosen active set (a solve with `C` pinned there) where the returned
+//! `z` is untested; OSQP and penalty add their law ([`StepTerms::violation_tolerance`]). The
+//! energy drift is the sum of the steps' residuals on the recorded numbers (telescoping); it
+//! is checked against the sum of the steps' absolute identity tolerances plus the rounding of
+//! the two sums ([`SolverRun::drift_tolerance`]), so that its ratio says how much of the
+//! per-step allowance accumulates (the former bound, the signed residuals' sum, was the drift
+//! itself by the same telescoping and could not fail).
 //! A run's figure is its worst step by ratio ([`Worst`]). The distance between solvers keeps
 //! its a-priori `κ(C)` forward-error bound ([`roundoff_distance`]).
 //!
@@ -353,8 +360,18 @@ pub struct SolverRun {
     /// to its a-posteriori tolerance ([`StepTerms`]).
     pub identity: Worst,
     pub violation: Worst,
-    /// The drift's tolerance: the per-step identity tolerances summed (absolute) plus the
-    /// balance's own rounding, over the same scale as `energy_drift`.
+    /// The drift's tolerance, over the same scale as `energy_drift`: the per-step identity
+    /// tolerances summed in units of energy ([`StepTerms::identity_bound`]), plus the rounding
+    /// between the drift and the steps' residuals (each residual's four, the balance's terms
+    /// and running sum, the final difference's two).
+    ///
+    /// Derivation: on the recorded numbers, in exact arithmetic, the residuals
+    /// `E^{n+1/2} − E^{n−1/2} − work + viscous + contact` telescope to the drift
+    /// `E^{N−1/2} − E^{1/2} − Σ (work − viscous − contact)`. Each computed residual is within
+    /// its step's identity tolerance when that check holds and the energy the step carried is
+    /// the recorded one. Not the former bound `|Σ_n signed residuals|`, which is the drift
+    /// itself by the same telescoping (ratio 1, a check that could not fail): an energy held
+    /// in single precision passed it on every run.
     pub drift_tolerance: f64,
 }
 
@@ -585,20 +602,18 @@ pub struct StepTerms {
     pub stored_rounding: f64,
     /// `|E^{n+1/2}| + |E^{n−1/2}| + |work| + viscous + |contact|`: the final four sums.
     pub combination: f64,
-    /// `max(0, −(û_j + a_j))` over the constrained nodes.
+    /// The penetration `max(0, −(û^{n+1}_j + a_j))` at the constrained node whose ratio to its
+    /// own tolerance is the largest (the three terms below are that node's).
     pub violation: f64,
-    /// Forward error of the inactive constrained unknowns: `max_j (C_II⁻¹ (|ρ̂_I| + f_I))_j`,
-    /// bounded by `max_j (C⁻¹ v)_j` with `v = |ρ̂_I| + f_I` on I and 0 on A (for a Stieltjes
-    /// matrix `(C⁻¹)_II >= C_II⁻¹ >= 0` entrywise, by the Schur complement), where `C` is a
-    /// Stieltjes matrix (`Δt >= Δx/√3` or so), else `‖|ρ̂_I| + f_I‖₂ / λ_min(C)`
-    /// with `λ_min` lowered by the bisection's error bound
-    /// ([`crate::linalg::spectrum::reference::STURM_ERROR_ULPS`]); `f` here is the rounding
-    /// of `ρ̂` alone.
-    pub forward: f64,
-    /// `2u max_j (|lower_j| + |z_j| + |û^{n+1}_j| + |a_j|)`: forming the bound, `u + z`, the gap.
+    /// `γ_2 (|lo_j| + |û^{n+1}_j|)`: the rounding of the bound and of the stored displacement
+    /// ([`GAP_ROUNDINGS`]).
     pub gap_rounding: f64,
-    /// `max_j r_j` of this step.
-    pub max_reaction: f64,
+    /// What the solver's acceptance test lets the `z` it returns fall below `lo_j` at a node
+    /// without a reaction (0 at nodes with one, where `z_j = lo_j` exactly): the block-pivoting
+    /// solver's tie threshold, or the end enumeration's forward error on its active set.
+    pub allowance: f64,
+    /// The solver's own law ([`violation_law`]): 0 for the exact solvers.
+    pub law: f64,
 }
 
 impl StepTerms {
@@ -618,32 +633,78 @@ impl StepTerms {
         if self.scale <= 0.0 {
             return 0.0;
         }
+        self.identity_bound() / self.scale
+    }
+
+    /// The identity tolerance in units of energy (`identity_tolerance · scale`, formed before
+    /// the division): what the energy drift sums ([`SolverRun::drift_tolerance`]).
+    pub fn identity_bound(&self) -> f64 {
+        if self.scale <= 0.0 {
+            return 0.0;
+        }
         let k = self.sum_len.max(1) as f64 + SUM_TERM_ROUNDINGS;
-        let abs = self.rho_dot
+        self.rho_dot
             + self.floor_rho_abs
             + sum_rounding(k, self.sum_terms)
             + self.stored_rounding
-            + COMBINATION_ROUNDINGS * UNIT_ROUNDOFF * self.combination;
-        abs / self.scale
+            + COMBINATION_ROUNDINGS * UNIT_ROUNDOFF * self.combination
     }
 
-    /// The penetration tolerance of this step for `solver`: what the forward error of the
-    /// inactive unknowns and the rounding of the gap can leave, plus the solver's own law
-    /// (penalty: `ε r`; OSQP: its audited primal tolerance).
+    /// The penetration tolerance of this step at its worst node: the gap's rounding, the
+    /// solver's allowance and its law, `gap_rounding + allowance + law`, each derived from
+    /// what the solver tests on the `z` it returns.
     ///
-    /// Penalty: (PP) penetrates by `ε r` by design; `z_j = z⁰_j + Σ S_jk r_k` is rounded to
-    /// ulps of `|z⁰_j| <= |z_j| + S_jj r` (`s_max` the largest `S_jj`, as in the audit's
-    /// penalty-law floor).
-    pub fn violation_tolerance(&self, solver: &str, scale: f64, s_max: f64) -> f64 {
-        let law = match solver {
-            "exact" => 0.0,
-            "osqp" => AUDIT_MARGIN * OSQP_DEFAULT_EPS * (1.0 + scale),
-            _ => {
-                let eps_r = epsilon_of(solver) * self.max_reaction;
-                eps_r + ROUNDOFF_ULPS * f64::EPSILON * (eps_r + s_max * self.max_reaction)
-            }
-        };
-        law + self.forward + self.gap_rounding
+    /// *The gap's rounding.* The simulation forms `lo_j = fl(−a_j − û^n_j)`, stores
+    /// `û^{n+1}_j = fl(û^n_j + z_j)` and measures `fl(û^{n+1}_j + a_j)` (`fill_lower`,
+    /// `fill_contact`). If `z_j >= lo_j`, then `û^n_j + z_j + a_j >= (−a_j − û^n_j) δ_1` and
+    /// `û^{n+1}_j + a_j >= −u (|lo_j| + |û^{n+1}_j|)/(1 − u)`; the last rounding keeps the sign
+    /// and adds a factor `1 + u`, so the computed gap is at least
+    /// `−γ_2 (|lo_j| + |û^{n+1}_j|)` (Higham, Lemma 3.1). No forward error of the solve enters
+    /// it: only whether the returned `z_j >= lo_j` holds.
+    ///
+    /// *The exact solvers' allowance* (`src/step/exact.rs`, `src/step/block_pivot.rs`). At a
+    /// node with a reaction every path writes `z_j = lo_j` bit for bit (`superpose`,
+    /// `superpose_and_add`, `solve_on_active_set`; block pivoting copies `lo` into the active
+    /// runs in `solve_all`): allowance 0. At a node without one:
+    /// - block pivoting accepts an iteration only when no free node has
+    ///   `z_i − lo_i < −TIE_ULPS ε max(max|z|, max|lo|)` (`margin_at`, `select_infeasible`),
+    ///   on the `z` it returns: that threshold is the allowance;
+    /// - the end enumeration with no active end returns `z⁰`, which its candidate `∅` tested
+    ///   as is (`candidate` adds `Σ 0·S_ji` to `z⁰_j`): allowance 0. The warm start also
+    ///   tests the `z` it returns (`solve_on_active_set`'s flag), but with an active end the
+    ///   enumeration tests the Schur value `z⁰_j + Σ r_i S_ji`, not the superposed or
+    ///   re-solved `z` it returns (`resolve` ignores the flag), and the run cannot tell the
+    ///   paths apart: the allowance is then the forward error of `z` against the exact answer
+    ///   on the same active set, `(C_II⁻¹ (|ρ̂_I| + f_I))_j`, a solve with `C` pinned on the
+    ///   active ends (`stiff_runs::forward_on_inactive`). It assumes the chosen set is the
+    ///   exact one: a set chosen wrongly beyond round-off is what this check is there to
+    ///   report.
+    ///
+    /// *The law*: penalty `ε r` (its rounding included), OSQP its audited primal tolerance
+    /// ([`violation_law`]); those solvers' `z` is checked against their law by the audit.
+    pub fn violation_tolerance(&self) -> f64 {
+        self.law + self.allowance + self.gap_rounding
+    }
+}
+
+/// Roundings between the bound and the measured gap: `lo_j = −a_j − û^n_j` and
+/// `û^{n+1}_j = û^n_j + z_j`, each at most `u` times its result (the gap's own rounding keeps
+/// its sign): `γ_2 (|lo_j| + |û^{n+1}_j|)` ([`StepTerms::violation_tolerance`]).
+pub const GAP_ROUNDINGS: f64 = 2.0;
+
+/// The penetration a solver's law allows at step size `max_reaction` (the step's largest
+/// reaction), `scale` the run's largest displacement and `s_max` the largest `(C⁻¹)_jj` at
+/// the ends: 0 for the exact solvers; OSQP its audited primal tolerance; penalty `ε r`, its
+/// `z_j = z⁰_j + Σ S_jk r_k` rounded to ulps of `|z⁰_j| <= |z_j| + S_jj r` (as in the audit's
+/// penalty-law floor).
+pub fn violation_law(solver: &str, max_reaction: f64, scale: f64, s_max: f64) -> f64 {
+    match solver {
+        "exact" => 0.0,
+        "osqp" => AUDIT_MARGIN * OSQP_DEFAULT_EPS * (1.0 + scale),
+        _ => {
+            let eps_r = epsilon_of(solver) * max_reaction;
+            eps_r + ROUNDOFF_ULPS * f64::EPSILON * (eps_r + s_max * max_reaction)
+        }
     }
 }
 
