@@ -107,15 +107,24 @@ impl StepSolver for Traced {
 /// end enumeration puts an active node on its bound exactly, moving `z_j` by its forward error
 /// (up to `κ ε |z|`), which leaves a force residual `C_jj` times that by design. Its image in
 /// displacement, `‖C⁻¹(Cz − b − r)‖`, is checked: that is the error of the answer.
-fn worst_ratio(r: &crate::step::AuditReport) -> f64 {
+fn worst_ratio(r: &crate::step::AuditReport) -> (f64, &'static str) {
     [
-        r.primal_violation.map_or(0.0, |w| w.max_over_tolerance),
-        r.negative_reaction.max_over_tolerance,
-        r.complementarity.map_or(0.0, |w| w.max_over_tolerance),
-        r.stationarity_displacement.max_over_tolerance,
+        (
+            r.primal_violation.map_or(0.0, |w| w.max_over_tolerance),
+            "primal violation",
+        ),
+        (r.negative_reaction.max_over_tolerance, "negative reaction"),
+        (
+            r.complementarity.map_or(0.0, |w| w.max_over_tolerance),
+            "complementarity",
+        ),
+        (
+            r.stationarity_displacement.max_over_tolerance,
+            "stationarity in displacement",
+        ),
     ]
     .into_iter()
-    .fold(0.0, f64::max)
+    .fold((0.0, "none"), |a, b| if b.0 > a.0 { b } else { a })
 }
 
 fn build(case: &Case, method: &str, trace: Rc<RefCell<Trace>>) -> Result<Simulation, RunError> {
@@ -459,6 +468,10 @@ struct Live {
     /// of the drift's per-step rounding bounds.
     allowance_sum: f64,
     drift_rounding: f64,
+    /// `Σ_n` of the steps' residuals on the recorded numbers, signed and absolute (the
+    /// drift's notes: how much of the allowance is used, how much cancels).
+    residual_sum: f64,
+    residual_abs_sum: f64,
     dump: Option<StepTerms>,
     /// The factors of `C` pinned on an active set of ends ([`Penetration::pinned`]).
     pinned: Vec<(u8, Ldlt)>,
@@ -506,6 +519,11 @@ impl Live {
             // This step's rounding between the drift and the steps' computed residuals: the
             // residual's own roundings (its exact value on the recorded numbers telescopes),
             // two of the balance's term and one of its running sum.
+            let residual = r.energy - self.energy_prev - r.work
+                + r.viscous_dissipation
+                + r.contact_dissipation;
+            self.residual_sum += residual;
+            self.residual_abs_sum += residual.abs();
             let combination = r.energy.abs() + self.energy_prev.abs() + size;
             let c = u * (COMBINATION_ROUNDINGS * combination + 2.0 * size + self.balance.abs());
             self.drift_rounding += c;
@@ -579,6 +597,15 @@ impl Live {
             + 2.0
                 * UNIT_ROUNDOFF
                 * (s.energy_final.abs() + s.energy_initial.abs() + self.balance.abs());
+        if self.allowance_sum > 0.0 {
+            o.drift_used = self.residual_abs_sum / self.allowance_sum;
+        }
+        if self.residual_abs_sum > 0.0 {
+            o.drift_cancellation = self.residual_sum.abs() / self.residual_abs_sum;
+        }
+        if let Some(t) = &self.dump {
+            o.identity_dominant = t.dominant_term();
+        }
         (o.energy_drift, o.drift_tolerance) = if scale > 0.0 {
             (drift / scale, bound / scale)
         } else {
@@ -638,6 +665,10 @@ pub fn run_case(case: &Case) -> CaseResult {
                     identity: Worst::default(),
                     violation: Worst::default(),
                     drift_tolerance: 0.0,
+                    drift_used: 0.0,
+                    drift_cancellation: 0.0,
+                    identity_dominant: "none",
+                    audit_worst: "none",
                 },
                 tracker: None,
                 trace: Rc::new(RefCell::new(Trace::default())),
@@ -651,6 +682,8 @@ pub fn run_case(case: &Case) -> CaseResult {
                 balance: 0.0,
                 magnitude: 0.0,
                 allowance_sum: 0.0,
+                residual_sum: 0.0,
+                residual_abs_sum: 0.0,
                 drift_rounding: 0.0,
                 dump: None,
                 pinned: Vec::new(),
@@ -697,8 +730,13 @@ pub fn run_case(case: &Case) -> CaseResult {
         .map(|mut l| {
             l.settle();
             if let Some(sim) = &l.sim {
-                l.out.audit_ratio = (l.out.solver == "exact")
-                    .then(|| sim.solver_report().map_or(0.0, |r| worst_ratio(&r.audit)));
+                if l.out.solver == "exact" {
+                    let (ratio, what) = sim
+                        .solver_report()
+                        .map_or((0.0, "none"), |r| worst_ratio(&r.audit));
+                    l.out.audit_ratio = Some(ratio);
+                    l.out.audit_worst = what;
+                }
                 if case.family == Family::Rigid {
                     let t = sim.time();
                     l.out.rigid_drift = Some(rigid_drift(&l.u, t));
