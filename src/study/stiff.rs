@@ -843,3 +843,45 @@ impl Worst {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The gap as the simulation forms it from `z`: `lo = −a − û^n`, `û^{n+1} = û^n + z`,
+    /// `gap = û^{n+1} + a`; returns `(gap, lo, û^{n+1})`.
+    fn gap_of(a: f64, u: f64, z: f64) -> (f64, f64, f64) {
+        let lo = -a - u;
+        let u1 = u + z;
+        (u1 + a, lo, u1)
+    }
+
+    proptest! {
+        /// [`StepTerms::violation_tolerance`]'s gap rounding: any `z >= lo` leaves a computed
+        /// gap of at least `−γ_2 (|lo| + |û^{n+1}|)`, whatever the sizes of `a`, `û^n` and the
+        /// margin.
+        #[test]
+        fn a_feasible_z_leaves_a_gap_within_its_rounding(
+            a in -1e3f64..1e3,
+            u in -1e6f64..1e6,
+            margin in prop_oneof![Just(0.0), 0.0f64..1e-12, 0.0f64..1.0],
+        ) {
+            let lo = -a - u;
+            let (gap, lo, u1) = gap_of(a, u, lo + margin * lo.abs().max(1.0));
+            let tol = sum_rounding(GAP_ROUNDINGS, lo.abs() + u1.abs());
+            prop_assert!(-gap <= tol, "gap {gap:e}, tolerance {tol:e}");
+        }
+    }
+
+    /// And it is tight enough to see a `z` put 16 ulps of `|lo|` below its bound where `|lo|`
+    /// dominates (the block-pivoting mutation of the stiff matrix).
+    #[test]
+    fn a_z_sixteen_ulps_below_its_bound_exceeds_it() {
+        let (a, u) = (0.3, 212.1);
+        let lo = -a - u;
+        let (gap, lo, u1) = gap_of(a, u, lo - 16.0 * f64::EPSILON * lo.abs());
+        let tol = sum_rounding(GAP_ROUNDINGS, lo.abs() + u1.abs());
+        assert!(-gap > tol, "gap {gap:e}, tolerance {tol:e}");
+    }
+}
