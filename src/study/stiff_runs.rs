@@ -12,11 +12,12 @@ use crate::linalg::norms::{max_abs, max_distance};
 use crate::linalg::spectrum::reference::STURM_ERROR_ULPS;
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::audit::{KktAudit, Law};
+use crate::step::block_pivot::TIE_ULPS;
 use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
 use crate::study::accuracy::rigid_drift;
 use crate::study::stiff::{
-    COMBINATION_ROUNDINGS, Case, CaseResult, Family, RESIDUAL_ROUNDINGS, Size, SolverRun,
-    StepTerms, UNIT_ROUNDOFF, Worst, cases,
+    COMBINATION_ROUNDINGS, Case, CaseResult, Family, GAP_ROUNDINGS, RESIDUAL_ROUNDINGS, Size,
+    SolverRun, StepTerms, UNIT_ROUNDOFF, Worst, cases, sum_rounding, violation_law,
 };
 use crate::time::RunError;
 use crate::time::simulation::StepRecord;
@@ -106,15 +107,24 @@ impl StepSolver for Traced {
 /// end enumeration puts an active node on its bound exactly, moving `z_j` by its forward error
 /// (up to `κ ε |z|`), which leaves a force residual `C_jj` times that by design. Its image in
 /// displacement, `‖C⁻¹(Cz − b − r)‖`, is checked: that is the error of the answer.
-fn worst_ratio(r: &crate::step::AuditReport) -> f64 {
+fn worst_ratio(r: &crate::step::AuditReport) -> (f64, &'static str) {
     [
-        r.primal_violation.map_or(0.0, |w| w.max_over_tolerance),
-        r.negative_reaction.max_over_tolerance,
-        r.complementarity.map_or(0.0, |w| w.max_over_tolerance),
-        r.stationarity_displacement.max_over_tolerance,
+        (
+            r.primal_violation.map_or(0.0, |w| w.max_over_tolerance),
+            "primal violation",
+        ),
+        (r.negative_reaction.max_over_tolerance, "negative reaction"),
+        (
+            r.complementarity.map_or(0.0, |w| w.max_over_tolerance),
+            "complementarity",
+        ),
+        (
+            r.stationarity_displacement.max_over_tolerance,
+            "stationarity in displacement",
+        ),
     ]
     .into_iter()
-    .fold(0.0, f64::max)
+    .fold((0.0, "none"), |a, b| if b.0 > a.0 { b } else { a })
 }
 
 fn build(case: &Case, method: &str, trace: Rc<RefCell<Trace>>) -> Result<Simulation, RunError> {
@@ -199,9 +209,23 @@ fn stored_form(a: &SymTridiag, v: &[f64]) -> f64 {
     q
 }
 
+/// What a run's penetration tolerance needs besides the step's vectors.
+struct Penetration<'a> {
+    solver: &'static str,
+    /// The run's largest displacement so far (OSQP's relative primal tolerance).
+    scale: f64,
+    /// `max_j (C⁻¹)_jj` over the constrained ends (0 with an obstacle): the penalty law.
+    schur_max: f64,
+    /// A lower bound on `λ_min(C)` (the norm bound where `C` is not a Stieltjes matrix).
+    lambda_min: f64,
+    /// The factors of `C` with the rows and columns of an active set of ends replaced by
+    /// identity ones, by mask (at most three per run: computed when first needed).
+    pinned: &'a mut Vec<(u8, Ldlt)>,
+}
+
 /// The a-posteriori quantities of a step (see [`StepTerms`]): `t` the solve's vectors, `u1`,
-/// `u0`, `um` the stored `û^{n+1}, û^n, û^{n−1}` on the unknowns, `force` the step's `F^n`, `e_prev = E^{n−1/2}`,
-/// `lambda_min` a lower bound on `λ_min(C)`.
+/// `u0`, `um` the stored `û^{n+1}, û^n, û^{n−1}` on the unknowns, `force` the step's `F^n`,
+/// `e_prev = E^{n−1/2}`.
 #[allow(clippy::too_many_arguments)]
 fn step_terms(
     d: &Discretisation,
@@ -213,8 +237,7 @@ fn step_terms(
     um: &[f64],
     rec: &StepRecord,
     e_prev: f64,
-    lambda_min: f64,
-    forward_factor: &mut Option<Ldlt>,
+    penetration: &mut Penetration,
 ) -> StepTerms {
     let n = t.z.len();
     let u = UNIT_ROUNDOFF;
@@ -280,70 +303,66 @@ fn step_terms(
         + rec.work.abs()
         + rec.viscous_dissipation
         + rec.contact_dissipation.abs();
-    // Forward error of the inactive unknowns I (all but the constrained ones carrying a
-    // reaction, which the exact solvers put on their bound): the exact answer for the same
-    // `b̂` and active set differs from z by `e`, `e_A = 0`, `C_II e_I = ρ_I`, and
-    // `|ρ_I| <= |ρ̂_I| + f_solve` (the rounding of ρ̂ only: the solver answered `b̂`).
-    let mut active = Vec::new();
-    for (j, &l) in locals.iter().enumerate() {
-        if t.reactions[j] > 0.0 {
-            active.push(l);
+    let solver = penetration.solver;
+    let mut max_reaction = 0.0f64;
+    for &r in &t.reactions {
+        max_reaction = max_reaction.max(r);
+    }
+    let law = violation_law(
+        solver,
+        max_reaction,
+        penetration.scale,
+        penetration.schur_max,
+    );
+    // The exact solvers' allowance at the constrained nodes without a reaction (see
+    // [`StepTerms::violation_tolerance`]): the block-pivoting solver accepts the z it returns
+    // with margins down to `−TIE_ULPS ε max(max|z|, max|lo|)`; the end enumeration decides on
+    // its Schur candidate (or re-solves after it), so the z it returns is untested when an
+    // end is active, and the forward error of that z on its own active set is allowed there.
+    let ends = d.ends_only();
+    let mut mask = 0u8;
+    for (j, &r) in t.reactions.iter().enumerate() {
+        if ends && r > 0.0 {
+            mask |= 1 << j;
         }
     }
-    let mut v: Vec<f64> = (0..n)
-        .map(|i| rho[i].abs() + RESIDUAL_ROUNDINGS * u * (cz[i] + b[i].abs() + pr[i].abs()))
-        .collect();
-    for &l in &active {
-        v[l] = 0.0;
-    }
-    let inactive_constrained = locals
-        .iter()
-        .enumerate()
-        .filter(|&(j, _)| t.reactions[j] <= 0.0)
-        .map(|(_, &l)| l);
-    let stieltjes = d.step_matrix.off.iter().all(|&e| e <= 0.0);
-    // The factor of C itself, once per run. For a Stieltjes C (a nonsingular M-matrix),
-    // `(C⁻¹)_II = (C_II − C_IA C_AA⁻¹ C_AI)⁻¹ >= C_II⁻¹ >= 0` entrywise (the Schur complement
-    // is a Z-matrix below C_II), so `C⁻¹` applied to `|ρ̂_I| + f_I` (0 on A) bounds
-    // `C_II⁻¹ (|ρ̂_I| + f_I)` on I without a factorisation per active set (which made the
-    // full matrix's obstacle runs take over 20 minutes).
-    if stieltjes && forward_factor.is_none() {
-        *forward_factor = Ldlt::factor(&d.step_matrix).ok();
-    }
-    let factor = if stieltjes {
-        forward_factor.as_ref()
+    let inactive = t.reactions.iter().filter(|&&r| r <= 0.0).count();
+    let untested = solver == "exact" && ends && mask != 0 && inactive > 0;
+    let forward = if untested {
+        Some(forward_on_inactive(
+            d,
+            locals,
+            mask,
+            &rho,
+            &cz,
+            b,
+            &pr,
+            penetration,
+        ))
     } else {
         None
     };
-    let forward = match factor {
-        // C is a Stieltjes matrix (SPD, off-diagonals <= 0): |e_I| <= C_II⁻¹ (|ρ̂_I| + f_I)
-        // <= (C⁻¹ v)_I componentwise (above); that solve has no cancellation (all its
-        // factors keep their signs) and errs by at most γ_{3n} relative, covered by the
-        // factor 1 + 2nε.
-        Some(f) => {
-            f.solve_in_place(&mut v);
-            let grow = 1.0 + 2.0 * n as f64 * f64::EPSILON;
-            inactive_constrained
-                .map(|l| grow * v[l].max(0.0))
-                .fold(0.0, f64::max)
-        }
-        // Otherwise the norm bound: |e_j| <= ‖e_I‖₂ <= ‖ρ_I‖₂ / λ_min(C_II), and
-        // λ_min(C_II) >= λ_min(C) (interlacing).
-        None => {
-            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if inactive_constrained.count() > 0 {
-                norm / lambda_min
-            } else {
-                0.0
-            }
-        }
+    let tie = if solver == "exact" && !ends {
+        TIE_ULPS * f64::EPSILON * max_abs(z).max(max_abs(&t.lower))
+    } else {
+        0.0
     };
-    let mut gap_rounding = 0.0f64;
-    let mut max_reaction = 0.0f64;
+    let mut node = Worst::default();
+    let (mut node_gap, mut node_allowance) = (0.0, 0.0);
     for (j, (&l, c)) in locals.iter().zip(&d.constraints).enumerate() {
-        let size = t.lower[j].abs() + z[l].abs() + u1[l].abs() + c.gap.abs();
-        gap_rounding = gap_rounding.max(2.0 * u * size);
-        max_reaction = max_reaction.max(t.reactions[j]);
+        // The gap as the simulation forms it (`fill_contact`): `û^{n+1}_j + a_j`.
+        let violation = (-(u1[l] + c.gap)).max(0.0);
+        let gap = sum_rounding(GAP_ROUNDINGS, t.lower[j].abs() + u1[l].abs());
+        let allowance = match (&forward, t.reactions[j] > 0.0) {
+            (_, true) => 0.0,
+            (Some(f), false) => f[l],
+            (None, false) => tie,
+        };
+        let before = node;
+        node.update(violation, law + gap + allowance);
+        if node != before {
+            (node_gap, node_allowance) = (gap, allowance);
+        }
     }
     StepTerms {
         residual: rec.identity_residual,
@@ -354,15 +373,75 @@ fn step_terms(
         sum_len: n,
         stored_rounding,
         combination,
-        violation: if d.constraints.is_empty() {
-            0.0
-        } else {
-            (-rec.min_gap).max(0.0)
-        },
-        forward,
-        gap_rounding,
-        max_reaction,
+        violation: node.value,
+        gap_rounding: node_gap,
+        allowance: node_allowance,
+        law,
     }
+}
+
+/// The forward error of the end solver's answer on the unknowns off its active set: `z`
+/// against the exact answer `z*` of the same `b̂` with `z*_A = lo_A` on the ends that carry a
+/// reaction (`mask`). Both have `z_A = lo_A` (the solver writes `lower[j]` there on every
+/// path), so `e = z − z*` has `e_A = 0` and `C_II e_I = ρ_I` with `ρ = C z − b̂ − r` (`r_I = 0`)
+/// in exact arithmetic, and `|ρ_I| <= |ρ̂_I| + f_I`, `f` the rounding of `ρ̂` alone (the
+/// solver answered `b̂`). `C_II` is `C` with its active ends removed: one O(n) solve with the
+/// factor of `C` pinned there (at most three factors per run, against the previous full-`C`
+/// bound, whose near-singular rigid mode made it 1e4 times too large at `Δt = 1e4 Δx`). Where
+/// `C` is a Stieltjes matrix, `C_II⁻¹ >= 0` entrywise, so `|e_I| <= C_II⁻¹ (|ρ̂_I| + f_I)`
+/// componentwise; that solve has no cancellation (pivots positive, multipliers `<= 0`, data
+/// `>= 0`) and errs by at most `γ_{3n}` relative, covered by `1 + 2nε`. Else the norm bound
+/// `‖|ρ̂_I| + f_I‖₂ / λ_min(C)` (`λ_min(C_II) >= λ_min(C)` by interlacing) at every node.
+#[allow(clippy::too_many_arguments)]
+fn forward_on_inactive(
+    d: &Discretisation,
+    locals: &[usize],
+    mask: u8,
+    rho: &[f64],
+    cz: &[f64],
+    b: &[f64],
+    pr: &[f64],
+    penetration: &mut Penetration,
+) -> Vec<f64> {
+    let n = rho.len();
+    let u = UNIT_ROUNDOFF;
+    let active: Vec<usize> = (locals.iter().enumerate())
+        .filter(|&(j, _)| mask & (1 << j) != 0)
+        .map(|(_, &l)| l)
+        .collect();
+    let mut v: Vec<f64> = (0..n)
+        .map(|i| rho[i].abs() + RESIDUAL_ROUNDINGS * u * (cz[i] + b[i].abs() + pr[i].abs()))
+        .collect();
+    for &l in &active {
+        v[l] = 0.0;
+    }
+    let stieltjes = d.step_matrix.off.iter().all(|&e| e <= 0.0);
+    if !stieltjes {
+        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt() / penetration.lambda_min;
+        v.fill(norm);
+        return v;
+    }
+    let pinned = &mut *penetration.pinned;
+    let k = match pinned.iter().position(|(m, _)| *m == mask) {
+        Some(k) => k,
+        None => match Ldlt::factor_with_identity_rows(&d.step_matrix, &active) {
+            Ok(f) => {
+                pinned.push((mask, f));
+                pinned.len() - 1
+            }
+            // Not expected (a principal submatrix of an SPD C): a NaN tolerance fails.
+            Err(_) => {
+                v.fill(f64::NAN);
+                return v;
+            }
+        },
+    };
+    pinned[k].1.solve_in_place(&mut v);
+    let grow = 1.0 + 2.0 * n as f64 * f64::EPSILON;
+    for x in v.iter_mut() {
+        *x = grow * x.max(0.0);
+    }
+    v
 }
 
 /// One solver's run state while stepping in lockstep with the others.
@@ -385,13 +464,17 @@ struct Live {
     energy_max: f64,
     balance: f64,
     magnitude: f64,
-    /// `Σ_n` of the steps' signed identity residuals (absolute), and of the drift's per-step
-    /// rounding bounds.
-    residual_sum: f64,
+    /// `Σ_n` of the steps' absolute identity tolerances ([`StepTerms::identity_bound`]) and
+    /// of the drift's per-step rounding bounds.
+    allowance_sum: f64,
     drift_rounding: f64,
+    /// `Σ_n` of the steps' residuals on the recorded numbers, signed and absolute (the
+    /// drift's notes: how much of the allowance is used, how much cancels).
+    residual_sum: f64,
+    residual_abs_sum: f64,
     dump: Option<StepTerms>,
-    /// The factor of `C`, for the forward error of the inactive unknowns.
-    forward_factor: Option<Ldlt>,
+    /// The factors of `C` pinned on an active set of ends ([`Penetration::pinned`]).
+    pinned: Vec<(u8, Ldlt)>,
 }
 
 impl Live {
@@ -433,20 +516,16 @@ impl Live {
             let size = r.work.abs() + r.viscous_dissipation + r.contact_dissipation.abs();
             self.balance += term;
             self.magnitude += size;
-            // The step's residual with its sign, in the record's own operations (the same
-            // bits as `identity_residual · scale`).
+            // This step's rounding between the drift and the steps' computed residuals: the
+            // residual's own roundings (its exact value on the recorded numbers telescopes),
+            // two of the balance's term and one of its running sum.
             let residual = r.energy - self.energy_prev - r.work
                 + r.viscous_dissipation
                 + r.contact_dissipation;
             self.residual_sum += residual;
-            // This step's rounding in the drift's two computations: the four roundings of
-            // the residual, two of the balance's term and one of each running sum.
+            self.residual_abs_sum += residual.abs();
             let combination = r.energy.abs() + self.energy_prev.abs() + size;
-            let c = u
-                * (COMBINATION_ROUNDINGS * combination
-                    + 2.0 * size
-                    + self.balance.abs()
-                    + self.residual_sum.abs());
+            let c = u * (COMBINATION_ROUNDINGS * combination + 2.0 * size + self.balance.abs());
             self.drift_rounding += c;
             if let Some(sim) = self.sim.as_mut() {
                 // F^n as the step used it, evaluated again (deterministic).
@@ -466,17 +545,23 @@ impl Live {
                     &self.u_before,
                     r,
                     self.energy_prev,
-                    self.lambda_min,
-                    &mut self.forward_factor,
+                    &mut Penetration {
+                        solver: self.out.solver,
+                        scale: self.out.max_displacement.max(max_abs(&self.u)),
+                        schur_max: self.schur_max,
+                        lambda_min: self.lambda_min,
+                        pinned: &mut self.pinned,
+                    },
                 );
                 let id_tol = terms.identity_tolerance();
+                self.allowance_sum += terms.identity_bound();
                 if terms.residual / id_tol >= self.out.identity.ratio() {
                     self.dump = Some(terms);
                 }
                 self.out.identity.update(terms.residual, id_tol);
-                let scale = self.out.max_displacement.max(max_abs(&self.u));
-                let v_tol = terms.violation_tolerance(self.out.solver, scale, self.schur_max);
-                self.out.violation.update(terms.violation, v_tol);
+                self.out
+                    .violation
+                    .update(terms.violation, terms.violation_tolerance());
                 self.u_before.clone_from(&self.u_now);
                 self.u_now.copy_from_slice(&self.u[unknowns]);
             }
@@ -503,13 +588,24 @@ impl Live {
         o.max_violation = s.max_violation;
         let scale = self.energy_max.max(self.magnitude);
         let drift = (s.energy_final - s.energy_initial - self.balance).abs();
-        // The drift is the sum of the steps' residuals (telescoping): both computed, they
-        // differ by the per-step roundings and the final difference's two.
-        let bound = self.residual_sum.abs()
+        // The drift is the sum of the steps' residuals on the recorded numbers (telescoping),
+        // each within its step's identity tolerance when that check holds and the energy each
+        // step carries is the one recorded: their sum, the per-step roundings and the final
+        // difference's two (`SolverRun::drift_tolerance`).
+        let bound = self.allowance_sum
             + self.drift_rounding
             + 2.0
                 * UNIT_ROUNDOFF
                 * (s.energy_final.abs() + s.energy_initial.abs() + self.balance.abs());
+        if self.allowance_sum > 0.0 {
+            o.drift_used = self.residual_abs_sum / self.allowance_sum;
+        }
+        if self.residual_abs_sum > 0.0 {
+            o.drift_cancellation = self.residual_sum.abs() / self.residual_abs_sum;
+        }
+        if let Some(t) = &self.dump {
+            o.identity_dominant = t.dominant_term();
+        }
         (o.energy_drift, o.drift_tolerance) = if scale > 0.0 {
             (drift / scale, bound / scale)
         } else {
@@ -569,6 +665,10 @@ pub fn run_case(case: &Case) -> CaseResult {
                     identity: Worst::default(),
                     violation: Worst::default(),
                     drift_tolerance: 0.0,
+                    drift_used: 0.0,
+                    drift_cancellation: 0.0,
+                    identity_dominant: "none",
+                    audit_worst: "none",
                 },
                 tracker: None,
                 trace: Rc::new(RefCell::new(Trace::default())),
@@ -581,10 +681,12 @@ pub fn run_case(case: &Case) -> CaseResult {
                 energy_max: 0.0,
                 balance: 0.0,
                 magnitude: 0.0,
+                allowance_sum: 0.0,
                 residual_sum: 0.0,
+                residual_abs_sum: 0.0,
                 drift_rounding: 0.0,
                 dump: None,
-                forward_factor: None,
+                pinned: Vec::new(),
             };
             match build(case, solver, l.trace.clone()) {
                 Ok(sim) => {
@@ -628,8 +730,13 @@ pub fn run_case(case: &Case) -> CaseResult {
         .map(|mut l| {
             l.settle();
             if let Some(sim) = &l.sim {
-                l.out.audit_ratio = (l.out.solver == "exact")
-                    .then(|| sim.solver_report().map_or(0.0, |r| worst_ratio(&r.audit)));
+                if l.out.solver == "exact" {
+                    let (ratio, what) = sim
+                        .solver_report()
+                        .map_or((0.0, "none"), |r| worst_ratio(&r.audit));
+                    l.out.audit_ratio = Some(ratio);
+                    l.out.audit_worst = what;
+                }
                 if case.family == Family::Rigid {
                     let t = sim.time();
                     l.out.rigid_drift = Some(rigid_drift(&l.u, t));
