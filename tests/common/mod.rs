@@ -34,11 +34,6 @@ pub fn builtin(name: &str, overrides: &[&str]) -> Scene {
 /// random problems).
 pub use viscobar::study::agreement::MIN_MARGIN;
 
-/// Relative agreement with the dense oracle and KKT residuals on [`spd_tridiag`] problems: both
-/// sides are backward-stable solves of systems with condition number below 1e4, so 1e-9 leaves
-/// a wide margin over round-off.
-pub const AGREEMENT_TOL: f64 = 1e-9;
-
 /// Random SPD tridiagonal matrices of size `2..=max_n`: diagonally dominant by a random margin
 /// of at least [`MIN_MARGIN`], off-diagonals of either sign (the step matrix C is not an
 /// M-matrix when the mass term dominates).
@@ -55,4 +50,4 @@ pub fn spd_tridiag(max_n: usize) -> impl Strategy<Value = SymTridiag> {
 /// The KKT residual, its per-case round-off bound and the tests' seeded data stream, defined
 /// beside their measurement in the tolerance registry (`viscobar verify --tolerances`).
 #[allow(unused_imports)] // each test file uses some of them
-pub use viscobar::study::tolerances::{kkt, kkt_ratio, stream};
+pub use viscobar::study::tolerances::{AGREEMENT_TOL, kkt, kkt_ratio, stream};
