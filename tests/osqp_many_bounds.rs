@@ -110,10 +110,6 @@ fn a_priori_tolerance(
     chen_xiang_constant(c) * ((2.0 * t_z).max(3.0 * t_f) + 2.0 * exact_floor)
 }
 
-/// KKT residual of the exact answer, relative to the data: backward-stable solves of systems
-/// with condition number below about 1e4 (the generator's margin) stay below this.
-const EXACT_KKT_TOL: f64 = 1e-9;
-
 /// Slack on the dense check of the cited inequality: the dense inverse is computed by an LU
 /// with partial pivoting on matrices of condition below about 1e3, good to ~1e-13 relative.
 const DENSE_INVERSE_TOL: f64 = 1e-10;
@@ -140,7 +136,9 @@ proptest! {
             let lo: Vec<f64> = (0..k).map(|_| 2.0 * rnd() - 1.0).collect();
             let (mut ze, mut re) = (vec![0.0; n], vec![0.0; k]);
             exact.solve(&b, &lo, &mut ze, &mut re).unwrap();
-            prop_assert!(common::kkt(&c, &b, &nodes, &lo, &ze, &re) <= EXACT_KKT_TOL);
+            // The exact answer's KKT residual within its per-case round-off bound (the registry's
+            // `kkt_ratio`, measured by `viscobar verify --tolerances` on a seeded sample).
+            prop_assert!(common::kkt_ratio(&c, &b, &nodes, &lo, &ze, &re) <= 1.0);
             let (mut zo, mut ro) = (vec![0.0; n], vec![0.0; k]);
             osqp.solve(&b, &lo, &mut zo, &mut ro)
                 .map_err(|e| TestCaseError::fail(format!("osqp: {e}")))?;

@@ -3,7 +3,6 @@
 
 use proptest::prelude::*;
 use viscobar::Scene;
-use viscobar::linalg::norms::max_abs;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::scene;
 use viscobar::study::agreement::{MAX_MARGIN, diagonally_dominant};
@@ -35,11 +34,6 @@ pub fn builtin(name: &str, overrides: &[&str]) -> Scene {
 /// random problems).
 pub use viscobar::study::agreement::MIN_MARGIN;
 
-/// Relative agreement with the dense oracle and KKT residuals on [`spd_tridiag`] problems: both
-/// sides are backward-stable solves of systems with condition number below 1e4, so 1e-9 leaves
-/// a wide margin over round-off.
-pub const AGREEMENT_TOL: f64 = 1e-9;
-
 /// Random SPD tridiagonal matrices of size `2..=max_n`: diagonally dominant by a random margin
 /// of at least [`MIN_MARGIN`], off-diagonals of either sign (the step matrix C is not an
 /// M-matrix when the mass term dominates).
@@ -53,33 +47,7 @@ pub fn spd_tridiag(max_n: usize) -> impl Strategy<Value = SymTridiag> {
     })
 }
 
-/// The worst KKT residual of `(z, r)` for `min ½zᵀCz − bᵀz, z_j >= lo_j (j in nodes)`,
-/// relative to the data: stationarity `‖Cz − b − Σ r_j e_j‖∞`, feasibility, sign and
-/// complementarity, over `1 + max(‖b‖∞, ‖lo‖∞, ‖z‖∞)`.
-pub fn kkt(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64], z: &[f64], r: &[f64]) -> f64 {
-    let scale = 1.0 + max_abs(b).max(max_abs(lo)).max(max_abs(z));
-    let mut rho = c.mul(z);
-    for (ri, bi) in rho.iter_mut().zip(b) {
-        *ri -= bi;
-    }
-    for (&i, rj) in nodes.iter().zip(r) {
-        rho[i] -= rj;
-    }
-    let mut worst = max_abs(&rho);
-    for (j, &i) in nodes.iter().enumerate() {
-        let g = z[i] - lo[j];
-        worst = worst.max(-g).max(-r[j]).max((g * r[j]).abs() / scale);
-    }
-    worst / scale
-}
-
-/// xorshift64: reproducible data from one proptest-drawn seed, so that shrinking stays cheap.
-pub fn stream(seed: u64) -> impl FnMut() -> f64 {
-    let mut x = seed | 1;
-    move || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        (x >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+/// The KKT residual, its per-case round-off bound and the tests' seeded data stream, defined
+/// beside their measurement in the tolerance registry (`viscobar verify --tolerances`).
+#[allow(unused_imports)] // each test file uses some of them
+pub use viscobar::study::tolerances::{AGREEMENT_TOL, kkt, kkt_ratio, stream};
