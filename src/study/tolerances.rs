@@ -535,7 +535,9 @@ pub fn stiff_checks(results: &[CaseResult]) -> Vec<StiffCheck> {
                 if !tol.is_finite() {
                     continue; // reported, not checked (pre-asymptotic penalty distances)
                 }
-                let ratio = value / tol;
+                // A zero value is a zero ratio, whatever its tolerance (0/0 included), as in
+                // `stiff::Worst::ratio`.
+                let ratio = if value == 0.0 { 0.0 } else { value / tol };
                 let i = match out
                     .iter()
                     .position(|c| c.check == check && c.solver == solver)
@@ -721,8 +723,15 @@ fn reason(name: &str, file: &str) -> &'static str {
         ("BAR_CASE_MIN_MOTION", _) => {
             "a lower bound on the motion compared (the check must compare motion, not rest)"
         }
+        ("NOTE_RATIO_FLOOR", _) => {
+            "a reporting threshold (which ratios of the stiff matrix get a generated reason), \
+             not a tolerance"
+        }
         ("UNIT_ROUNDOFF", _) => "the unit round-off ε/2, a constant of the a-posteriori bounds",
-        ("RESIDUAL_ROUNDINGS" | "SUM_TERM_ROUNDINGS" | "COMBINATION_ROUNDINGS", _) => {
+        (
+            "RESIDUAL_ROUNDINGS" | "SUM_TERM_ROUNDINGS" | "COMBINATION_ROUNDINGS" | "GAP_ROUNDINGS",
+            _,
+        ) => {
             "a count of roundings in the stiff matrix's a-posteriori bounds, not a tolerance \
              compared with a measured value (the bounds it enters are measured by the checks above)"
         }
