@@ -51,7 +51,7 @@ fn rounded_digits(t: f64) -> Option<(i64, u32)> {
 const POWER_OF_TEN_MARGIN: f64 = 1e-9;
 
 /// `a.log10().floor()` for `a > 0`, the same value, found by comparing `a` with the powers of ten
-/// in `[1e-11, 1e12)` (the range of [`rounded_digits`]' fast path; ~10x cheaper than `log10`);
+/// in `[1e-11, 1e12)` (the range of `rounded_digits`' fast path; ~10x cheaper than `log10`);
 /// `log10` itself near a power of ten and outside that range.
 fn floor_log10(a: f64) -> i32 {
     let near = |b: f64, lo: f64| {
@@ -81,7 +81,7 @@ fn floor_log10(a: f64) -> i32 {
 /// differ only in layout. In Żmij's fixed-point range (`1e-5 <= |t| < 1e16`) the layouts agree
 /// but for Żmij's `.0` on whole numbers, which is dropped; elsewhere `Display` writes the text.
 ///
-/// On [`rounded_digits`]' fast path the text is written from the integer digits directly:
+/// On `rounded_digits`' fast path the text is written from the integer digits directly:
 /// the shortest digits of `digits / 10^k` are those digits without their trailing zeros (the
 /// argument above), which `Display` lays out without an exponent.
 pub fn push_output_time(t: f64, out: &mut Vec<u8>) {
