@@ -457,6 +457,10 @@ fn ranges(name: &str) -> Vec<(&'static str, Vec<f64>)> {
             draw(200_000, &mut |g| g.uniform(-745.2, -700.0)),
         ));
         v.push((
+            "zero results",
+            draw(200_000, &mut |g| g.uniform(-1e5, -740.0)),
+        ));
+        v.push((
             "overflow edge",
             draw(200_000, &mut |g| g.uniform(705.0, 710.0)),
         ));
@@ -521,6 +525,10 @@ fn the_block_kernels_treat_special_values_as_std() {
         1.7e6,
         -1.6e6,
         1e22,
+        -745.9,
+        -746.0,
+        -746.000_001,
+        -1e308,
     ];
     for (name, kernel, reference) in KERNELS {
         let mut v = specials.to_vec();

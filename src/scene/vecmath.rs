@@ -7,8 +7,9 @@
 //! with the branches replaced by arithmetic selections. Only `f64` additions, multiplications
 //! and divisions in a fixed order, never fused (Rust does not contract `a*b + c`), and integer
 //! operations on the bits: the same bits on every x86-64, in a vector lane or alone, so at any
-//! block split. Arguments outside the kernels' ranges (large, NaN, ±∞) take `std`'s value
-//! in a second pass over the block. Error: at most [`MAX_ULPS`] from `std` (tests/expressions.rs
+//! block split. Arguments outside the kernels' ranges (large, NaN, ±∞; `exp`'s below
+//! [`EXP_ZERO`] give `+0` in the vector pass) take `std`'s value in a second pass over the
+//! block. Error: at most [`MAX_ULPS`] from `std` (tests/expressions.rs
 //! measures it over millions of arguments).
 
 // fdlibm's constants as published (the nearest doubles), to be checked against the source.
@@ -105,11 +106,15 @@ fn sin_quadrant(x: f64, k: u64) -> f64 {
     f64::from_bits(((s & !odd) | (c & odd)) ^ ((q & 2) << 62))
 }
 
-/// Applies `kernel` to every value of `v` in `[lo, hi]`, `fallback` to the others (NaN
-/// included) in a second pass over the block only when there are any.
+/// Applies `kernel` to every value of `v` that is `inside`, `fallback` to the others in a
+/// second pass over the block only when there are any.
 #[inline(always)]
-fn map(v: &mut [f64], lo: f64, hi: f64, kernel: impl Fn(f64) -> f64, fallback: fn(f64) -> f64) {
-    let inside = |x: f64| x >= lo && x <= hi;
+fn map(
+    v: &mut [f64],
+    inside: impl Fn(f64) -> bool,
+    kernel: impl Fn(f64) -> f64,
+    fallback: fn(f64) -> f64,
+) {
     // `|` rather than `any`: no early exit, so the check vectorises.
     if v.iter().fold(false, |out, &x| out | !inside(x)) {
         v.iter_mut()
@@ -121,12 +126,12 @@ fn map(v: &mut [f64], lo: f64, hi: f64, kernel: impl Fn(f64) -> f64, fallback: f
 
 /// `v[i] = sin(v[i])`.
 pub fn sin(v: &mut [f64]) {
-    map(v, -TRIG_MAX, TRIG_MAX, |x| sin_quadrant(x, 0), f64::sin);
+    map(v, |x| x.abs() <= TRIG_MAX, |x| sin_quadrant(x, 0), f64::sin);
 }
 
 /// `v[i] = cos(v[i])`, as `sin(x + π/2)` with the quarter turn added exactly to the quadrant.
 pub fn cos(v: &mut [f64]) {
-    map(v, -TRIG_MAX, TRIG_MAX, |x| sin_quadrant(x, 1), f64::cos);
+    map(v, |x| x.abs() <= TRIG_MAX, |x| sin_quadrant(x, 1), f64::cos);
 }
 
 const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1;
@@ -140,9 +145,12 @@ const P4: f64 = -1.653_390_220_546_525_153_90e-6;
 const P5: f64 = 4.138_136_797_057_238_460_39e-8;
 
 /// Range of [`exp`]'s kernel: the result is a normal number, `2^k` with `−1021 ≤ k ≤ 1023`
-/// built from its exponent bits; beyond it (subnormal, 0, ∞) `std` takes over.
+/// built from its exponent bits; beyond it (subnormal, ∞) `std` takes over.
 pub const EXP_MIN: f64 = -708.0;
 pub const EXP_MAX: f64 = 709.0;
+/// Below it `e^x` rounds to `+0` (`e^x < 2^−1075` from `x < −745.14`): selected in the
+/// vector pass, as a load `exp(−(x − t)²)` far from its centre gives it at every node.
+pub const EXP_ZERO: f64 = -746.0;
 
 /// `e^x = 2^k e^r`, `k = round(x/ln 2)`, `r = x − k·ln2_hi − k·ln2_lo` (`ln2_hi` has 32 bits,
 /// so `k·ln2_hi` is exact), `|r| ≤ ln2/2`; `e^r = 1 + r + r·c/(2 − c)` with
@@ -163,5 +171,13 @@ fn exp_kernel(x: f64) -> f64 {
 
 /// `v[i] = e^{v[i]}`.
 pub fn exp(v: &mut [f64]) {
-    map(v, EXP_MIN, EXP_MAX, exp_kernel, f64::exp);
+    map(
+        v,
+        |x| (EXP_MIN..=EXP_MAX).contains(&x) || x < EXP_ZERO,
+        |x| {
+            let y = exp_kernel(x.max(EXP_MIN));
+            if x < EXP_ZERO { 0.0 } else { y }
+        },
+        f64::exp,
+    );
 }
