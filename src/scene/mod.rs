@@ -10,6 +10,7 @@ pub mod nodal;
 pub mod plane;
 pub mod schema;
 pub mod separation;
+pub mod vecmath;
 
 pub use error::SceneError;
 pub use expr::Expression;
