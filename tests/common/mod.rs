@@ -50,4 +50,4 @@ pub fn spd_tridiag(max_n: usize) -> impl Strategy<Value = SymTridiag> {
 /// The KKT residual, its per-case round-off bound and the tests' seeded data stream, defined
 /// beside their measurement in the tolerance registry (`viscobar verify --tolerances`).
 #[allow(unused_imports)] // each test file uses some of them
-pub use viscobar::study::tolerances::{AGREEMENT_TOL, kkt, kkt_ratio, stream};
+pub use viscobar::study::tolerances::{kkt, kkt_ratio, stream};
