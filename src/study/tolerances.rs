@@ -1776,12 +1776,7 @@ pub fn exact_tie() -> Result<(f64, bool, bool), RunError> {
         let (mut z, mut r) = (vec![0.0; 3], vec![0.0; 2]);
         solver
             .solve(&b, &[1.0, 1.0], &mut z, &mut r)
-            .map_err(|failure| RunError::Step {
-                step: call,
-                time: 0.0,
-                solver: "exact".into(),
-                failure,
-            })?;
+            .map_err(exact_sample_error(call))?;
         for i in 0..3 {
             worst = worst.max((z[i] - z_free[i]).abs());
         }
@@ -2092,6 +2087,16 @@ pub fn kkt_ratio(
     if value == 0.0 { 0.0 } else { value / bound }
 }
 
+/// The error of the exact solver failing on case (or call) `case` of a registry sample.
+fn exact_sample_error(case: usize) -> impl FnOnce(crate::step::StepFailure) -> RunError {
+    move |failure| RunError::Step {
+        step: case,
+        time: 0.0,
+        solver: "exact".into(),
+        failure,
+    }
+}
+
 /// Cases of the seeded samples of the proptests' distributions.
 pub const KKT_SAMPLE_CASES: usize = 200;
 
@@ -2118,12 +2123,7 @@ pub fn random_kkt_worst() -> Result<(f64, f64), RunError> {
             let (mut z, mut r) = (vec![0.0; n], vec![0.0; k]);
             solver
                 .solve(&b, &lo, &mut z, &mut r)
-                .map_err(|failure| RunError::Step {
-                    step: case,
-                    time: 0.0,
-                    solver: "exact".into(),
-                    failure,
-                })?;
+                .map_err(exact_sample_error(case))?;
             ratio = ratio.max(kkt_ratio(&c, &b, &nodes, &lo, &z, &r));
             worst = worst.max(kkt(&c, &b, &nodes, &lo, &z, &r));
         }
@@ -2327,12 +2327,7 @@ pub fn oracle_agreement_worst() -> Result<f64, RunError> {
         for (bb, ll) in [(&b, &lower), (&b2, &lower2)] {
             solver
                 .solve(bb, ll, &mut z, &mut r)
-                .map_err(|failure| RunError::Step {
-                    step: case,
-                    time: 0.0,
-                    solver: "exact".into(),
-                    failure,
-                })?;
+                .map_err(exact_sample_error(case))?;
             worst = worst
                 .max(oracle_agreement(&c, bb, &nodes, ll, &z, &r))
                 .max(kkt_ratio(&c, bb, &nodes, ll, &z, &r));
