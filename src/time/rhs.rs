@@ -82,10 +82,11 @@ pub(crate) fn rhs_into<const LOAD: bool, K: Interior>(
 ///
 /// Rows `1..n−1` (`n >= 3`). Row `i` of `A x` in difference form
 /// is `s_i x_i + A_i,i−1 (x_i−1 − x_i) + A_i,i+1 (x_i+1 − x_i) = (s_i x_i − g_i−1) + g_i` with the
-/// edge flux `g_i = A_i,i+1 (x_i+1 − x_i)`: the same bits as [`row_of`] (negation is exact),
-/// but each flux is computed once, for the two rows it enters, and carried to the next row.
-/// `S_R = false` drops `s_i y_i` from the stiffness rows (for `s_i = 0`; only the sign of a
-/// zero result can differ). No branch in the loop, so it vectorises, carried values included.
+/// edge flux `g_i = A_i,i+1 (x_i+1 − x_i)`: the same bits as [`row_of`] (negation is exact).
+/// Each flux is computed twice, once for each row it enters, rather than carried from row to
+/// row: a carried value made the loop a recurrence, which the compiler left scalar, while
+/// rows that share nothing vectorise. `S_R = false` drops `s_i y_i` from the stiffness rows
+/// (for `s_i = 0`; only the sign of a zero result can differ).
 pub(crate) struct RhsInterior<'a, const LOAD: bool, const S_R: bool, K> {
     pub(crate) coefficients: (K, K),
     pub(crate) c_w: f64,
@@ -112,22 +113,84 @@ impl<const LOAD: bool, const S_R: bool, K: Interior> dispatch::Kernel
             rhs,
         } = self;
         let n = rhs.len();
-        let y = |i: usize| c_w * w[i] - u[i];
-        let (mut y_i, mut w_i) = (y(1), w[1]);
-        let mut g_y = ri.e(0) * (y_i - y(0));
-        let mut g_w = mi.e(0) * (w_i - w[0]);
-        for i in 1..n - 1 {
-            let (y_next, w_next) = (y(i + 1), w[i + 1]);
-            let (g_y_next, g_w_next) = (ri.e(i) * (y_next - y_i), mi.e(i) * (w_next - w_i));
+        // Row k = i + 1 reads nodes i, i + 1, i + 2: three windows of one length, so the
+        // loop has no bounds checks and nothing carried from one row to the next.
+        let out = &mut rhs[1..n - 1];
+        let m = out.len();
+        let (u_l, u_c, u_r) = (&u[..m], &u[1..m + 1], &u[2..m + 2]);
+        let (w_l, w_c, w_r) = (&w[..m], &w[1..m + 1], &w[2..m + 2]);
+        let force = if LOAD { &force[1..m + 1] } else { &[][..] };
+        let y = |u: f64, w: f64| c_w * w - u;
+        for i in 0..m {
+            let k = i + 1;
+            let (y_l, y_c, y_r) = (y(u_l[i], w_l[i]), y(u_c[i], w_c[i]), y(u_r[i], w_r[i]));
+            let (g_y, g_y_next) = (ri.e(k - 1) * (y_c - y_l), ri.e(k) * (y_r - y_c));
+            let (g_w, g_w_next) = (mi.e(k - 1) * (w_c[i] - w_l[i]), mi.e(k) * (w_r[i] - w_c[i]));
             let ry = if S_R {
-                (ri.s(i) * y_i - g_y) + g_y_next
+                (ri.s(k) * y_c - g_y) + g_y_next
             } else {
                 g_y_next - g_y
             };
-            let mw = (mi.s(i) * w_i - g_w) + g_w_next;
+            let mw = (mi.s(k) * w_c[i] - g_w) + g_w_next;
             let b = ry + mw * inv_dt2;
-            rhs[i] = if LOAD { b + force[i] } else { b };
-            (y_i, w_i, g_y, g_w) = (y_next, w_next, g_y_next, g_w_next);
+            out[i] = if LOAD { b + force[i] } else { b };
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bar::matrices::{self, MatrixVariant};
+
+    /// The interior kernel gives the bits of the row-by-row formula [`row_of`] on every row,
+    /// for uniform and row-by-row coefficients, with and without a load, for every tail length
+    /// of the vector loop (mutation-checked: a flux taken with the wrong coefficient index
+    /// fails it on the non-uniform matrix).
+    #[test]
+    fn rhs_equals_the_row_formula_bit_for_bit() {
+        for n in [2usize, 3, 4, 5, 6, 7, 8, 9, 10, 37, 1002] {
+            let dx = 1.0 / n as f64;
+            let m = matrices::mass(MatrixVariant::Consistent, n, dx);
+            let r = matrices::stiffness(MatrixVariant::Consistent, n, dx);
+            // A non-uniform pair: the consistent matrices with wobbling entries.
+            let wobble = |a: &SymTridiag, amp: f64| {
+                let d =
+                    (a.diag.iter().enumerate()).map(|(i, v)| v * (1.0 + amp * (i as f64).sin()));
+                let e = (a.off.iter().enumerate()).map(|(i, v)| v * (1.0 + amp * (i as f64).cos()));
+                SymTridiag::new(d.collect(), e.collect())
+            };
+            let (m2, r2) = (wobble(&m, 0.3), wobble(&r, 0.2));
+            let v = |a: f64, offset: f64| {
+                (0..n)
+                    .map(|i| offset + (a * i as f64 + 0.3).sin())
+                    .collect::<Vec<_>>()
+            };
+            let (u, w, f) = (v(0.7, 1e2), v(2.1, 1e2 + 1e-3), v(0.4, -1.0));
+            let (c_w, inv_dt2) = (-0.37, 1.0 / (dx * dx));
+            let expected = |mass: &SymTridiag, stiffness: &SymTridiag, load: bool| {
+                (0..n)
+                    .map(|i| {
+                        let y = |j: usize| c_w * w[j] - u[j];
+                        let b = row_of(stiffness, y, i, n) + row_of(mass, |j| w[j], i, n) * inv_dt2;
+                        if load { b + f[i] } else { b }
+                    })
+                    .map(f64::to_bits)
+                    .collect::<Vec<_>>()
+            };
+            let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            let mut out = vec![0.0; n];
+            if let Some(k) = m.uniform().zip(r.uniform()) {
+                rhs_into::<true, _>(&m, &r, k, c_w, inv_dt2, &u, &w, &f, &mut out);
+                assert_eq!(bits(&out), expected(&m, &r, true), "uniform, load, n = {n}");
+                rhs_into::<false, _>(&m, &r, k, c_w, inv_dt2, &u, &w, &[], &mut out);
+                assert_eq!(bits(&out), expected(&m, &r, false), "uniform, n = {n}");
+            }
+            let k = (m2.rows(), r2.rows());
+            rhs_into::<true, _>(&m2, &r2, k, c_w, inv_dt2, &u, &w, &f, &mut out);
+            assert_eq!(bits(&out), expected(&m2, &r2, true), "rows, load, n = {n}");
+            rhs_into::<false, _>(&m2, &r2, k, c_w, inv_dt2, &u, &w, &[], &mut out);
+            assert_eq!(bits(&out), expected(&m2, &r2, false), "rows, n = {n}");
         }
     }
 }
