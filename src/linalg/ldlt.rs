@@ -2,6 +2,7 @@
 //! and solved every step (odd–even reduction, then a twisted factorisation: see [`Ldlt`]),
 //! with the refactorisations that change a few rows and share the unchanged halves.
 
+use crate::linalg::dispatch;
 use crate::linalg::tridiag::SymTridiag;
 use std::cell::Cell;
 use std::sync::Arc;
@@ -450,6 +451,18 @@ impl Ldlt {
     /// row fills in its inner odd node. With `ADD`, each `x_i` is also added to `u_i`
     /// (otherwise `u` is not touched and may be `x`).
     fn solve_from<V: Value, const ADD: bool>(&self, b: &[V], x: &[Cell<f64>], u: &[Cell<f64>]) {
+        dispatch::run(Solve::<V, ADD> {
+            ldlt: self,
+            b,
+            x,
+            u,
+        });
+    }
+
+    /// The body of [`Ldlt::solve_from`], compiled into [`dispatch::run`]'s callers (AVX or
+    /// baseline: the same operations, so the same bits).
+    #[inline(always)]
+    fn solve_body<V: Value, const ADD: bool>(&self, b: &[V], x: &[Cell<f64>], u: &[Cell<f64>]) {
         let n = self.n;
         if n == 0 {
             return;
@@ -567,7 +580,26 @@ impl Ldlt {
             add(uo, v);
         }
     }
+}
 
+/// [`Ldlt::solve_from`] with its arguments, for [`dispatch::run`]: the chains are scalar, but
+/// the three-operand AVX encoding of the same instructions saves the register copies.
+struct Solve<'a, V, const ADD: bool> {
+    ldlt: &'a Ldlt,
+    b: &'a [V],
+    x: &'a [Cell<f64>],
+    u: &'a [Cell<f64>],
+}
+
+impl<V: Value, const ADD: bool> dispatch::Kernel for Solve<'_, V, ADD> {
+    type Output = ();
+    #[inline(always)]
+    fn call(self) {
+        self.ldlt.solve_body::<V, ADD>(self.b, self.x, self.u)
+    }
+}
+
+impl Ldlt {
     /// `A⁻¹ e_j` as a new vector (set-up only).
     pub fn column_of_inverse(&self, j: usize) -> Vec<f64> {
         let mut c = vec![0.0; self.dim()];
@@ -635,6 +667,58 @@ mod tests {
 
     /// The sweeps that carry the odd nodes' quotients and the reduced off-diagonals from row to
     /// row give the bits of the formulas, at every size from 1 to 13 and at 100, 101 and 1000.
+    /// The solve compiled for AVX gives the bits of the baseline build (see [`dispatch`]),
+    /// for every parity and small size (empty halves, the outer odd node) and a large one,
+    /// separate and in place, with and without the fused `u += x`.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn the_solve_gives_the_same_bits_with_and_without_avx() {
+        if !dispatch::has_avx() {
+            eprintln!("this CPU has no AVX: only the baseline build runs, nothing to compare");
+            return;
+        }
+        for n in (1usize..=13).chain([100, 1001]) {
+            let diag = (0..n).map(|i| 4.0 + (i as f64 * 0.7).sin()).collect();
+            let off = (0..n.saturating_sub(1))
+                .map(|i| -1.0 + 0.3 * (i as f64).cos())
+                .collect();
+            let f = Ldlt::factor(&SymTridiag::new(diag, off)).unwrap();
+            let b: Vec<f64> = (0..n).map(|i| (i as f64 * 1.3 + 0.2).cos()).collect();
+            let u0: Vec<f64> = (0..n).map(|i| 1e3 + (i as f64).sin()).collect();
+            let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            let mut outputs = Vec::new();
+            for avx in [false, true] {
+                let (mut x, mut u, mut y) = (vec![0.0; n], u0.clone(), b.clone());
+                fn cells(v: &mut [f64]) -> &[Cell<f64>] {
+                    Cell::from_mut(v).as_slice_of_cells()
+                }
+                let (xc, uc) = (cells(&mut x), cells(&mut u));
+                let separate = Solve::<f64, true> {
+                    ldlt: &f,
+                    b: &b,
+                    x: xc,
+                    u: uc,
+                };
+                let yc = cells(&mut y);
+                let in_place = Solve::<Cell<f64>, false> {
+                    ldlt: &f,
+                    b: yc,
+                    x: yc,
+                    u: yc,
+                };
+                if avx {
+                    dispatch::run(separate);
+                    dispatch::run(in_place);
+                } else {
+                    dispatch::baseline(separate);
+                    dispatch::baseline(in_place);
+                }
+                outputs.push((bits(&x), bits(&u), bits(&y)));
+            }
+            assert_eq!(outputs[0], outputs[1], "n = {n}");
+        }
+    }
+
     #[test]
     fn the_carried_sweeps_equal_the_formulas_bit_for_bit() {
         for n in (1usize..=13).chain([100, 101, 1000]) {
