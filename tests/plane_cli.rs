@@ -8,6 +8,9 @@ use std::process::Command;
 use viscobar::study::tolerances::PLANE_IDENTITY_TOL as IDENTITY_TOL;
 /// A drawn figure is more than its headers: the smallest plausible PNG or SVG of a mesh.
 const MIN_FIGURE_BYTES: u64 = 1000;
+/// Three quotients of one total add up to 1 up to their four roundings (each at most ε/2 of
+/// a number at most 1), with a factor 2 to spare.
+const PHASE_SUM_TOL: f64 = 4.0 * f64::EPSILON;
 
 fn viscobar(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_viscobar"))
@@ -44,6 +47,18 @@ fn run_writes_the_plane_outputs_and_the_figure() {
     assert_eq!(summary["steps"], 40);
     assert_eq!(summary["unknowns"], 2 * 64 * 9);
     assert!(summary["max_identity_residual"].as_f64().unwrap() <= IDENTITY_TOL);
+    // The bar's phase shares: steps 1 -> 2 ... 39 -> 40 are timed one in 32, from the first
+    // (n = 1 and 33).
+    let shares = &summary["time_shares"];
+    assert_eq!(shares["sampled_steps"], 2, "{shares}");
+    let share = |k: &str| shares[k].as_f64().unwrap();
+    let parts = ["solver", "rhs", "diagnostics"].map(share);
+    assert!(parts.iter().all(|p| (0.0..=1.0).contains(p)), "{shares}");
+    assert!(
+        (parts.iter().sum::<f64>() - 1.0).abs() <= PHASE_SUM_TOL,
+        "{shares}"
+    );
+    assert!(share("stepping") > 0.0, "{shares}");
     let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
     assert_eq!(history.lines().count(), 41);
     assert!(history.starts_with("step,t,energy,work,viscous_dissipation,identity_residual\n"));

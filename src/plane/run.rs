@@ -7,7 +7,7 @@ use crate::plane::simulation::{PlaneRecord, PlaneSimulation};
 use crate::scene::plane::PlaneScene;
 use crate::step::report::AuditReport;
 use crate::time::run::{RUN_FILES, write_whole};
-use crate::time::summary::output_time;
+use crate::time::summary::{TimeShares, output_time};
 use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -39,6 +39,11 @@ pub struct PlaneSummary {
     pub wall_time_s: f64,
     /// `wall_time_s` / (steps × unknowns), nanoseconds.
     pub ns_per_unknown_step: f64,
+    /// Shares of the stepping time per phase, estimated on a sample of the steps, as the
+    /// bar's: `rhs` (load and right-hand side), `solver` (the solve with the factor of `C` or
+    /// the contact solver, and `u += z`), `diagnostics` (contact figures, energy balance),
+    /// `stepping` (the sampled phases' share of the wall time).
+    pub time_shares: TimeShares,
     /// `E^{1/2}`, `E^{N−1/2}`.
     pub energy_initial: f64,
     pub energy_final: f64,
@@ -158,6 +163,7 @@ impl Tracker {
             final_time: output_time(sim.time()),
             wall_time_s: wall,
             ns_per_unknown_step: wall * 1e9 / (steps as f64 * d.unknowns() as f64),
+            time_shares: TimeShares::from_phases(sim.phase_times(), steps, wall),
             energy_initial: self.energy_initial,
             energy_final: self.last_energy,
             max_energy_rise: (!self.forced).then_some(rise),

@@ -21,6 +21,7 @@ use crate::plane::rhs::{RhsTerms, rhs_into};
 use crate::scene::expr::Expression;
 use crate::scene::plane::PlaneScene;
 use crate::step::report::AuditReport;
+use crate::time::clock::{PhaseClock, PhaseTimes};
 
 /// The discretised body: grid, unknowns, and `M`, `K` on the unknowns (one pattern).
 pub struct PlaneDiscretisation {
@@ -183,6 +184,8 @@ pub struct PlaneSimulation {
     first_record: PlaneRecord,
     /// `u_0`, `u_1` at every full degree of freedom (for the output at `t = 0`).
     initial: (Vec<f64>, Vec<f64>),
+    /// Wall time per phase of the sampled steps (the bar's [`PhaseTimes`]).
+    timing: PhaseTimes,
 }
 
 impl PlaneSimulation {
@@ -311,6 +314,7 @@ impl PlaneSimulation {
             first_record,
             initial: (u0_full, v0_full),
             disc,
+            timing: PhaseTimes::default(),
         })
     }
 
@@ -334,6 +338,7 @@ impl PlaneSimulation {
     /// side, the energy balance) and returns the step's diagnostics. Allocates nothing.
     pub fn step(&mut self) -> Result<PlaneRecord, PlaneError> {
         let n = self.n;
+        let clock = PhaseClock::start(self.timing.samples(n));
         self.update_force(n)?;
         let d = &self.disc;
         let terms = RhsTerms {
@@ -344,6 +349,7 @@ impl PlaneSimulation {
             c_w: 0.5 - d.alpha / (2.0 * d.dt),
         };
         rhs_into(&terms, &self.u, &self.w, &self.force, &mut self.rhs);
+        let clock = clock.lap(&mut self.timing.rhs_ns);
         let mut iterations = 0;
         if let Some(contact) = &mut self.contact {
             iterations = contact.step(&mut self.chol, &self.rhs, &self.u, &mut self.z, n + 1)?;
@@ -354,6 +360,7 @@ impl PlaneSimulation {
         for (u, z) in self.u.iter_mut().zip(&self.z) {
             *u += z;
         }
+        let clock = clock.lap(&mut self.timing.solve_ns);
         let contact = self
             .contact
             .as_ref()
@@ -390,6 +397,7 @@ impl PlaneSimulation {
         self.potential = sums.potential;
         std::mem::swap(&mut self.w, &mut self.z);
         self.n = n + 1;
+        clock.lap(&mut self.timing.diagnostics_ns);
         Ok(PlaneRecord {
             step: n + 1,
             time,
@@ -425,6 +433,13 @@ impl PlaneSimulation {
 
     pub fn discretisation(&self) -> &PlaneDiscretisation {
         &self.disc
+    }
+
+    /// Wall time spent in each phase of the steps taken so far, measured on a sample of the
+    /// steps: `rhs` (load and right-hand side), `solve` (the solve with the factor of `C` or
+    /// the contact solver, and `u += z`), `diagnostics` (contact figures, energy balance).
+    pub fn phase_times(&self) -> PhaseTimes {
+        self.timing
     }
 
     /// `n`: the state held is `u^n`.

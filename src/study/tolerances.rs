@@ -728,6 +728,10 @@ fn reason(name: &str, file: &str) -> &'static str {
             "a reporting threshold (which ratios of the stiff matrix get a generated reason), \
              not a tolerance"
         }
+        ("PHASE_SUM_TOL", _) => {
+            "the rounding of three quotients of one total and of their sum (timing shares in \
+             summary.json), not a tolerance of the numerics"
+        }
         ("UNIT_ROUNDOFF", _) => "the unit round-off ε/2, a constant of the a-posteriori bounds",
         (
             "RESIDUAL_ROUNDINGS" | "SUM_TERM_ROUNDINGS" | "COMBINATION_ROUNDINGS" | "GAP_ROUNDINGS",

@@ -2,6 +2,7 @@
 //! [`Tracker`] (energies, identity residual, complementarity, contact episodes, iterations,
 //! time shares), and the rounding of times in every output file.
 
+use crate::time::clock::PhaseTimes;
 use crate::time::simulation::{CONTACT_GAP_TOL, Simulation, StepRecord};
 use serde::Serialize;
 
@@ -247,10 +248,15 @@ pub struct TimeShares {
 
 impl TimeShares {
     fn new(sim: &Simulation, wall_time_s: f64) -> Self {
-        let p = sim.phase_times();
+        Self::from_phases(sim.phase_times(), sim.step_index(), wall_time_s)
+    }
+
+    /// The shares of `p`, measured on the steps `1 → 2 … n − 1 → n` of a run that reached
+    /// `u^n` (`n = steps`; the start-up step is not timed) in `wall_time_s`.
+    pub(crate) fn from_phases(p: PhaseTimes, steps: usize, wall_time_s: f64) -> Self {
         let total = p.total_ns() as f64;
         let share = |x: u64| if total > 0.0 { x as f64 / total } else { 0.0 };
-        let steps = sim.step_index().saturating_sub(1) as f64;
+        let steps = steps.saturating_sub(1) as f64;
         let per_step = total / p.sampled_steps.max(1) as f64;
         Self {
             solver: share(p.solve_ns),
