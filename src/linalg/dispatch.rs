@@ -4,7 +4,9 @@
 //! flags. The right-hand side, the energy sums and the update `z += r c; u += z` are
 //! throughput bound, so on a CPU with AVX (four doubles per vector) they run as AVX code:
 //! the right-hand side through `run` (the compiler vectorises it), the other two as AVX
-//! intrinsics behind [`has_avx`] (the compiler does not vectorise them). The bits do not
+//! intrinsics behind [`has_avx`] (the compiler does not vectorise them). The tridiagonal
+//! solve (`Ldlt`) also goes through `run`: its chains stay scalar, but the three-operand AVX
+//! encoding needs fewer instructions. The bits do not
 //! change: AVX without FMA performs the same IEEE operations in the same order (Rust never
 //! contracts `a * b + c` into a fused multiply-add), and every sum has its lane order fixed
 //! in the source, so the vector width cannot reorder it.
