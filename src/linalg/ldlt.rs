@@ -570,7 +570,10 @@ impl Ldlt {
 
     /// `A⁻¹ e_j` as a new vector (set-up only).
     pub fn column_of_inverse(&self, j: usize) -> Vec<f64> {
-        let mut c = vec![0.0; self.dim()];
+        // Zeros written, not `vec!`'s calloc: a fresh mapped page that the solve reads before
+        // writing would fault twice (the shared zero page, then its copy).
+        let mut c = Vec::with_capacity(self.dim());
+        c.resize(self.dim(), 0.0);
         c[j] = 1.0;
         self.solve_in_place(&mut c);
         c
