@@ -118,6 +118,159 @@ impl Steady {
     }
 }
 
+/// The matrix's own arrays (`d(i) = rd[i]`, `e(i) = re[i]` away from the `changed` rows), for
+/// finding where a stationary sweep may copy rows: row `r` repeats the row swept before it
+/// when it reads the same entries shifted by two nodes.
+struct RawRows<'a> {
+    rd: &'a [f64],
+    re: &'a [f64],
+    changed: &'a [usize],
+    n: usize,
+}
+
+/// The first `j` in `from..to` with `v[j] != v[j − 2]` bitwise, or `to` (`from >= 2`): eight
+/// comparisons at a time without a branch, then one by one from the block that differs.
+fn first_lag2_change(v: &[f64], from: usize, to: usize) -> usize {
+    if from >= to {
+        return to;
+    }
+    let (a, b) = (&v[from - 2..to - 2], &v[from..to]);
+    let mut k = 0;
+    for (ca, cb) in a.chunks_exact(8).zip(b.chunks_exact(8)) {
+        if !(ca.iter().zip(cb)).fold(true, |s, (x, y)| s & (x.to_bits() == y.to_bits())) {
+            break;
+        }
+        k += 8;
+    }
+    (k..a.len())
+        .find(|&p| a[p].to_bits() != b[p].to_bits())
+        .map_or(to, |p| from + p)
+}
+
+/// The last `j` in `from..to` with `v[j] != v[j − 2]` bitwise, if any (`from >= 2`).
+fn last_lag2_change(v: &[f64], from: usize, to: usize) -> Option<usize> {
+    if from >= to {
+        return None;
+    }
+    let (a, b) = (&v[from - 2..to - 2], &v[from..to]);
+    let mut k = a.len();
+    for (ca, cb) in a.rchunks_exact(8).zip(b.rchunks_exact(8)) {
+        if !(ca.iter().zip(cb)).fold(true, |s, (x, y)| s & (x.to_bits() == y.to_bits())) {
+            break;
+        }
+        k -= 8;
+    }
+    (0..k)
+        .rev()
+        .find(|&p| a[p].to_bits() != b[p].to_bits())
+        .map(|p| from + p)
+}
+
+impl RawRows<'_> {
+    /// Entries `lo..=hi` of the diagonal and the off-diagonal are the arrays' own. (The row-by-row
+    /// reference of the block scans.)
+    #[cfg(test)]
+    fn raw_ok(&self, lo: usize, hi: usize) -> bool {
+        self.changed.iter().all(|&c| c < lo || c > hi)
+    }
+
+    /// Whether top row `r` (r >= 3) reads the entries row `r − 1` read, shifted by two. (The row-by-row
+    /// reference of the block scans.)
+    #[cfg(test)]
+    fn top_repeats(&self, r: usize) -> bool {
+        let (rd, re, i) = (self.rd, self.re, 2 * r);
+        let same = |a: f64, b: f64| a.to_bits() == b.to_bits();
+        i + 2 < self.n
+            && self.raw_ok(i - 3, i + 2)
+            && same(rd[i], rd[i - 2])
+            && same(re[i - 1], re[i - 3])
+            && same(re[i], re[i - 2])
+            && same(re[i + 1], re[i - 1])
+            && same(rd[i + 1], rd[i - 1])
+    }
+
+    /// The same for bottom row `r` against row `r + 1`, swept before it. (The row-by-row
+    /// reference of the block scans.)
+    #[cfg(test)]
+    fn bottom_repeats(&self, r: usize) -> bool {
+        let (rd, re, i) = (self.rd, self.re, 2 * r);
+        let same = |a: f64, b: f64| a.to_bits() == b.to_bits();
+        i >= 2
+            && i + 3 < self.n
+            && self.raw_ok(i - 2, i + 3)
+            && same(rd[i], rd[i + 2])
+            && same(re[i - 2], re[i])
+            && same(re[i - 1], re[i + 1])
+            && same(re[i], re[i + 2])
+            && same(rd[i - 1], rd[i + 1])
+    }
+
+    /// The first top row in `start..twist` that does not repeat (`twist` if all do), for
+    /// `start >= 3`: what `while end < twist && top_repeats(end)` finds, with the entries
+    /// compared in blocks. Row `r` compares `rd` at `2r, 2r + 1` and `re` at `2r − 1 ..= 2r + 1`
+    /// with the entries two before; the first such entry that differs, `j`, is first read by
+    /// row `⌊j/2⌋`.
+    fn top_end(&self, start: usize, twist: usize) -> usize {
+        // Rows from `(n − 1)/2` on fail `i + 2 < n`.
+        let mut fail = twist.min(self.n.saturating_sub(1) / 2);
+        for &c in self.changed {
+            // Row `r` reads rows `2r − 3 ..= 2r + 2`.
+            let (lo, hi) = (c.saturating_sub(1) / 2, (c + 3) / 2);
+            if hi >= start && lo < fail {
+                fail = fail.min(lo.max(start));
+            }
+        }
+        if fail <= start {
+            return start;
+        }
+        let j = first_lag2_change(self.re, 2 * start - 1, 2 * fail).min(first_lag2_change(
+            self.rd,
+            2 * start,
+            2 * fail,
+        ));
+        if j < 2 * fail {
+            fail = (j / 2).max(start);
+        }
+        fail
+    }
+
+    /// The first `k` in `start..` whose bottom row `ν − 1 − k` does not repeat, or `ν − 1 −
+    /// twist` (the first row not swept), for `start >= 3`: what `while end + twist + 1 < ν &&
+    /// bottom_repeats(ν − 1 − end)` finds. Row `r` compares `rd` at `2r + 1, 2r + 2` and `re` at
+    /// `2r ..= 2r + 2` with the entries two before; going down, the first such entry that
+    /// differs, `j`, is read by row `⌊(j − 1)/2⌋` (`rd`) or `⌊j/2⌋` (`re`).
+    fn bottom_end(&self, start: usize, nu: usize, twist: usize) -> usize {
+        if start + twist + 1 >= nu {
+            return start;
+        }
+        // The rows swept, from the top down: `top` to `twist + 1`; `fail` the highest that
+        // does not repeat (`twist`: none).
+        let top = nu - 1 - start;
+        let mut fail = twist;
+        // `i + 3 < n`.
+        if 2 * top + 3 >= self.n {
+            return start;
+        }
+        for &c in self.changed {
+            // Row `r` reads rows `2r − 2 ..= 2r + 3`.
+            let (lo, hi) = (c.saturating_sub(2) / 2, (c + 2) / 2);
+            if lo <= top && hi > fail {
+                fail = fail.max(hi.min(top));
+            }
+        }
+        if fail < top {
+            let lo = fail + 1;
+            if let Some(j) = last_lag2_change(self.rd, 2 * lo + 1, 2 * top + 3) {
+                fail = fail.max((j - 1) / 2);
+            }
+            if let Some(j) = last_lag2_change(self.re, 2 * lo, 2 * top + 3) {
+                fail = fail.max((j / 2).min(top));
+            }
+        }
+        nu - 1 - fail
+    }
+}
+
 impl Ldlt {
     pub fn factor(a: &SymTridiag) -> Result<Self, NotPositiveDefinite> {
         Self::factor_by(
@@ -175,7 +328,11 @@ impl Ldlt {
                     .then(|| Arc::clone(if top { &f.top } else { &f.bottom }))
             })
         };
-        let changed = |i: usize| nodes.contains(&i);
+        // A range test first: the sweeps ask about every row, and the solvers' nodes are at
+        // most two, at the ends.
+        let lo = nodes.iter().copied().min().unwrap_or(usize::MAX);
+        let hi = nodes.iter().copied().max().unwrap_or(0);
+        let changed = |i: usize| i >= lo && i <= hi && nodes.contains(&i);
         let halves = [reuse(true), reuse(false)];
         match change {
             RowChange::Identity => Self::factor_by(
@@ -215,32 +372,7 @@ impl Ldlt {
         reuse: [Option<Arc<Vec<[f64; 5]>>>; 2],
     ) -> Result<Self, NotPositiveDefinite> {
         let (rd, re, changed) = raw;
-        // Entries `lo..=hi` of the diagonal and the off-diagonal are the arrays' own.
-        let raw_ok = |lo: usize, hi: usize| changed.iter().all(|&c| c < lo || c > hi);
-        let same = |a: f64, b: f64| a.to_bits() == b.to_bits();
-        // Whether top row `r` (r >= 3) reads the entries row `r − 1` read, shifted by two.
-        let top_repeats = |r: usize| {
-            let i = 2 * r;
-            i + 2 < n
-                && raw_ok(i - 3, i + 2)
-                && same(rd[i], rd[i - 2])
-                && same(re[i - 1], re[i - 3])
-                && same(re[i], re[i - 2])
-                && same(re[i + 1], re[i - 1])
-                && same(rd[i + 1], rd[i - 1])
-        };
-        // The same for bottom row `r` against row `r + 1`, swept before it.
-        let bottom_repeats = |r: usize| {
-            let i = 2 * r;
-            i >= 2
-                && i + 3 < n
-                && raw_ok(i - 2, i + 3)
-                && same(rd[i], rd[i + 2])
-                && same(re[i - 2], re[i])
-                && same(re[i - 1], re[i + 1])
-                && same(re[i], re[i + 2])
-                && same(rd[i - 1], rd[i + 1])
-        };
+        let raw_rows = RawRows { rd, re, changed, n };
         let [reuse_top, reuse_bottom] = reuse;
         let check = |index: usize, pivot: f64| {
             if pivot > 0.0 && pivot.is_finite() {
@@ -251,8 +383,26 @@ impl Ldlt {
         };
         // Odd node `2k + 1`: [f1, f2, 1/d] (f2 = 0 for the last node); recomputed where
         // needed rather than stored, so the set-up holds nothing beyond the factorisation.
-        for o in (1..n).step_by(2) {
-            check(o, d(o))?;
+        // Every odd pivot `d(o)` positive and finite: one branch-free pass over the raw diagonal
+        // plus the changed rows (`d` agrees with it elsewhere); the node-by-node loop, which
+        // names the first bad pivot, runs only when that pass fails.
+        let usable = |p: f64| (p > 0.0) & (p < f64::INFINITY);
+        let raw_odd_ok = {
+            // Sixteen entries from an odd one at a time: eight odd ones at even offsets.
+            let mut blocks = rd.get(1..n).unwrap_or_default().chunks_exact(16);
+            let mut ok = true;
+            for block in &mut blocks {
+                ok &= (0..8).fold(true, |all, k| all & usable(block[2 * k]));
+            }
+            (blocks.remainder().iter().step_by(2)).fold(ok, |ok, &p| ok & usable(p))
+        };
+        let changed_ok = changed
+            .iter()
+            .all(|&c| c % 2 == 0 || c >= n || usable(d(c)));
+        if !(raw_odd_ok && changed_ok) {
+            for o in (1..n).step_by(2) {
+                check(o, d(o))?;
+            }
         }
         let odd = |k: usize| {
             let o = 2 * k + 1;
@@ -300,10 +450,7 @@ impl Ldlt {
                         // Row r repeats row r − 1; so do the rows after it that read the
                         // same entries (checked on the matrix's own arrays, away from the
                         // changed rows).
-                        let mut end = r + 1;
-                        while end < twist && top_repeats(end) {
-                            end += 1;
-                        }
+                        let end = raw_rows.top_end(r + 1, twist);
                         top.resize(end, top[r - 1]);
                         r = end;
                         continue;
@@ -358,10 +505,7 @@ impl Ldlt {
                         d(i - 1),
                     ];
                     if steady.repeats(k, inputs) {
-                        let mut end = k + 1;
-                        while end + twist + 1 < nu && bottom_repeats(nu - 1 - end) {
-                            end += 1;
-                        }
+                        let end = raw_rows.bottom_end(k + 1, nu, twist);
                         bottom.resize(end, bottom[k - 1]);
                         k = end;
                         continue;
@@ -602,7 +746,10 @@ impl<V: Value, const ADD: bool> dispatch::Kernel for Solve<'_, V, ADD> {
 impl Ldlt {
     /// `A⁻¹ e_j` as a new vector (set-up only).
     pub fn column_of_inverse(&self, j: usize) -> Vec<f64> {
-        let mut c = vec![0.0; self.dim()];
+        // Zeros written, not `vec!`'s calloc: a fresh mapped page that the solve reads before
+        // writing would fault twice (the shared zero page, then its copy).
+        let mut c = Vec::with_capacity(self.dim());
+        c.resize(self.dim(), 0.0);
         c[j] = 1.0;
         self.solve_in_place(&mut c);
         c
@@ -868,5 +1015,61 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// `top_end` and `bottom_end` stop at the row where the row-by-row checks stop, on arrays
+    /// that repeat with period two in stretches broken at random places, with changed rows
+    /// anywhere, for every start and twist.
+    #[test]
+    fn the_block_scans_stop_where_the_row_checks_stop() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let mut long = 0;
+        for n in (4usize..=40).chain([67, 100, 101]) {
+            for trial in 0..12 {
+                // Period two, with a break every so often (none in the first trials).
+                let mut rd = vec![2.0, 3.0];
+                let mut re = vec![-1.0, 0.5];
+                while rd.len() < n {
+                    let i = rd.len();
+                    let breaks = trial > 2 && next() % (4 + 3 * trial as u64) == 0;
+                    rd.push(if breaks { rd[i - 2] + 1.0 } else { rd[i - 2] });
+                    let breaks = trial > 2 && next() % (4 + 3 * trial as u64) == 0;
+                    re.push(if breaks { re[i - 2] * 0.5 } else { re[i - 2] });
+                }
+                rd.truncate(n);
+                re.truncate(n - 1);
+                let changed: Vec<usize> = (0..trial % 4).map(|_| next() as usize % n).collect();
+                let rows = RawRows {
+                    rd: &rd,
+                    re: &re,
+                    changed: &changed,
+                    n,
+                };
+                let nu = n.div_ceil(2);
+                for twist in 0..=nu {
+                    for start in 3..nu + 2 {
+                        let mut end = start;
+                        while end < twist && rows.top_repeats(end) {
+                            end += 1;
+                        }
+                        assert_eq!(rows.top_end(start, twist), end, "top n {n} {twist} {start}");
+                        long += usize::from(end > start + 2);
+                        let mut end = start;
+                        while end + twist + 1 < nu && rows.bottom_repeats(nu - 1 - end) {
+                            end += 1;
+                        }
+                        let got = rows.bottom_end(start, nu, twist);
+                        assert_eq!(got, end, "bottom n {n} {changed:?} {twist} {start}");
+                    }
+                }
+            }
+        }
+        assert!(long > 1000, "{long} long stretches");
     }
 }

@@ -75,15 +75,31 @@ impl SymTridiag {
         )
     }
 
-    /// [`SymTridiag::sub`], reusing this matrix's storage.
+    /// [`SymTridiag::sub`], reusing this matrix's storage, row sums included: an interior row
+    /// of the sub-matrix keeps both neighbours, so its sum has the same bits; only the two end
+    /// rows are summed again (no J-sized vector allocated and filled at set-up).
     pub fn into_sub(self, first: usize, last: usize) -> SymTridiag {
-        let (mut diag, mut off) = (self.diag, self.off);
-        drop(self.row_sums);
+        let (mut diag, mut off, mut s) = (self.diag, self.off, self.row_sums);
         diag.truncate(last + 1);
         diag.drain(..first);
         off.truncate(last);
         off.drain(..first);
-        SymTridiag::new(diag, off)
+        s.truncate(last + 1);
+        s.drain(..first);
+        let n = diag.len();
+        match n {
+            0 => {}
+            1 => s[0] = (0.0 + diag[0]) + 0.0,
+            _ => {
+                s[0] = (0.0 + diag[0]) + off[0];
+                s[n - 1] = (off[n - 2] + diag[n - 1]) + 0.0;
+            }
+        }
+        SymTridiag {
+            diag,
+            off,
+            row_sums: s,
+        }
     }
 
     /// `y = A x`, without allocating, in difference form
@@ -127,9 +143,10 @@ impl SymTridiag {
         for (s, xi) in self.row_sums.iter().zip(&x[..n]) {
             q += s * xi * xi;
         }
-        for i in 0..n.saturating_sub(1) {
-            let d = x[i + 1] - x[i];
-            q -= self.off[i] * d * d;
+        // The same sum in the same order, through windows (no bounds checks).
+        for (e, w) in self.off.iter().zip(x[..n].windows(2)) {
+            let d = w[1] - w[0];
+            q -= e * d * d;
         }
         q
     }
@@ -297,4 +314,33 @@ pub fn backward_error(a: &SymTridiag, x: &[f64], b: &[f64]) -> f64 {
 /// `xᵀ y`.
 pub fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `into_sub` keeps the interior row sums it had: every entry of the result, row sums
+    /// included, has the bits `sub` computes afresh (signed zeros too).
+    #[test]
+    fn into_sub_has_the_bits_of_sub() {
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for n in 1..8 {
+            let diag: Vec<f64> = (0..n).map(|i| [0.3, -0.0, 1.0 / 3.0, 7.5][i % 4]).collect();
+            let off: Vec<f64> = (1..n).map(|i| [-0.0, 0.1, -2.0 / 7.0][i % 3]).collect();
+            let a = SymTridiag::new(diag, off);
+            for first in 0..n {
+                for last in first..n {
+                    let (want, got) = (a.sub(first, last), a.clone().into_sub(first, last));
+                    assert_eq!(bits(&got.diag), bits(&want.diag));
+                    assert_eq!(bits(&got.off), bits(&want.off));
+                    assert_eq!(
+                        bits(got.row_sums()),
+                        bits(want.row_sums()),
+                        "{n} {first}..={last}"
+                    );
+                }
+            }
+        }
+    }
 }

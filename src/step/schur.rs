@@ -128,10 +128,14 @@ pub(crate) fn inverse_columns(factor: &Ldlt, nodes: &[usize]) -> Vec<Column> {
             }
             let start = values.iter().position(|v| *v != 0.0).unwrap_or(0);
             let end = values.iter().rposition(|v| *v != 0.0).map_or(0, |e| e + 1);
+            let max_abs = max_abs(&values);
+            // The support kept in the column's own storage (no second J-sized copy).
+            values.truncate(end);
+            values.drain(..start.min(end));
             Column {
                 node,
-                max_abs: max_abs(&values),
-                values: values.get(start..end).unwrap_or_default().to_vec(),
+                max_abs,
+                values,
                 support: start..end,
             }
         })
