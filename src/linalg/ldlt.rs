@@ -35,15 +35,37 @@ pub struct Ldlt {
     /// its inner side (towards the twist): `top[r] = [l_r, 1/D_r, f1_o, f2_o, 1/d_o]` with
     /// `o = 2r + 1` for rows `r = 0..μ` (`l_r = E'_r/D_r`); `bottom[k]` the same for row
     /// `r = ν−1−k > μ` with `o = 2r − 1` and `l_r = E'_r−1/D_r`. A half that several
-    /// factorisations have is stored once ([`Ldlt::factor_with_rows_changed`]).
-    top: Arc<Vec<[f64; 5]>>,
-    bottom: Arc<Vec<[f64; 5]>>,
+    /// factorisations have is stored once ([`Ldlt::factor_with_rows_changed`]), and a half
+    /// whose sweep ends in a stationary stretch stores that stretch's row once ([`Half`]).
+    top: Arc<Half>,
+    bottom: Arc<Half>,
     /// `[f1, 1/d]` of the last node when it is odd (`n` even): it is on no reduced row's inner
     /// side.
     outer: Option<[f64; 2]>,
     /// `1/D_μ`, the twist pivot.
     inv_twist: f64,
     n: usize,
+}
+
+/// One half of an [`Ldlt`]: `len` rows, of which the first `rows.len()` are stored and the
+/// rest repeat the last one stored. A sweep that becomes stationary up to the twist (a
+/// uniform interior, once the pivots have converged) repeats one row bit for bit to the
+/// end: storing it once saves the set-up its pages and the solve its loads.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct Half {
+    rows: Vec<[f64; 5]>,
+    len: usize,
+}
+
+impl Half {
+    /// Every row, the repeated ones included (tests).
+    #[cfg(test)]
+    fn expanded(&self) -> Vec<[f64; 5]> {
+        let last = self.rows.last().copied().unwrap_or_default();
+        let mut rows = self.rows.clone();
+        rows.resize(self.len, last);
+        rows
+    }
 }
 
 /// How [`Ldlt::factor_with_rows_changed`] changes the rows (and columns) of its nodes.
@@ -369,7 +391,7 @@ impl Ldlt {
         d: impl Fn(usize) -> f64,
         e: impl Fn(usize) -> f64,
         raw: (&[f64], &[f64], &[usize]),
-        reuse: [Option<Arc<Vec<[f64; 5]>>>; 2],
+        reuse: [Option<Arc<Half>>; 2],
     ) -> Result<Self, NotPositiveDefinite> {
         let (rd, re, changed) = raw;
         let raw_rows = RawRows { rd, re, changed, n };
@@ -425,7 +447,7 @@ impl Ldlt {
         let reduced_off = |r: usize| -(e(2 * r) * odd(r)[1]);
         let twist = nu / 2;
         // The last multiplier of each half enters the twist pivot.
-        let last_l = |half: &[[f64; 5]]| half.last().map_or(0.0, |row| row[0]);
+        let last_l = |half: &Half| half.rows.last().map_or(0.0, |row| row[0]);
         // The sweeps below carry each odd node's quotients and each reduced off-diagonal from
         // one row to the next instead of calling `odd` and `reduced_off` again (the same
         // operations on the same numbers: the same bits, a third of the divisions).
@@ -451,7 +473,9 @@ impl Ldlt {
                         // same entries (checked on the matrix's own arrays, away from the
                         // changed rows).
                         let end = raw_rows.top_end(r + 1, twist);
-                        top.resize(end, top[r - 1]);
+                        if end < twist {
+                            top.resize(end, top[r - 1]);
+                        }
                         r = end;
                         continue;
                     }
@@ -475,7 +499,11 @@ impl Ldlt {
                     (odd_prev, off_prev) = (cur, off);
                     r += 1;
                 }
-                Arc::new(top)
+                top.shrink_to_fit();
+                Arc::new(Half {
+                    rows: top,
+                    len: twist,
+                })
             }
         };
         let bottom = match reuse_bottom {
@@ -506,7 +534,9 @@ impl Ldlt {
                     ];
                     if steady.repeats(k, inputs) {
                         let end = raw_rows.bottom_end(k + 1, nu, twist);
-                        bottom.resize(end, bottom[k - 1]);
+                        if end + twist + 1 < nu {
+                            bottom.resize(end, bottom[k - 1]);
+                        }
                         k = end;
                         continue;
                     }
@@ -530,7 +560,11 @@ impl Ldlt {
                     (odd_next, off_next) = (lo, off);
                     k += 1;
                 }
-                Arc::new(bottom)
+                bottom.shrink_to_fit();
+                Arc::new(Half {
+                    rows: bottom,
+                    len: nu.saturating_sub(twist + 1),
+                })
             }
         };
         let (l_prev, l_next) = (last_l(&top), last_l(&bottom));
@@ -611,11 +645,19 @@ impl Ldlt {
         if n == 0 {
             return;
         }
-        let (top_f, bottom_f) = (&self.top[..], &self.bottom[..]);
-        let m = top_f.len();
+        // Row `k` of a half is `rows[k]` for `k < p` (the rows stored) and the stationary row
+        // `rows[p − 1]` after that (see `Half`): each loop below runs in segments, reading
+        // the stored rows from memory and the stationary one from a local.
+        let (top_rows, bottom_rows) = (&self.top.rows[..], &self.bottom.rows[..]);
+        let (top_still, bottom_still) = (
+            top_rows.last().copied().unwrap_or_default(),
+            bottom_rows.last().copied().unwrap_or_default(),
+        );
+        let still = |row: &[f64; 5]| std::iter::repeat(*row);
+        let (m, bottom_len) = (self.top.len, self.bottom.len);
         // Top rows r < μ own nodes (2r, 2r+1); the twist is node 2μ; bottom rows own
         // (2r−1, 2r); then the outer odd node when n is even.
-        let bottom_nodes = 2 * bottom_f.len();
+        let bottom_nodes = 2 * bottom_len;
         let (b_top, b_rest) = b.split_at(2 * m);
         let (b_mid, b_rest) = b_rest.split_at(1);
         let (b_bottom, b_outer) = b_rest.split_at(bottom_nodes);
@@ -625,7 +667,11 @@ impl Ldlt {
         let (u_top, u_rest) = u.split_at(2 * m);
         let (u_mid, u_rest) = u_rest.split_at(1);
         let (u_bottom, u_outer) = u_rest.split_at(bottom_nodes);
-        let common = m.min(bottom_f.len());
+        let common = m.min(bottom_len);
+        let (pt, pb) = (top_rows.len().min(m), bottom_rows.len().min(bottom_len));
+        // Links `0..common` of both chains in three segments: both stored (`..s1`), one stored
+        // (`s1..s2`), neither (`s2..`).
+        let (s1, s2) = (pt.min(pb).min(common), pt.max(pb).min(common));
 
         // Inward. Per chain: y (the elimination value), l (the multiplier of the row before)
         // and c, the term of the shared odd node (`f b_o`) the next row subtracts.
@@ -649,19 +695,45 @@ impl Ldlt {
                 x[1].set(*y * f[1]);
                 (*l, *c) = (f[0], f[2] * bo);
             };
-        let mut top = b_top.chunks_exact(2).zip(x_top.chunks_exact(2)).zip(top_f);
-        let mut bottom = (b_bottom.rchunks_exact(2).zip(x_bottom.rchunks_exact(2))).zip(bottom_f);
-        for (((bt, xt), ft), ((bb, xb), fb)) in
-            top.by_ref().take(common).zip(bottom.by_ref().take(common))
-        {
-            inward_top(bt, xt, ft, &mut yt, &mut lt, &mut ct);
-            inward_bottom(bb, xb, fb, &mut yb, &mut lb, &mut cb);
+        let mut top = b_top.chunks_exact(2).zip(x_top.chunks_exact(2));
+        let mut bottom = b_bottom.rchunks_exact(2).zip(x_bottom.rchunks_exact(2));
+        macro_rules! inward_both {
+            ($links:expr, $top_rows:expr, $bottom_rows:expr) => {
+                for (((bt, xt), ft), ((bb, xb), fb)) in (top.by_ref().take($links).zip($top_rows))
+                    .zip(bottom.by_ref().take($links).zip($bottom_rows))
+                {
+                    inward_top(bt, xt, &ft, &mut yt, &mut lt, &mut ct);
+                    inward_bottom(bb, xb, &fb, &mut yb, &mut lb, &mut cb);
+                }
+            };
         }
-        for ((bt, xt), ft) in top {
-            inward_top(bt, xt, ft, &mut yt, &mut lt, &mut ct);
+        inward_both!(
+            s1,
+            top_rows[..s1].iter().copied(),
+            bottom_rows[..s1].iter().copied()
+        );
+        if pt <= pb {
+            inward_both!(
+                s2 - s1,
+                still(&top_still),
+                bottom_rows[s1..s2].iter().copied()
+            );
+        } else {
+            inward_both!(
+                s2 - s1,
+                top_rows[s1..s2].iter().copied(),
+                still(&bottom_still)
+            );
         }
-        for ((bb, xb), fb) in bottom {
-            inward_bottom(bb, xb, fb, &mut yb, &mut lb, &mut cb);
+        inward_both!(common - s2, still(&top_still), still(&bottom_still));
+        // The longer half's rest: stored rows, then the stationary one.
+        let top_stored = top_rows[common.min(pt)..pt].iter().copied();
+        for ((bt, xt), ft) in top.zip(top_stored.chain(still(&top_still))) {
+            inward_top(bt, xt, &ft, &mut yt, &mut lt, &mut ct);
+        }
+        let bottom_stored = bottom_rows[common.min(pb)..pb].iter().copied();
+        for ((bb, xb), fb) in bottom.zip(bottom_stored.chain(still(&bottom_still))) {
+            inward_bottom(bb, xb, &fb, &mut yb, &mut lb, &mut cb);
         }
         // Twist row: the terms are 0 when a side is empty (l = 0, y = 0, c = 0).
         let xm = (((b_mid[0].value() - ct) - cb) - lt * yt - lb * yb) * self.inv_twist;
@@ -698,21 +770,52 @@ impl Ldlt {
                 *xn = xe;
             };
         let mut top = (b_top.chunks_exact(2).zip(x_top.chunks_exact(2)))
-            .zip(u_top.chunks_exact(2).zip(top_f))
+            .zip(u_top.chunks_exact(2))
             .rev();
         let mut bottom = (b_bottom.rchunks_exact(2).zip(x_bottom.rchunks_exact(2)))
-            .zip(u_bottom.rchunks_exact(2).zip(bottom_f))
+            .zip(u_bottom.rchunks_exact(2))
             .rev();
-        for ((bt, xt), (ut, ft)) in top.by_ref().take(m - common) {
-            outward_top(bt, xt, ut, ft, &mut xt_);
+        // The longer half's rest first, from the twist: the stationary row, then stored rows.
+        let top_rest = std::iter::repeat_n(top_still, m - pt.max(common))
+            .chain(top_rows[common.min(pt)..pt].iter().rev().copied());
+        for (((bt, xt), ut), ft) in top.by_ref().take(m - common).zip(top_rest) {
+            outward_top(bt, xt, ut, &ft, &mut xt_);
         }
-        for ((bb, xb), (ub, fb)) in bottom.by_ref().take(bottom_f.len() - common) {
-            outward_bottom(bb, xb, ub, fb, &mut xb_);
+        let bottom_rest = std::iter::repeat_n(bottom_still, bottom_len - pb.max(common))
+            .chain(bottom_rows[common.min(pb)..pb].iter().rev().copied());
+        for (((bb, xb), ub), fb) in bottom.by_ref().take(bottom_len - common).zip(bottom_rest) {
+            outward_bottom(bb, xb, ub, &fb, &mut xb_);
         }
-        for (((bt, xt), (ut, ft)), ((bb, xb), (ub, fb))) in top.zip(bottom) {
-            outward_top(bt, xt, ut, ft, &mut xt_);
-            outward_bottom(bb, xb, ub, fb, &mut xb_);
+        macro_rules! outward_both {
+            ($links:expr, $top_rows:expr, $bottom_rows:expr) => {
+                for ((((bt, xt), ut), ft), (((bb, xb), ub), fb)) in
+                    (top.by_ref().take($links).zip($top_rows))
+                        .zip(bottom.by_ref().take($links).zip($bottom_rows))
+                {
+                    outward_top(bt, xt, ut, &ft, &mut xt_);
+                    outward_bottom(bb, xb, ub, &fb, &mut xb_);
+                }
+            };
         }
+        outward_both!(common - s2, still(&top_still), still(&bottom_still));
+        if pt <= pb {
+            outward_both!(
+                s2 - s1,
+                still(&top_still),
+                bottom_rows[s1..s2].iter().rev().copied()
+            );
+        } else {
+            outward_both!(
+                s2 - s1,
+                top_rows[s1..s2].iter().rev().copied(),
+                still(&bottom_still)
+            );
+        }
+        outward_both!(
+            s1,
+            top_rows[..s1].iter().rev().copied(),
+            bottom_rows[..s1].iter().rev().copied()
+        );
         if let (Some([f1, inv_d]), Some(bo), Some(xo), Some(uo)) = (
             self.outer,
             b_outer.first(),
@@ -866,6 +969,70 @@ mod tests {
         }
     }
 
+    /// A solve with halves that store their stationary row once gives the bits of the same
+    /// factorisation with every row stored, on uniform matrices (compact halves of different
+    /// stored lengths: plain, one end or both ends changed), one uniform on each side of the
+    /// twist with different stationary rows, and a non-uniform one (nothing to compact),
+    /// separate and in place, with the fused update (mutation-checked: a segment taking its
+    /// stationary row from the wrong half fails it).
+    #[test]
+    fn compact_halves_solve_like_stored_rows() {
+        for n in (1usize..=14).chain([60, 61, 1000, 1001]) {
+            let a = SymTridiag::new(vec![4.0; n], vec![-1.0; n.saturating_sub(1)]);
+            let wobbly = SymTridiag::new(
+                (0..n).map(|i| 4.0 + (i as f64).sin()).collect(),
+                vec![-1.0; n.saturating_sub(1)],
+            );
+            // Uniform on each side of the twist node `2μ` with different diagonals: both halves
+            // compact, with different stationary rows.
+            let twist_node = 2 * (n.div_ceil(2) / 2);
+            let two_level = SymTridiag::new(
+                (0..n)
+                    .map(|i| if i < twist_node { 4.0 } else { 5.0 })
+                    .collect(),
+                vec![-1.0; n.saturating_sub(1)],
+            );
+            let mut cases = vec![
+                Ldlt::factor(&a).unwrap(),
+                Ldlt::factor(&wobbly).unwrap(),
+                Ldlt::factor(&two_level).unwrap(),
+            ];
+            if n == 1001 {
+                let f = &cases[2];
+                assert!(f.top.rows.len() < 64 && f.bottom.rows.len() < 64);
+                assert_ne!(f.top.rows.last(), f.bottom.rows.last());
+            }
+            if n >= 2 {
+                for nodes in [&[0][..], &[n - 1], &[0, n - 1]] {
+                    let f = Ldlt::factor_with_rows_changed(&a, nodes, RowChange::Identity, &[]);
+                    cases.push(f.unwrap());
+                }
+            }
+            let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37 + 0.1).cos()).collect();
+            let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            for f in cases {
+                let stored = |h: &Half| {
+                    Arc::new(Half {
+                        rows: h.expanded(),
+                        len: h.len,
+                    })
+                };
+                let full = Ldlt {
+                    top: stored(&f.top),
+                    bottom: stored(&f.bottom),
+                    ..f.clone()
+                };
+                let solve = |g: &Ldlt| {
+                    let (mut x, mut u, mut y) = (vec![0.0; n], vec![1.0; n], b.clone());
+                    g.solve_into_and_add(&b, &mut x, &mut u);
+                    g.solve_in_place(&mut y);
+                    (bits(&x), bits(&u), bits(&y))
+                };
+                assert_eq!(solve(&f), solve(&full), "n {n}");
+            }
+        }
+    }
+
     #[test]
     fn the_carried_sweeps_equal_the_formulas_bit_for_bit() {
         for n in (1usize..=13).chain([100, 101, 1000]) {
@@ -878,8 +1045,8 @@ mod tests {
             let f = Ldlt::factor(&a).unwrap();
             let (top, bottom, inv_twist) = by_the_formulas(&a);
             let bits = |h: &[[f64; 5]]| h.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
-            assert_eq!(bits(&f.top), bits(&top), "n {n}: top");
-            assert_eq!(bits(&f.bottom), bits(&bottom), "n {n}: bottom");
+            assert_eq!(bits(&f.top.expanded()), bits(&top), "n {n}: top");
+            assert_eq!(bits(&f.bottom.expanded()), bits(&bottom), "n {n}: bottom");
             assert_eq!(f.inv_twist.to_bits(), inv_twist.to_bits(), "n {n}: twist");
         }
     }
@@ -892,8 +1059,8 @@ mod tests {
         let bits = |h: &[[f64; 5]]| h.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
         let check = |a: &SymTridiag, f: &Ldlt, what: &str| {
             let (top, bottom, inv_twist) = by_the_formulas(a);
-            assert_eq!(bits(&f.top), bits(&top), "{what}: top");
-            assert_eq!(bits(&f.bottom), bits(&bottom), "{what}: bottom");
+            assert_eq!(bits(&f.top.expanded()), bits(&top), "{what}: top");
+            assert_eq!(bits(&f.bottom.expanded()), bits(&bottom), "{what}: bottom");
             assert_eq!(f.inv_twist.to_bits(), inv_twist.to_bits(), "{what}: twist");
         };
         for n in (1usize..=14).chain([100, 101, 1000, 4097]) {
@@ -908,7 +1075,15 @@ mod tests {
                     diag[n - 1] = end;
                 }
                 let mut a = SymTridiag::new(diag.clone(), vec![e; n.saturating_sub(1)]);
-                check(&a, &Ldlt::factor(&a).unwrap(), &format!("n {n}, d {d}"));
+                let f = Ldlt::factor(&a).unwrap();
+                check(&a, &f, &format!("n {n}, d {d}"));
+                if n >= 1000 && d == 4.0 {
+                    // Converged within a few dozen rows: each half stores its stationary row
+                    // once.
+                    for h in [&f.top, &f.bottom] {
+                        assert!(h.rows.len() < 64 && h.len > 200, "n {n}: {}", h.rows.len());
+                    }
+                }
                 if n > 6 {
                     diag[n / 2] *= 1.5;
                     a = SymTridiag::new(diag.clone(), vec![e; n - 1]);
@@ -967,8 +1142,8 @@ mod tests {
         let bits = |f: &Ldlt| {
             let half = |h: &[[f64; 5]]| h.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
             (
-                half(&f.top),
-                half(&f.bottom),
+                half(&f.top.expanded()),
+                half(&f.bottom.expanded()),
                 f.outer.map(|o| o.map(f64::to_bits)),
                 f.inv_twist.to_bits(),
             )
@@ -1003,7 +1178,7 @@ mod tests {
                     made.push(shared);
                 }
                 if pair == [0, n - 1] && n >= 5 {
-                    let mut halves: Vec<&Arc<Vec<[f64; 5]>>> = Vec::new();
+                    let mut halves: Vec<&Arc<Half>> = Vec::new();
                     for f in std::iter::once(&plain).chain(&made) {
                         for h in [&f.top, &f.bottom] {
                             if !halves.iter().any(|k| Arc::ptr_eq(k, h)) {
