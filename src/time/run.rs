@@ -4,7 +4,9 @@
 use crate::scene::{OutputFormat, Scene};
 use crate::time::RunError;
 use crate::time::simulation::{NodeValues, Simulation, StepRecord, Unstarted};
-use crate::time::summary::{Summary, Tracker, output_time, push_output_time};
+use crate::time::summary::{
+    Summary, TIME_TEXT_BYTES, Tracker, output_time, output_time_text, push_output_time,
+};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -300,7 +302,7 @@ const PROFILE_CHUNK_BYTES: usize = 1 << 17;
 /// Room for a row `t,x,u,v\n` with padded fields: `t` and `x` in fields of [`FIELD_BYTES`]
 /// (the second written over the first's padding), `u` and `v` of at most 24 bytes each
 /// (`-1.2345678901234567e-308`), two separators.
-const PROFILE_ROW_MAX_BYTES: usize = 2 * FIELD_BYTES + 2 * 24 + 2;
+const PROFILE_ROW_MAX_BYTES: usize = 2 * FIELD_BYTES + 2 * NUMBER_BYTES + 2;
 
 /// `displacement.csv`: one row `t,x,u,v` a written node at each kept step. `t` and `x` are
 /// rounded (see [`output_time`]) and written as `Display` would, `x` formatted once per run;
@@ -371,20 +373,37 @@ impl ProfileCsv {
         let capacity = usize::try_from(sampling.nodes_written).unwrap_or(0);
         let mut xs = XFields::Narrow(Vec::with_capacity(capacity));
         let mut long_fields = false;
-        let mut text = Vec::with_capacity(FIELD_BYTES);
+        let mut slow = Vec::with_capacity(FIELD_BYTES);
+        let mut fast = [0; TIME_TEXT_BYTES];
         for i in written_nodes(stride, nodes) {
-            x_text(i, &mut text);
-            long_fields |= text.len() > FIELD_BYTES;
+            // `x` without a `Vec` on the fast path.
+            let (text, len): (&[u8], usize) = match output_time_text(disc.x(i), &mut fast) {
+                Some(len) => {
+                    fast[len] = b',';
+                    (&fast, len + 1)
+                }
+                None => {
+                    x_text(i, &mut slow);
+                    let len = slow.len();
+                    slow.resize(len.max(FIELD_BYTES), 0);
+                    (&slow, len)
+                }
+            };
+            long_fields |= len > FIELD_BYTES;
             if let XFields::Narrow(narrow) = &xs
-                && text.len() > NARROW_FIELD_BYTES
+                && len > NARROW_FIELD_BYTES
             {
                 let mut wide = Vec::with_capacity(capacity);
-                wide.extend(narrow.iter().map(|(f, len)| field(&f[..usize::from(*len)])));
+                wide.extend(narrow.iter().map(|(f, len)| {
+                    let mut w = [0; FIELD_BYTES];
+                    w[..NARROW_FIELD_BYTES].copy_from_slice(f);
+                    (w, *len)
+                }));
                 xs = XFields::Wide(wide);
             }
             match &mut xs {
-                XFields::Narrow(xs) => xs.push(field(&text)),
-                XFields::Wide(xs) => xs.push(field(&text)),
+                XFields::Narrow(xs) => xs.push(field(text, len)),
+                XFields::Wide(xs) => xs.push(field(text, len)),
             }
         }
         let long_xs = if long_fields {
@@ -414,13 +433,24 @@ impl ProfileCsv {
 
     /// The rows of one kept step at time `t`.
     fn write(&mut self, t: f64, values: NodeValues<'_>) -> std::io::Result<()> {
-        let mut t_text = Vec::with_capacity(FIELD_BYTES);
-        push_output_time(t, &mut t_text);
-        t_text.push(b',');
-        if self.long_fields || t_text.len() > FIELD_BYTES {
-            return self.write_long(&t_text, values);
-        }
-        let (t_field, t_len) = field(&t_text);
+        let mut fast = [0; TIME_TEXT_BYTES];
+        let (t_field, t_len) = match output_time_text(t, &mut fast) {
+            Some(len) if !self.long_fields => {
+                fast[len] = b',';
+                field(&fast, len + 1)
+            }
+            _ => {
+                let mut t_text = Vec::with_capacity(FIELD_BYTES);
+                push_output_time(t, &mut t_text);
+                t_text.push(b',');
+                if self.long_fields || t_text.len() > FIELD_BYTES {
+                    return self.write_long(&t_text, values);
+                }
+                let len = t_text.len();
+                t_text.resize(FIELD_BYTES, 0);
+                field(&t_text, len)
+            }
+        };
         let t = (&t_field, usize::from(t_len));
         // Taken out for the loop (`Vec::new` allocates nothing) and put back.
         let xs = std::mem::replace(&mut self.xs, XFields::Narrow(Vec::new()));
@@ -440,25 +470,26 @@ impl ProfileCsv {
         values: NodeValues<'_>,
     ) -> std::io::Result<()> {
         let (mut bu, mut bv) = (zmij::Buffer::new(), zmij::Buffer::new());
-        for (i, (x_field, x_len)) in written_nodes(self.stride, self.nodes).zip(xs) {
-            let (u, v) = values.at(i);
+        let last = self.nodes.saturating_sub(1);
+        for (j, (x_field, x_len)) in xs.iter().enumerate() {
+            // The `j`-th of `written_nodes`, without its chained iterator.
+            let (u, v) = values.at(j.saturating_mul(self.stride).min(last));
             if self.len > PROFILE_CHUNK_BYTES - PROFILE_ROW_MAX_BYTES {
                 self.file.write_all(&self.chunk[..self.len])?;
                 self.len = 0;
             }
-            let row = &mut self.chunk[self.len..self.len + PROFILE_ROW_MAX_BYTES];
+            let Some(row) = self.chunk[self.len..].first_chunk_mut::<PROFILE_ROW_MAX_BYTES>()
+            else {
+                unreachable!("a chunk has room for a row after the check above")
+            };
             row[..FIELD_BYTES].copy_from_slice(t_field);
             let mut at = t_len;
             row[at..at + W].copy_from_slice(x_field);
             at += usize::from(*x_len);
-            let u = bu.format(u).as_bytes();
-            row[at..at + u.len()].copy_from_slice(u);
-            at += u.len();
+            at += put_number(&mut row[at..], bu.format(u).as_bytes());
             row[at] = b',';
             at += 1;
-            let v = bv.format(v).as_bytes();
-            row[at..at + v.len()].copy_from_slice(v);
-            at += v.len();
+            at += put_number(&mut row[at..], bv.format(v).as_bytes());
             row[at] = b'\n';
             self.len += at + 1;
         }
@@ -498,12 +529,32 @@ impl ProfileCsv {
     }
 }
 
-/// `text` padded to a field, with its length (`text` no longer than a field).
-fn field<const W: usize>(text: &[u8]) -> ([u8; W], u8) {
+/// Longest text of a Żmij number (`-1.2345678901234567e-308`).
+const NUMBER_BYTES: usize = 24;
+
+/// Copies `text` (a Żmij number) to the start of `to` and returns its length. Most are 16 to
+/// 24 bytes: then two overlapping 16-byte copies through registers instead of a `memcpy` call.
+/// `to` has room for [`NUMBER_BYTES`] (the row's bound).
+#[inline(always)]
+fn put_number(to: &mut [u8], text: &[u8]) -> usize {
+    let n = text.len().min(NUMBER_BYTES);
+    let to = &mut to[..NUMBER_BYTES];
+    if let (Some(head), Some(tail)) = (text.first_chunk::<16>(), text[..n].last_chunk::<16>()) {
+        let (head, tail) = (u128::from_ne_bytes(*head), u128::from_ne_bytes(*tail));
+        to[n - 16..n].copy_from_slice(&tail.to_ne_bytes());
+        to[..16].copy_from_slice(&head.to_ne_bytes());
+    } else {
+        to[..n].copy_from_slice(&text[..n]);
+    }
+    n
+}
+
+/// The field of the text `text[..len]`: `text`'s first `W` bytes (`text` at least that long;
+/// a fixed-size copy, the bytes past the text unread), with the length (at most `W`).
+fn field<const W: usize>(text: &[u8], len: usize) -> ([u8; W], u8) {
     let mut f = [0; W];
-    let len = text.len().min(W);
-    f[..len].copy_from_slice(&text[..len]);
-    (f, len as u8)
+    f.copy_from_slice(&text[..W]);
+    (f, len.min(W) as u8)
 }
 
 /// Every `stride`-th of `nodes` nodes and the last ([`crate::scene::OutputSampling::writes_node`]).
