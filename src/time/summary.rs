@@ -41,8 +41,23 @@ fn rounded_digits(t: f64) -> Option<(i64, u32)> {
     if !(0..=22).contains(&k) {
         return None;
     }
-    let digits = (t * POWERS_OF_TEN[k as usize]).round();
+    let digits = round_half_away(t * POWERS_OF_TEN[k as usize]);
     (digits.abs() < 1e15).then_some((digits as i64, k as u32))
+}
+
+/// `y.round()` (half away from zero) for finite `y`, inline rather than a libm call: `y` minus
+/// its truncation is exact, and `|y| >= 2^52` is a whole number (up to `2^63`, where the
+/// truncation saturates; callers refuse such `y` anyway).
+fn round_half_away(y: f64) -> f64 {
+    let whole = y as i64 as f64;
+    let frac = y - whole;
+    if frac >= 0.5 {
+        whole + 1.0
+    } else if frac <= -0.5 {
+        whole - 1.0
+    } else {
+        whole
+    }
 }
 
 /// Relative distance from a power of ten beyond which `floor(log10 a)` is found by comparisons:
@@ -54,25 +69,32 @@ const POWER_OF_TEN_MARGIN: f64 = 1e-9;
 /// in `[1e-11, 1e12)` (the range of `rounded_digits`' fast path; ~10x cheaper than `log10`);
 /// `log10` itself near a power of ten and outside that range.
 fn floor_log10(a: f64) -> i32 {
-    let near = |b: f64, lo: f64| {
-        b < lo * (1.0 + POWER_OF_TEN_MARGIN) || b > lo * 10.0 * (1.0 - POWER_OF_TEN_MARGIN)
-    };
-    if (1.0..1e12).contains(&a) {
-        // Exact comparisons: the powers up to 1e12 are exact doubles.
-        let e = (1..=12).find(|&e| a < POWERS_OF_TEN[e]).expect("a < 1e12") - 1;
-        if !near(a, POWERS_OF_TEN[e]) {
-            return e as i32;
+    if (1e-11..1e12).contains(&a) {
+        // With `a` in `[2^b, 2^(b+1))` the answer is `floor(b·log10 2)` or one more
+        // (`1233 / 4096` is `log10 2` closely enough for these `b`); one comparison decides.
+        // The powers below 1 are not exact, but within an ulp: far inside the margin.
+        let b = ((a.to_bits() >> 52) as i32) - 1023;
+        let mut e = (b * 1233) >> 12;
+        let power = |e: i32| NEAR_POWERS_OF_TEN[(e - NEAR_POWERS_FROM) as usize];
+        if a >= power(e + 1) {
+            e += 1;
         }
-    } else if (1e-11..1.0).contains(&a) {
-        // `a·10^j` is within an ulp of the exact product, far inside the margin.
-        if let Some(j) = (1..=11).find(|&j| a * POWERS_OF_TEN[j] >= 1.0)
-            && !near(a * POWERS_OF_TEN[j], 1.0)
-        {
-            return -(j as i32);
+        let lo = power(e);
+        if lo * (1.0 + POWER_OF_TEN_MARGIN) <= a && a <= lo * 10.0 * (1.0 - POWER_OF_TEN_MARGIN) {
+            return e;
         }
     }
     a.log10().floor() as i32
 }
+
+/// The exponent of [`NEAR_POWERS_OF_TEN`]' first entry.
+const NEAR_POWERS_FROM: i32 = -12;
+
+/// The doubles nearest `10^e` for `e = -12..=12` (those from 1 up exact).
+const NEAR_POWERS_OF_TEN: [f64; 25] = [
+    1e-12, 1e-11, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1e0, 1e1, 1e2, 1e3,
+    1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12,
+];
 
 /// Appends the text of `output_time(t)` as `Display` writes it (`output_time(t).to_string()`,
 /// the same bytes), through Żmij rather than `core::fmt`. Both give the shortest digits that
@@ -648,6 +670,44 @@ mod tests {
             check(sign * mantissa * 10f64.powi(decade));
         }
         assert!(fast > 600_000, "{fast} values on the fast path");
+    }
+
+    /// `floor_log10`'s first guess from the binary exponent is `floor(b·log10 2)` over its range.
+    #[test]
+    fn binary_exponent_guess_is_the_floor() {
+        for b in -40..=40 {
+            let exact = (f64::from(b) * std::f64::consts::LOG10_2).floor() as i32;
+            assert_eq!((b * 1233) >> 12, exact, "b = {b}");
+        }
+    }
+
+    #[test]
+    fn round_half_away_is_round() {
+        let mut state = 0x853c_49e6_748f_ea9b_u64;
+        let check = |y: f64| assert_eq!(round_half_away(y), y.round(), "{y:e}");
+        for y in [
+            0.5,
+            1.5,
+            2.5,
+            -0.5,
+            -2.5,
+            0.49999999999999994,
+            4503599627370495.5,
+            4503599627370497.0,
+            1e15,
+            -1e15 + 0.5,
+            1e18,
+        ] {
+            check(y);
+        }
+        for _ in 0..1_000_000 {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1);
+            let y = ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2e15;
+            check(y);
+            check((y * 2.0).round() / 2.0);
+        }
     }
 
     #[test]
