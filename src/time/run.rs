@@ -408,21 +408,23 @@ impl ProfileCsv {
         let t_len = usize::from(t_len);
         let (mut bu, mut bv) = (zmij::Buffer::new(), zmij::Buffer::new());
         let last = self.nodes.saturating_sub(1);
+        // Locals rather than fields in the loop (the file write would make them reloaded).
+        let (file, chunk, xs) = (&mut self.file, &mut self.chunk[..], &self.xs[..]);
+        let mut len = self.len;
         let mut x_at = 0;
         for (j, &x_len) in self.x_lens.iter().enumerate() {
             // The `j`-th of `written_nodes`, without its chained iterator.
             let (u, v) = values.at(j.saturating_mul(self.stride).min(last));
-            if self.len > PROFILE_CHUNK_BYTES - PROFILE_ROW_MAX_BYTES {
-                self.file.write_all(&self.chunk[..self.len])?;
-                self.len = 0;
+            if len > PROFILE_CHUNK_BYTES - PROFILE_ROW_MAX_BYTES {
+                file.write_all(&chunk[..len])?;
+                len = 0;
             }
-            let Some(row) = self.chunk[self.len..].first_chunk_mut::<PROFILE_ROW_MAX_BYTES>()
-            else {
+            let Some(row) = chunk[len..].first_chunk_mut::<PROFILE_ROW_MAX_BYTES>() else {
                 unreachable!("a chunk has room for a row after the check above")
             };
             row[..FIELD_BYTES].copy_from_slice(&t_field);
             let mut at = t_len;
-            row[at..at + FIELD_BYTES].copy_from_slice(&self.xs[x_at..x_at + FIELD_BYTES]);
+            row[at..at + FIELD_BYTES].copy_from_slice(&xs[x_at..x_at + FIELD_BYTES]);
             let x_len = usize::from(x_len);
             x_at += x_len;
             at += x_len;
@@ -431,8 +433,9 @@ impl ProfileCsv {
             at += 1;
             at += put_number(&mut row[at..], bv.format(v).as_bytes());
             row[at] = b'\n';
-            self.len += at + 1;
+            len += at + 1;
         }
+        self.len = len;
         Ok(())
     }
 
