@@ -177,3 +177,56 @@ fn cli_run_with_npy_output_without_the_feature_exits_2_writing_nothing() {
     assert!(stderr.contains("--features npy"), "{stderr}");
     assert!(!dir.exists(), "nothing written");
 }
+
+/// `t` and `x` are written as `Display` of the rounded value (`output_time`), whichever path
+/// formats them: `x` fields narrow (`0.0125,`), wide (`0.000000246,`) and longer than a field
+/// (a bar of 1e24), and times needing every digit.
+#[test]
+fn t_and_x_are_the_display_of_the_rounded_values() {
+    use viscobar::time::summary::output_time;
+    for (tag, sets) in [
+        ("unit", vec!["mesh.elements=80"]),
+        ("short", vec!["bar.length=1.23e-5", "mesh.elements=50"]),
+        ("shorter", vec!["bar.length=2.5e-7", "mesh.elements=50"]),
+        ("long", vec!["bar.length=3e13", "mesh.elements=50"]),
+        ("longer", vec!["bar.length=1e24", "mesh.elements=50"]),
+        (
+            "odd-step",
+            vec![
+                "mesh.elements=30",
+                "time.step=0.0123456789",
+                "time.end=3.0123456516",
+                "output.every=1",
+            ],
+        ),
+    ] {
+        let scene = common::builtin("impact", &sets);
+        let dir = std::env::temp_dir().join(format!("viscobar-tx-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        run_to_dir("impact", &scene, &dir, false).unwrap();
+        let text = std::fs::read_to_string(dir.join("displacement.csv")).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        let sim = Simulation::new(&scene).unwrap();
+        let disc = sim.discretisation();
+        let mut rows = 0;
+        for (j, row) in text.lines().skip(1).enumerate() {
+            let mut cells = row.split(',');
+            let (t, x) = (cells.next().unwrap(), cells.next().unwrap());
+            let step = j / disc.nodes;
+            let every = if tag == "odd-step" { 1 } else { 5 };
+            let n = (step * every).min(scene.steps());
+            assert_eq!(
+                t,
+                output_time(n as f64 * disc.dt).to_string(),
+                "{tag}: {row}"
+            );
+            assert_eq!(
+                x,
+                output_time(disc.x(j % disc.nodes)).to_string(),
+                "{tag}: {row}"
+            );
+            rows += 1;
+        }
+        assert!(rows > 3 * disc.nodes, "{tag}: {rows} rows");
+    }
+}

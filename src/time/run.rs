@@ -4,7 +4,9 @@
 use crate::scene::{OutputFormat, Scene};
 use crate::time::RunError;
 use crate::time::simulation::{NodeValues, Simulation, StepRecord, Unstarted};
-use crate::time::summary::{Summary, Tracker, output_time, push_output_time};
+use crate::time::summary::{
+    Summary, TIME_TEXT_BYTES, Tracker, output_time, output_time_text, push_output_time,
+};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -80,8 +82,12 @@ pub(crate) fn write_whole<T, E>(
         std::fs::create_dir_all(out).map_err(|e| write_err(out.to_path_buf(), e))?;
         remove_stale_partials(out);
         let tmp = out.join(format!(".viscobar-partial-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&tmp);
-        std::fs::create_dir_all(&tmp).map_err(|e| write_err(tmp.clone(), e))?;
+        // Left by an earlier process with this id (`remove_stale_partials` spares it): cleared
+        // only when it is there, saving the look-up otherwise.
+        if std::fs::create_dir(&tmp).is_err() {
+            let _ = std::fs::remove_dir_all(&tmp);
+            std::fs::create_dir_all(&tmp).map_err(|e| write_err(tmp.clone(), e))?;
+        }
         let outcome = write(&tmp).and_then(|value| {
             for file in files {
                 std::fs::rename(tmp.join(file), out.join(file))
@@ -89,7 +95,10 @@ pub(crate) fn write_whole<T, E>(
             }
             Ok(value)
         });
-        let _ = std::fs::remove_dir_all(&tmp);
+        // Empty once its files are moved: one `rmdir` rather than a walk of the folder.
+        if std::fs::remove_dir(&tmp).is_err() {
+            let _ = std::fs::remove_dir_all(&tmp);
+        }
         outcome
     })();
     if outcome.is_err() {
@@ -300,14 +309,14 @@ const PROFILE_CHUNK_BYTES: usize = 1 << 17;
 /// Room for a row `t,x,u,v\n` with padded fields: `t` and `x` in fields of [`FIELD_BYTES`]
 /// (the second written over the first's padding), `u` and `v` of at most 24 bytes each
 /// (`-1.2345678901234567e-308`), two separators.
-const PROFILE_ROW_MAX_BYTES: usize = 2 * FIELD_BYTES + 2 * 24 + 2;
+const PROFILE_ROW_MAX_BYTES: usize = 2 * FIELD_BYTES + 2 * NUMBER_BYTES + 2;
 
 /// `displacement.csv`: one row `t,x,u,v` a written node at each kept step. `t` and `x` are
 /// rounded (see [`output_time`]) and written as `Display` would, `x` formatted once per run;
 /// `u` and `v` in the shortest form that reads back to the same `f64` (Żmij; `1.5e-7` rather
 /// than `0.00000015`), several times faster than `core::fmt`. Rows are built in a chunk that
-/// goes to the file when nearly full; `t` and `x` are copied as fixed-size fields (their
-/// text padded to [`FIELD_BYTES`]) and the next field overwrites the padding.
+/// goes to the file when nearly full; `t` and `x` are copied as fixed-size fields of
+/// [`FIELD_BYTES`] (the bytes after the text are garbage) and the next field overwrites them.
 struct ProfileCsv {
     file: std::fs::File,
     /// The chunk, `PROFILE_CHUNK_BYTES` long; `len` bytes of it are rows.
@@ -316,44 +325,19 @@ struct ProfileCsv {
     /// The written nodes: every `stride`-th and the last of `nodes`.
     stride: usize,
     nodes: usize,
-    /// Each written node's `x,` padded to a field, and its length.
-    xs: XFields,
+    /// The written nodes' `x,` texts one after the other, then [`FIELD_BYTES`] of padding, so
+    /// that a field can be copied from any text's start: half the memory of padded fields.
+    xs: Vec<u8>,
+    /// The length of each text in `xs`.
+    x_lens: Vec<u16>,
     /// Rows whose `t` or `x` text is longer than a field (a time or a bar beyond 1e22, written
     /// in full by `Display`) go through this slow path instead.
     long_fields: bool,
-    /// Each written node's `x,` text when `long_fields`.
-    long_xs: Vec<Vec<u8>>,
 }
 
 /// Room for the text of a rounded `t` or `x` and its comma: 12 digits, a point, up to 10
 /// leading zeros (`0.0000000000123456789012,`) and a sign fit.
 const FIELD_BYTES: usize = 32;
-
-/// The field of an `x` text when every one fits it (`3.14140097137,` or `0.000191747598,`
-/// do): half the memory of the wide fields, which a longer text (`0.0000314159265359,`)
-/// switches to.
-const NARROW_FIELD_BYTES: usize = 16;
-
-/// The `x,` texts of the written nodes, padded to fields of one width.
-enum XFields {
-    Narrow(Vec<([u8; NARROW_FIELD_BYTES], u8)>),
-    Wide(Vec<([u8; FIELD_BYTES], u8)>),
-}
-
-impl XFields {
-    /// The texts, unpadded.
-    fn texts(&self) -> Vec<Vec<u8>> {
-        fn unpadded<const W: usize>(xs: &[([u8; W], u8)]) -> Vec<Vec<u8>> {
-            xs.iter()
-                .map(|(f, len)| f[..usize::from(*len)].to_vec())
-                .collect()
-        }
-        match self {
-            Self::Narrow(xs) => unpadded(xs),
-            Self::Wide(xs) => unpadded(xs),
-        }
-    }
-}
 
 impl ProfileCsv {
     fn new(
@@ -363,40 +347,29 @@ impl ProfileCsv {
     ) -> Self {
         let stride = usize::try_from(sampling.node_stride).unwrap_or(usize::MAX);
         let nodes = disc.nodes;
-        let x_text = |i: usize, text: &mut Vec<u8>| {
-            text.clear();
-            push_output_time(disc.x(i), text);
-            text.push(b',');
-        };
         let capacity = usize::try_from(sampling.nodes_written).unwrap_or(0);
-        let mut xs = XFields::Narrow(Vec::with_capacity(capacity));
+        // Most texts are 12 digits, a point and a comma, with a leading `0.` or `0.00`.
+        let mut xs = Vec::with_capacity(capacity.saturating_mul(18).saturating_add(FIELD_BYTES));
+        let mut x_lens = Vec::with_capacity(capacity);
         let mut long_fields = false;
-        let mut text = Vec::with_capacity(FIELD_BYTES);
+        let mut fast = [0; TIME_TEXT_BYTES];
         for i in written_nodes(stride, nodes) {
-            x_text(i, &mut text);
-            long_fields |= text.len() > FIELD_BYTES;
-            if let XFields::Narrow(narrow) = &xs
-                && text.len() > NARROW_FIELD_BYTES
-            {
-                let mut wide = Vec::with_capacity(capacity);
-                wide.extend(narrow.iter().map(|(f, len)| field(&f[..usize::from(*len)])));
-                xs = XFields::Wide(wide);
+            let start = xs.len();
+            if let Some(len) = output_time_text(disc.x(i), &mut fast) {
+                // A fixed-size copy, then the garbage after the text dropped.
+                fast[len] = b',';
+                xs.extend_from_slice(&fast[..FIELD_BYTES]);
+                xs.truncate(start + len + 1);
+            } else {
+                push_output_time(disc.x(i), &mut xs);
+                xs.push(b',');
             }
-            match &mut xs {
-                XFields::Narrow(xs) => xs.push(field(&text)),
-                XFields::Wide(xs) => xs.push(field(&text)),
-            }
+            let len = xs.len() - start;
+            long_fields |= len > FIELD_BYTES;
+            // At most 330 bytes (`Display` of an f64 and a comma).
+            x_lens.push(u16::try_from(len).unwrap_or(u16::MAX));
         }
-        let long_xs = if long_fields {
-            (written_nodes(stride, nodes).map(|i| {
-                let mut text = Vec::new();
-                x_text(i, &mut text);
-                text
-            }))
-            .collect()
-        } else {
-            Vec::new()
-        };
+        xs.resize(xs.len() + FIELD_BYTES, 0);
         let mut chunk = vec![0; PROFILE_CHUNK_BYTES];
         let header = b"t,x,u,v\n";
         chunk[..header.len()].copy_from_slice(header);
@@ -407,79 +380,79 @@ impl ProfileCsv {
             stride,
             nodes,
             xs,
+            x_lens,
             long_fields,
-            long_xs,
         }
     }
 
     /// The rows of one kept step at time `t`.
     fn write(&mut self, t: f64, values: NodeValues<'_>) -> std::io::Result<()> {
-        let mut t_text = Vec::with_capacity(FIELD_BYTES);
-        push_output_time(t, &mut t_text);
-        t_text.push(b',');
-        if self.long_fields || t_text.len() > FIELD_BYTES {
-            return self.write_long(&t_text, values);
-        }
-        let (t_field, t_len) = field(&t_text);
-        let t = (&t_field, usize::from(t_len));
-        // Taken out for the loop (`Vec::new` allocates nothing) and put back.
-        let xs = std::mem::replace(&mut self.xs, XFields::Narrow(Vec::new()));
-        let result = match &xs {
-            XFields::Narrow(xs) => self.rows(t, xs, values),
-            XFields::Wide(xs) => self.rows(t, xs, values),
-        };
-        self.xs = xs;
-        result
-    }
-
-    /// The rows of [`ProfileCsv::write`] with `x` fields of `W` bytes.
-    fn rows<const W: usize>(
-        &mut self,
-        (t_field, t_len): (&[u8; FIELD_BYTES], usize),
-        xs: &[([u8; W], u8)],
-        values: NodeValues<'_>,
-    ) -> std::io::Result<()> {
-        let (mut bu, mut bv) = (zmij::Buffer::new(), zmij::Buffer::new());
-        for (i, (x_field, x_len)) in written_nodes(self.stride, self.nodes).zip(xs) {
-            let (u, v) = values.at(i);
-            if self.len > PROFILE_CHUNK_BYTES - PROFILE_ROW_MAX_BYTES {
-                self.file.write_all(&self.chunk[..self.len])?;
-                self.len = 0;
+        let mut fast = [0; TIME_TEXT_BYTES];
+        let (t_field, t_len): ([u8; FIELD_BYTES], u8) = match output_time_text(t, &mut fast) {
+            Some(len) if !self.long_fields => {
+                fast[len] = b',';
+                field(&fast, len + 1)
             }
-            let row = &mut self.chunk[self.len..self.len + PROFILE_ROW_MAX_BYTES];
-            row[..FIELD_BYTES].copy_from_slice(t_field);
+            _ => {
+                let mut t_text = Vec::with_capacity(FIELD_BYTES);
+                push_output_time(t, &mut t_text);
+                t_text.push(b',');
+                if self.long_fields || t_text.len() > FIELD_BYTES {
+                    return self.write_long(&t_text, values);
+                }
+                let len = t_text.len();
+                t_text.resize(FIELD_BYTES, 0);
+                field(&t_text, len)
+            }
+        };
+        let t_len = usize::from(t_len);
+        let (mut bu, mut bv) = (zmij::Buffer::new(), zmij::Buffer::new());
+        let last = self.nodes.saturating_sub(1);
+        // Locals rather than fields in the loop (the file write would make them reloaded).
+        let (file, chunk, xs) = (&mut self.file, &mut self.chunk[..], &self.xs[..]);
+        let mut len = self.len;
+        let mut x_at = 0;
+        for (j, &x_len) in self.x_lens.iter().enumerate() {
+            // The `j`-th of `written_nodes`, without its chained iterator.
+            let (u, v) = values.at(j.saturating_mul(self.stride).min(last));
+            if len > PROFILE_CHUNK_BYTES - PROFILE_ROW_MAX_BYTES {
+                file.write_all(&chunk[..len])?;
+                len = 0;
+            }
+            let Some(row) = chunk[len..].first_chunk_mut::<PROFILE_ROW_MAX_BYTES>() else {
+                unreachable!("a chunk has room for a row after the check above")
+            };
+            row[..FIELD_BYTES].copy_from_slice(&t_field);
             let mut at = t_len;
-            row[at..at + W].copy_from_slice(x_field);
-            at += usize::from(*x_len);
-            let u = bu.format(u).as_bytes();
-            row[at..at + u.len()].copy_from_slice(u);
-            at += u.len();
+            row[at..at + FIELD_BYTES].copy_from_slice(&xs[x_at..x_at + FIELD_BYTES]);
+            let x_len = usize::from(x_len);
+            x_at += x_len;
+            at += x_len;
+            at += put_number(&mut row[at..], bu.format(u).as_bytes());
             row[at] = b',';
             at += 1;
-            let v = bv.format(v).as_bytes();
-            row[at..at + v.len()].copy_from_slice(v);
-            at += v.len();
+            at += put_number(&mut row[at..], bv.format(v).as_bytes());
             row[at] = b'\n';
-            self.len += at + 1;
+            len += at + 1;
         }
+        self.len = len;
         Ok(())
     }
 
     /// [`ProfileCsv::write`] for texts longer than a field.
     fn write_long(&mut self, t_text: &[u8], values: NodeValues<'_>) -> std::io::Result<()> {
-        if self.long_xs.is_empty() {
-            // Only `t` is long: the short `x` texts, unpadded.
-            self.long_xs = self.xs.texts();
-            self.long_fields = true;
-        }
+        self.long_fields = true;
         self.file.write_all(&self.chunk[..self.len])?;
         self.len = 0;
         let mut rows = Vec::new();
         let (mut bu, mut bv) = (zmij::Buffer::new(), zmij::Buffer::new());
-        for (i, x) in written_nodes(self.stride, self.nodes).zip(&self.long_xs) {
+        let mut x_at = 0;
+        for (i, &x_len) in written_nodes(self.stride, self.nodes).zip(&self.x_lens) {
             let (u, v) = values.at(i);
+            let x_len = usize::from(x_len);
             rows.extend_from_slice(t_text);
-            rows.extend_from_slice(x);
+            rows.extend_from_slice(&self.xs[x_at..x_at + x_len]);
+            x_at += x_len;
             rows.extend_from_slice(bu.format(u).as_bytes());
             rows.push(b',');
             rows.extend_from_slice(bv.format(v).as_bytes());
@@ -498,12 +471,32 @@ impl ProfileCsv {
     }
 }
 
-/// `text` padded to a field, with its length (`text` no longer than a field).
-fn field<const W: usize>(text: &[u8]) -> ([u8; W], u8) {
+/// Longest text of a Żmij number (`-1.2345678901234567e-308`).
+const NUMBER_BYTES: usize = 24;
+
+/// Copies `text` (a Żmij number) to the start of `to` and returns its length. Most are 16 to
+/// 24 bytes: then two overlapping 16-byte copies through registers instead of a `memcpy` call.
+/// `to` has room for [`NUMBER_BYTES`] (the row's bound).
+#[inline(always)]
+fn put_number(to: &mut [u8], text: &[u8]) -> usize {
+    let n = text.len().min(NUMBER_BYTES);
+    let to = &mut to[..NUMBER_BYTES];
+    if let (Some(head), Some(tail)) = (text.first_chunk::<16>(), text[..n].last_chunk::<16>()) {
+        let (head, tail) = (u128::from_ne_bytes(*head), u128::from_ne_bytes(*tail));
+        to[n - 16..n].copy_from_slice(&tail.to_ne_bytes());
+        to[..16].copy_from_slice(&head.to_ne_bytes());
+    } else {
+        to[..n].copy_from_slice(&text[..n]);
+    }
+    n
+}
+
+/// The field of the text `text[..len]`: `text`'s first `W` bytes (`text` at least that long;
+/// a fixed-size copy, the bytes past the text unread), with the length (at most `W`).
+fn field<const W: usize>(text: &[u8], len: usize) -> ([u8; W], u8) {
     let mut f = [0; W];
-    let len = text.len().min(W);
-    f[..len].copy_from_slice(&text[..len]);
-    (f, len as u8)
+    f.copy_from_slice(&text[..W]);
+    (f, len.min(W) as u8)
 }
 
 /// Every `stride`-th of `nodes` nodes and the last ([`crate::scene::OutputSampling::writes_node`]).
@@ -586,5 +579,45 @@ pub(crate) fn remove_stale_partials(out: &Path) {
         if !alive {
             let _ = std::fs::remove_dir_all(entry.path());
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fresh(tag: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("viscobar-whole-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        dir
+    }
+
+    /// A folder left with this process's id (not removed as stale: the id is alive) is cleared
+    /// and reused; the temporary folder is gone afterwards, whether the write succeeds or fails.
+    #[test]
+    fn write_whole_reuses_a_left_folder_and_removes_its_own() {
+        let out = fresh("left");
+        let tmp = out.join(format!(".viscobar-partial-{}", std::process::id()));
+        std::fs::create_dir_all(tmp.join("sub")).unwrap();
+        std::fs::write(tmp.join("a.csv"), "old").unwrap();
+        let io = |path: PathBuf, e: std::io::Error| format!("{}: {e}", path.display());
+        let ok = write_whole(&out, &["a.csv"], io, |dir| {
+            assert!(!dir.join("sub").exists(), "the left folder is cleared");
+            std::fs::write(dir.join("a.csv"), "new").map_err(|e| e.to_string())
+        });
+        assert_eq!(ok, Ok(()));
+        assert_eq!(std::fs::read_to_string(out.join("a.csv")).unwrap(), "new");
+        assert!(!tmp.exists());
+        let failed: Result<(), String> = write_whole(&out, &["a.csv"], io, |dir| {
+            std::fs::write(dir.join("a.csv"), "half").unwrap();
+            Err("failed".to_string())
+        });
+        assert!(failed.is_err());
+        assert_eq!(std::fs::read_to_string(out.join("a.csv")).unwrap(), "new");
+        assert!(
+            !tmp.exists(),
+            "a failed write's folder, not empty, is removed too"
+        );
+        std::fs::remove_dir_all(&out).unwrap();
     }
 }

@@ -42,8 +42,23 @@ fn rounded_digits(t: f64) -> Option<(i64, u32)> {
     if !(0..=22).contains(&k) {
         return None;
     }
-    let digits = (t * POWERS_OF_TEN[k as usize]).round();
+    let digits = round_half_away(t * POWERS_OF_TEN[k as usize]);
     (digits.abs() < 1e15).then_some((digits as i64, k as u32))
+}
+
+/// `y.round()` (half away from zero) for finite `y`, inline rather than a libm call: `y` minus
+/// its truncation is exact, and `|y| >= 2^52` is a whole number (up to `2^63`, where the
+/// truncation saturates; callers refuse such `y` anyway).
+fn round_half_away(y: f64) -> f64 {
+    let whole = y as i64 as f64;
+    let frac = y - whole;
+    if frac >= 0.5 {
+        whole + 1.0
+    } else if frac <= -0.5 {
+        whole - 1.0
+    } else {
+        whole
+    }
 }
 
 /// Relative distance from a power of ten beyond which `floor(log10 a)` is found by comparisons:
@@ -55,25 +70,32 @@ const POWER_OF_TEN_MARGIN: f64 = 1e-9;
 /// in `[1e-11, 1e12)` (the range of `rounded_digits`' fast path; ~10x cheaper than `log10`);
 /// `log10` itself near a power of ten and outside that range.
 fn floor_log10(a: f64) -> i32 {
-    let near = |b: f64, lo: f64| {
-        b < lo * (1.0 + POWER_OF_TEN_MARGIN) || b > lo * 10.0 * (1.0 - POWER_OF_TEN_MARGIN)
-    };
-    if (1.0..1e12).contains(&a) {
-        // Exact comparisons: the powers up to 1e12 are exact doubles.
-        let e = (1..=12).find(|&e| a < POWERS_OF_TEN[e]).expect("a < 1e12") - 1;
-        if !near(a, POWERS_OF_TEN[e]) {
-            return e as i32;
+    if (1e-11..1e12).contains(&a) {
+        // With `a` in `[2^b, 2^(b+1))` the answer is `floor(b·log10 2)` or one more
+        // (`1233 / 4096` is `log10 2` closely enough for these `b`); one comparison decides.
+        // The powers below 1 are not exact, but within an ulp: far inside the margin.
+        let b = ((a.to_bits() >> 52) as i32) - 1023;
+        let mut e = (b * 1233) >> 12;
+        let power = |e: i32| NEAR_POWERS_OF_TEN[(e - NEAR_POWERS_FROM) as usize];
+        if a >= power(e + 1) {
+            e += 1;
         }
-    } else if (1e-11..1.0).contains(&a) {
-        // `a·10^j` is within an ulp of the exact product, far inside the margin.
-        if let Some(j) = (1..=11).find(|&j| a * POWERS_OF_TEN[j] >= 1.0)
-            && !near(a * POWERS_OF_TEN[j], 1.0)
-        {
-            return -(j as i32);
+        let lo = power(e);
+        if lo * (1.0 + POWER_OF_TEN_MARGIN) <= a && a <= lo * 10.0 * (1.0 - POWER_OF_TEN_MARGIN) {
+            return e;
         }
     }
     a.log10().floor() as i32
 }
+
+/// The exponent of [`NEAR_POWERS_OF_TEN`]' first entry.
+const NEAR_POWERS_FROM: i32 = -12;
+
+/// The doubles nearest `10^e` for `e = -12..=12` (those from 1 up exact).
+const NEAR_POWERS_OF_TEN: [f64; 25] = [
+    1e-12, 1e-11, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1e0, 1e1, 1e2, 1e3,
+    1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12,
+];
 
 /// Appends the text of `output_time(t)` as `Display` writes it (`output_time(t).to_string()`,
 /// the same bytes), through Żmij rather than `core::fmt`. Both give the shortest digits that
@@ -86,6 +108,11 @@ fn floor_log10(a: f64) -> i32 {
 /// the shortest digits of `digits / 10^k` are those digits without their trailing zeros (the
 /// argument above), which `Display` lays out without an exponent.
 pub fn push_output_time(t: f64, out: &mut Vec<u8>) {
+    let mut text = [0; TIME_TEXT_BYTES];
+    if let Some(len) = output_time_text(t, &mut text) {
+        out.extend_from_slice(&text[..len]);
+        return;
+    }
     if let Some((digits, k)) = rounded_digits(t) {
         push_decimal(digits, k, out);
         return;
@@ -100,6 +127,67 @@ pub fn push_output_time(t: f64, out: &mut Vec<u8>) {
         }
     }
     out.extend_from_slice(t.to_string().as_bytes());
+}
+
+/// Room for [`output_time_text`]'s text: a sign, 16 digits and a point, and the 16-byte copies
+/// that write them.
+pub const TIME_TEXT_BYTES: usize = 40;
+
+/// The bytes of [`push_output_time`] written into `out`, and their length, when `t` is on
+/// `rounded_digits`' fast path with at most 15 decimals (`|t| >= 1e-4` or so): the common case,
+/// done without a `Vec` and with whole-word copies. `None` otherwise (`out` then holds
+/// garbage). Bytes of `out` past the length are garbage too.
+pub fn output_time_text(t: f64, out: &mut [u8; TIME_TEXT_BYTES]) -> Option<usize> {
+    let (digits, k) = rounded_digits(t)?;
+    let (mut m, mut k) = (digits.unsigned_abs(), k as usize);
+    while k > 0 && m.is_multiple_of(10) {
+        m /= 10;
+        k -= 1;
+    }
+    if k > 15 {
+        return None;
+    }
+    // `m < 10^15`: its 16 digits, zero-padded, then room for the 16-byte copy of the decimals.
+    let mut padded = [b'0'; 32];
+    padded[..8].copy_from_slice(&eight_digits((m / 100_000_000) as u32));
+    padded[8..16].copy_from_slice(&eight_digits((m % 100_000_000) as u32));
+    // Integer digits: those of `m / 10^k`, at least one (a `0`).
+    let int = m / POWERS_OF_TEN_U64[k];
+    let int_len = int.checked_ilog10().map_or(1, |l| l as usize + 1);
+    let sign = usize::from(digits < 0);
+    out[0] = b'-';
+    let first = 16 - k - int_len;
+    out[sign..sign + 16].copy_from_slice(&padded[first..first + 16]);
+    let point = sign + int_len;
+    if k == 0 {
+        return Some(point);
+    }
+    out[point] = b'.';
+    out[point + 1..point + 17].copy_from_slice(&padded[16 - k..32 - k]);
+    Some(point + 1 + k)
+}
+
+/// `10^k` for `k = 0..=15`.
+const POWERS_OF_TEN_U64: [u64; 16] = {
+    let mut p = [1u64; 16];
+    let mut k = 1;
+    while k < 16 {
+        p[k] = p[k - 1] * 10;
+        k += 1;
+    }
+    p
+};
+
+/// The 8 decimal digits of `x < 10^8`, zero-padded: two digits a 16-bit lane, then one a byte
+/// (multiplications by reciprocals, exact in these ranges; see the test).
+fn eight_digits(x: u32) -> [u8; 8] {
+    let (hi, lo) = (u64::from(x / 10_000), u64::from(x % 10_000));
+    let fours = hi | (lo << 32);
+    let hundreds = ((fours * 10_486) >> 20) & 0x0000_007f_0000_007f;
+    let twos = hundreds | ((fours - hundreds * 100) << 16);
+    let tens = ((twos * 103) >> 10) & 0x000f_000f_000f_000f;
+    let ones = tens | ((twos - tens * 10) << 8);
+    (ones | 0x3030_3030_3030_3030).to_le_bytes()
 }
 
 /// `digits / 10^k` in plain decimal notation, trailing zeros dropped (`digits != 0`,
@@ -513,6 +601,119 @@ mod tests {
             "t = {t:e} ({:#x})",
             t.to_bits()
         );
+    }
+
+    #[test]
+    fn eight_digits_are_those_format_gives() {
+        let check = |x: u32| {
+            assert_eq!(eight_digits(x), *format!("{x:08}").as_bytes(), "{x}");
+        };
+        // The two 4-digit lanes are independent: every value in each.
+        for a in 0..10_000 {
+            check(a);
+            check(a * 10_000);
+            check(a * 10_000 + (9_999 - a));
+        }
+        for x in (0..100_000_000).step_by(9_973) {
+            check(x);
+        }
+        check(99_999_999);
+    }
+
+    /// `output_time_text` writes what the general path (`push_decimal`) writes.
+    #[test]
+    fn text_fast_path_is_the_general_path() {
+        let mut fast = 0;
+        let mut check = |t: f64| {
+            let mut text = [0; TIME_TEXT_BYTES];
+            let Some(len) = output_time_text(t, &mut text) else {
+                return;
+            };
+            fast += 1;
+            let mut general = Vec::new();
+            let (digits, k) = rounded_digits(t).expect("on the fast path");
+            push_decimal(digits, k, &mut general);
+            assert_eq!(&text[..len], &general[..], "t = {t:e}");
+            let mut pushed = Vec::new();
+            push_output_time(t, &mut pushed);
+            assert_eq!(pushed, general, "t = {t:e}");
+        };
+        for m in -6..=16 {
+            let p = 10f64.powi(m);
+            for t in [
+                p,
+                p.next_up(),
+                p.next_down(),
+                p * 1.5,
+                p * 9.999_999_999_995,
+            ] {
+                check(t);
+                check(-t);
+            }
+        }
+        for (n, length) in [
+            (16384, std::f64::consts::PI),
+            (100_000, 1.0),
+            (777, 123.456),
+        ] {
+            let dx = length / n as f64;
+            for i in 0..=n {
+                check(i as f64 * dx);
+            }
+        }
+        for i in 0..100_000 {
+            check(f64::from(i) * 0.1);
+            check(f64::from(i) * 0.000_123_456_7);
+        }
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        for _ in 0..500_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let mantissa = (state >> 11) as f64 / (1u64 << 53) as f64;
+            let decade = (state % 24) as i32 - 6;
+            let sign = if state & 2 == 0 { 1.0 } else { -1.0 };
+            check(sign * mantissa * 10f64.powi(decade));
+        }
+        assert!(fast > 600_000, "{fast} values on the fast path");
+    }
+
+    /// `floor_log10`'s first guess from the binary exponent is `floor(b·log10 2)` over its range.
+    #[test]
+    fn binary_exponent_guess_is_the_floor() {
+        for b in -40..=40 {
+            let exact = (f64::from(b) * std::f64::consts::LOG10_2).floor() as i32;
+            assert_eq!((b * 1233) >> 12, exact, "b = {b}");
+        }
+    }
+
+    #[test]
+    fn round_half_away_is_round() {
+        let mut state = 0x853c_49e6_748f_ea9b_u64;
+        let check = |y: f64| assert_eq!(round_half_away(y), y.round(), "{y:e}");
+        for y in [
+            0.5,
+            1.5,
+            2.5,
+            -0.5,
+            -2.5,
+            0.49999999999999994,
+            4503599627370495.5,
+            4503599627370497.0,
+            1e15,
+            -1e15 + 0.5,
+            1e18,
+        ] {
+            check(y);
+        }
+        for _ in 0..1_000_000 {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1);
+            let y = ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2e15;
+            check(y);
+            check((y * 2.0).round() / 2.0);
+        }
     }
 
     #[test]
