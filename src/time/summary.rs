@@ -592,6 +592,27 @@ mod tests {
         }
     }
 
+    /// `count` values `± m · 10^d` from an xorshift stream seeded with `seed`: `m` uniform in
+    /// [0, 1), `d` in `decades`, the sign from the bit `sign_bit` of the state.
+    fn random_values(
+        seed: u64,
+        count: usize,
+        decades: std::ops::Range<i32>,
+        sign_bit: u64,
+    ) -> impl Iterator<Item = f64> {
+        let span = (decades.end - decades.start) as u64;
+        let mut state = seed;
+        (0..count).map(move |_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let mantissa = (state >> 11) as f64 / (1u64 << 53) as f64;
+            let decade = (state % span) as i32 + decades.start;
+            let sign = if state & sign_bit == 0 { 1.0 } else { -1.0 };
+            sign * mantissa * 10f64.powi(decade)
+        })
+    }
+
     fn check(t: f64) {
         let mut out = Vec::new();
         push_output_time(t, &mut out);
@@ -665,16 +686,7 @@ mod tests {
             check(f64::from(i) * 0.1);
             check(f64::from(i) * 0.000_123_456_7);
         }
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        for _ in 0..500_000 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let mantissa = (state >> 11) as f64 / (1u64 << 53) as f64;
-            let decade = (state % 24) as i32 - 6;
-            let sign = if state & 2 == 0 { 1.0 } else { -1.0 };
-            check(sign * mantissa * 10f64.powi(decade));
-        }
+        random_values(0x2545_f491_4f6c_dd1d, 500_000, -6..18, 2).for_each(check);
         assert!(fast > 600_000, "{fast} values on the fast path");
     }
 
@@ -752,15 +764,6 @@ mod tests {
                 check(i as f64 * step);
             }
         }
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        for _ in 0..200_000 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let mantissa = (state >> 11) as f64 / (1u64 << 53) as f64;
-            let decade = (state % 31) as i32 - 15;
-            let sign = if state & 1 == 0 { 1.0 } else { -1.0 };
-            check(sign * mantissa * 10f64.powi(decade));
-        }
+        random_values(0x9e37_79b9_7f4a_7c15, 200_000, -15..16, 1).for_each(check);
     }
 }
