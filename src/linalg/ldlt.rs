@@ -986,21 +986,30 @@ mod tests {
             // Uniform on each side of the twist node `2μ` with different diagonals: both halves
             // compact, with different stationary rows.
             let twist_node = 2 * (n.div_ceil(2) / 2);
-            let two_level = SymTridiag::new(
-                (0..n)
-                    .map(|i| if i < twist_node { 4.0 } else { 5.0 })
-                    .collect(),
-                vec![-1.0; n.saturating_sub(1)],
-            );
+            // Both ways round, so that each half is once the one storing fewer rows.
+            let two_level = |left: f64, right: f64| {
+                SymTridiag::new(
+                    (0..n)
+                        .map(|i| if i < twist_node { left } else { right })
+                        .collect(),
+                    vec![-1.0; n.saturating_sub(1)],
+                )
+            };
             let mut cases = vec![
                 Ldlt::factor(&a).unwrap(),
                 Ldlt::factor(&wobbly).unwrap(),
-                Ldlt::factor(&two_level).unwrap(),
+                Ldlt::factor(&two_level(4.0, 5.0)).unwrap(),
+                Ldlt::factor(&two_level(5.0, 4.0)).unwrap(),
             ];
             if n == 1001 {
-                let f = &cases[2];
-                assert!(f.top.rows.len() < 64 && f.bottom.rows.len() < 64);
-                assert_ne!(f.top.rows.last(), f.bottom.rows.last());
+                let stored = |f: &Ldlt| (f.top.rows.len(), f.bottom.rows.len());
+                for f in &cases[2..4] {
+                    let (pt, pb) = stored(f);
+                    assert!(pt < 64 && pb < 64);
+                    assert_ne!(f.top.rows.last(), f.bottom.rows.last());
+                }
+                let ((t1, b1), (t2, b2)) = (stored(&cases[2]), stored(&cases[3]));
+                assert!((t1 < b1) != (t2 < b2), "{t1}, {b1}; {t2}, {b2}");
             }
             if n >= 2 {
                 for nodes in [&[0][..], &[n - 1], &[0, n - 1]] {
