@@ -51,7 +51,7 @@ pub struct Ldlt {
 /// rest repeat the last one stored. A sweep that becomes stationary up to the twist (a
 /// uniform interior, once the pivots have converged) repeats one row bit for bit to the
 /// end: storing it once saves the set-up its pages and the solve its loads.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug)]
 struct Half {
     rows: Vec<[f64; 5]>,
     len: usize,

@@ -16,16 +16,27 @@ pub struct SymTridiag {
 fn row_sums(diag: &[f64], off: &[f64]) -> Vec<f64> {
     let n = diag.len();
     let mut s = Vec::with_capacity(n);
+    if n >= 2 {
+        s.push(0.0);
+        s.extend((off.windows(2).zip(&diag[1..n - 1])).map(|(lr, d)| (lr[0] + d) + lr[1]));
+    }
+    s.resize(n, 0.0);
+    set_end_sums(diag, off, &mut s);
+    s
+}
+
+/// The row sums of the end rows into `s` (the formula of [`row_sums`]; one neighbour each, none
+/// when `n = 1`).
+fn set_end_sums(diag: &[f64], off: &[f64], s: &mut [f64]) {
+    let n = diag.len();
     match n {
         0 => {}
-        1 => s.push((0.0 + diag[0]) + 0.0),
+        1 => s[0] = (0.0 + diag[0]) + 0.0,
         _ => {
-            s.push((0.0 + diag[0]) + off[0]);
-            s.extend((off.windows(2).zip(&diag[1..n - 1])).map(|(lr, d)| (lr[0] + d) + lr[1]));
-            s.push((off[n - 2] + diag[n - 1]) + 0.0);
+            s[0] = (0.0 + diag[0]) + off[0];
+            s[n - 1] = (off[n - 2] + diag[n - 1]) + 0.0;
         }
     }
-    s
 }
 
 impl SymTridiag {
@@ -86,15 +97,7 @@ impl SymTridiag {
         off.drain(..first);
         s.truncate(last + 1);
         s.drain(..first);
-        let n = diag.len();
-        match n {
-            0 => {}
-            1 => s[0] = (0.0 + diag[0]) + 0.0,
-            _ => {
-                s[0] = (0.0 + diag[0]) + off[0];
-                s[n - 1] = (off[n - 2] + diag[n - 1]) + 0.0;
-            }
-        }
+        set_end_sums(&diag, &off, &mut s);
         SymTridiag {
             diag,
             off,
