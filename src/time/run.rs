@@ -407,14 +407,12 @@ impl ProfileCsv {
         };
         let t_len = usize::from(t_len);
         let (mut bu, mut bv) = (zmij::Buffer::new(), zmij::Buffer::new());
-        let last = self.nodes.saturating_sub(1);
         // Locals rather than fields in the loop (the file write would make them reloaded).
         let (file, chunk, xs) = (&mut self.file, &mut self.chunk[..], &self.xs[..]);
         let mut len = self.len;
         let mut x_at = 0;
         for (j, &x_len) in self.x_lens.iter().enumerate() {
-            // The `j`-th of `written_nodes`, without its chained iterator.
-            let (u, v) = values.at(j.saturating_mul(self.stride).min(last));
+            let (u, v) = values.at(written_node(j, self.stride, self.nodes));
             if len > PROFILE_CHUNK_BYTES - PROFILE_ROW_MAX_BYTES {
                 file.write_all(&chunk[..len])?;
                 len = 0;
@@ -479,7 +477,8 @@ const NUMBER_BYTES: usize = 24;
 /// `to` has room for [`NUMBER_BYTES`] (the row's bound).
 #[inline(always)]
 fn put_number(to: &mut [u8], text: &[u8]) -> usize {
-    let n = text.len().min(NUMBER_BYTES);
+    // A longer text fails the slicing below rather than being cut.
+    let n = text.len();
     let to = &mut to[..NUMBER_BYTES];
     if let (Some(head), Some(tail)) = (text.first_chunk::<16>(), text[..n].last_chunk::<16>()) {
         let (head, tail) = (u128::from_ne_bytes(*head), u128::from_ne_bytes(*tail));
@@ -501,10 +500,16 @@ fn field<const W: usize>(text: &[u8], len: usize) -> ([u8; W], u8) {
 
 /// Every `stride`-th of `nodes` nodes and the last ([`crate::scene::OutputSampling::writes_node`]).
 fn written_nodes(stride: usize, nodes: usize) -> impl Iterator<Item = usize> {
-    let last = nodes.checked_sub(1);
-    (0..nodes)
-        .step_by(stride.max(1))
-        .chain(last.filter(|&l| !l.is_multiple_of(stride.max(1))))
+    let count = nodes
+        .checked_sub(1)
+        .map_or(0, |l| l.div_ceil(stride.max(1)) + 1);
+    (0..count).map(move |j| written_node(j, stride, nodes))
+}
+
+/// The `j`-th of [`written_nodes`]: `j·stride`, the last node for the final one.
+#[inline(always)]
+fn written_node(j: usize, stride: usize, nodes: usize) -> usize {
+    j.saturating_mul(stride.max(1)).min(nodes.saturating_sub(1))
 }
 
 fn write_history_row(
@@ -585,6 +590,25 @@ pub(crate) fn remove_stale_partials(out: &Path) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The written nodes are every `stride`-th and the last, each once, in order, and
+    /// `written_node` indexes them (the rows' loop uses it).
+    #[test]
+    fn written_nodes_are_every_strideth_and_the_last() {
+        for nodes in 0..40 {
+            for stride in 1..9 {
+                let mut expected: Vec<usize> = (0..nodes).step_by(stride).collect();
+                if nodes > 0 && (nodes - 1) % stride != 0 {
+                    expected.push(nodes - 1);
+                }
+                let got: Vec<usize> = written_nodes(stride, nodes).collect();
+                assert_eq!(got, expected, "{nodes} nodes, stride {stride}");
+                for (j, &i) in expected.iter().enumerate() {
+                    assert_eq!(written_node(j, stride, nodes), i);
+                }
+            }
+        }
+    }
 
     fn fresh(tag: &str) -> PathBuf {
         let dir = std::env::temp_dir().join(format!("viscobar-whole-{tag}-{}", std::process::id()));
