@@ -632,7 +632,10 @@ fn verify(
     };
     let result = std::fs::read_to_string(&path)
         .map_err(|e| format!("cannot read {}: {e}", path.display()))
-        .and_then(|doc| viscobar::study::verify::update_document(&doc, &sections))
+        .and_then(|doc| {
+            viscobar::study::verify::update_document(&doc, &sections)
+                .map_err(|e| format!("{}: {e}", path.display()))
+        })
         .and_then(|doc| {
             viscobar::time::run::write_atomically(&path, doc.as_bytes())
                 .map_err(|e| format!("cannot write {}: {e}", path.display()))

@@ -255,15 +255,7 @@ pub fn headline_markdown(studies: &[Study]) -> String {
 /// (UTC) and the load average when the study started (other processes sharing the cores show
 /// there).
 pub fn machine_line(load_at_start: &str) -> String {
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|t| {
-            t.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split_once(':'))
-                .map(|(_, v)| v.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown CPU".into());
+    let cpu = cpu_model();
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
     let profile = if cfg!(debug_assertions) {
         "debug"
@@ -278,6 +270,19 @@ pub fn machine_line(load_at_start: &str) -> String {
     )
 }
 
+/// The CPU model named by `/proc/cpuinfo`, or `unknown CPU`.
+pub fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into())
+}
+
 /// The first three fields of `/proc/loadavg`, or `unknown`.
 pub fn load_average() -> String {
     std::fs::read_to_string("/proc/loadavg")
@@ -286,11 +291,17 @@ pub fn load_average() -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
-/// Now as `YYYY-MM-DD HH:MM` (UTC), from the system clock (civil-from-days, H. Hinnant).
+/// Now as `YYYY-MM-DD HH:MM` (UTC), from the system clock.
 fn utc_date_time() -> String {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs());
+    utc_date_time_at(
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_secs()),
+    )
+}
+
+/// `secs` since the Unix epoch as `YYYY-MM-DD HH:MM` (UTC; civil-from-days, H. Hinnant).
+pub fn utc_date_time_at(secs: u64) -> String {
     let days = (secs / 86_400) as i64;
     let (h, m) = ((secs % 86_400) / 3600, (secs % 3600) / 60);
     let z = days + 719_468;
@@ -415,6 +426,18 @@ mod tests {
             panic!("bracketed by levels 1 and 2")
         };
         assert!((t / 2f64.powf(1.5) - 1.0).abs() < INTERPOLATION_TOL, "{t}");
+    }
+
+    #[test]
+    fn known_instants_have_their_civil_dates() {
+        // `date -u -d @SECS '+%F %R'` for each.
+        for (secs, text) in [
+            (0, "1970-01-01 00:00"),
+            (951_782_400, "2000-02-29 00:00"),
+            (1_795_393_800, "2026-11-23 00:30"),
+        ] {
+            assert_eq!(utc_date_time_at(secs), text);
+        }
     }
 
     #[test]

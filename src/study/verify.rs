@@ -344,10 +344,10 @@ pub fn update_document(doc: &str, sections: &[Section]) -> Result<String, String
         let close = format!("<!-- end:{} -->", s.id);
         let a = out
             .find(&open)
-            .ok_or(format!("VERIFICATION.md has no marker `{}`", open.trim()))?;
+            .ok_or(format!("the document has no marker `{}`", open.trim()))?;
         let b = out[a..]
             .find(&close)
-            .ok_or(format!("VERIFICATION.md has no marker `{close}`"))?
+            .ok_or(format!("the document has no marker `{close}`"))?
             + a;
         out.replace_range(a + open.len()..b, &s.markdown);
     }
