@@ -27,7 +27,9 @@ fn readme_timings_are_written_by_bench_table() {
         let doc = std::fs::read_to_string(&path).unwrap();
         for id in ids {
             let open = format!("<!-- generated:{id} -->\n");
-            let start = doc.find(&open).unwrap_or_else(|| panic!("{file} lacks {open}"));
+            let start = doc
+                .find(&open)
+                .unwrap_or_else(|| panic!("{file} lacks {open}"));
             let body = &doc[start + open.len()..];
             let end = body
                 .find(&format!("<!-- end:{id} -->"))
@@ -38,7 +40,10 @@ fn readme_timings_are_written_by_bench_table() {
                     && block.contains("--example bench_table -- --update"),
                 "{file}: block {id} was not written by bench_table --update"
             );
-            assert!(block.contains("target <="), "{file}: block {id} has no targets");
+            assert!(
+                block.contains("target <="),
+                "{file}: block {id} has no targets"
+            );
         }
     }
 }
