@@ -2,19 +2,13 @@
 //! run exit with 1 and name the step; nothing is written for either, and an earlier good result
 //! in the output folder survives a failed rerun.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
+use common::viscobar;
 
-fn viscobar(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_viscobar"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
+use std::path::{Path, PathBuf};
 
 fn fresh_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("viscobar-bad-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
+    let d = common::fresh_dir("bad", name);
     std::fs::create_dir_all(&d).unwrap();
     d
 }

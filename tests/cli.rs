@@ -1,20 +1,14 @@
 //! The `viscobar` command line: outputs of `run`, listing and showing scenes (bad input is in
 //! `bad_input.rs`).
 
+mod common;
+use common::viscobar;
+
 use std::process::Command;
 use viscobar::study::tolerances::osqp_agreement_bound;
 
-fn viscobar(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_viscobar"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
-
 fn tmpdir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("viscobar-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+    common::fresh_dir("cli", name)
 }
 
 #[test]

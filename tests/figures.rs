@@ -3,24 +3,15 @@
 //! bad input without writing anything.
 
 mod common;
+use common::viscobar;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use viscobar::Simulation;
 use viscobar::study::figures::{self, TALK_FIGURES};
 use viscobar::study::sampled_run::{self, Sampling};
 
-fn viscobar(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_viscobar"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
-
 fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("viscobar-figures-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+    common::fresh_dir("figures", name)
 }
 
 /// Strides that do not divide the mesh, so the last node and the last step are added.

@@ -5,18 +5,11 @@
 //! the generic checker of `tests/solvers.rs`.
 
 mod common;
+use common::viscobar;
 
-use std::process::Command;
 use viscobar::bar::Discretisation;
 use viscobar::scene::MassVariant;
 use viscobar::study::mass_variants::{MassRow, group_order, groups, mass_study, run_with_mass};
-
-fn viscobar(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_viscobar"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
 
 /// The refused combinations exit 2 with a message naming both keys, and write nothing.
 #[test]

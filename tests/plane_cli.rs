@@ -1,8 +1,10 @@
 //! `viscobar run` on plane scenes through the binary: the outputs (and the figure), and bad
 //! plane input refused with exit code 2 and a message naming the field, nothing written.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
+use common::viscobar;
+
+use std::path::PathBuf;
 
 // The plane identity's tolerance: in the registry (study::tolerances), measured there.
 use viscobar::study::tolerances::PLANE_IDENTITY_TOL as IDENTITY_TOL;
@@ -12,17 +14,8 @@ const MIN_FIGURE_BYTES: u64 = 1000;
 /// a number at most 1), with a factor 2 to spare.
 const PHASE_SUM_TOL: f64 = 4.0 * f64::EPSILON;
 
-fn viscobar(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_viscobar"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
-
 fn fresh_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("viscobar-plane-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+    common::fresh_dir("plane", name)
 }
 
 #[test]
@@ -152,18 +145,7 @@ const CASES: &[(&str, &[&str], &str)] = &[
 
 #[test]
 fn bad_plane_input_exits_2_naming_the_field_and_writes_nothing() {
-    for (what, sets, needle) in CASES {
-        let out = fresh_dir("bad");
-        let mut args = vec!["run", "plane-strip", "--out", out.to_str().unwrap()];
-        for s in *sets {
-            args.extend(["--set", s]);
-        }
-        let o = viscobar(&args);
-        let stderr = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{what}: {stderr}");
-        assert!(stderr.contains(needle), "{what}: {stderr}");
-        assert!(!Path::new(&out).exists(), "{what}: wrote {}", out.display());
-    }
+    common::assert_each_refused("plane-strip", CASES, &fresh_dir("bad"));
 }
 
 #[test]

@@ -2,23 +2,16 @@
 //! and summary, each `[solver]` method bit for bit against the library run of that method, and
 //! bad contact or solver input refused with exit code 2 naming the field, nothing written.
 
+mod common;
+use common::viscobar;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 // The plane identity's and gap's tolerances: in the registry (study::tolerances), measured there.
 use viscobar::study::tolerances::{PLANE_GAP_TOL as GAP_TOL, PLANE_IDENTITY_TOL as IDENTITY_TOL};
 
-fn viscobar(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_viscobar"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
-
 fn fresh_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("viscobar-contact-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+    common::fresh_dir("contact", name)
 }
 
 #[test]
@@ -153,18 +146,7 @@ const CASES: &[(&str, &[&str], &str)] = &[
 
 #[test]
 fn bad_contact_input_exits_2_naming_the_field_and_writes_nothing() {
-    for (what, sets, needle) in CASES {
-        let out = fresh_dir("bad");
-        let mut args = vec!["run", "plane-strip", "--out", out.to_str().unwrap()];
-        for s in *sets {
-            args.extend(["--set", s]);
-        }
-        let o = viscobar(&args);
-        let stderr = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{what}: {stderr}");
-        assert!(stderr.contains(needle), "{what}: {stderr}");
-        assert!(!Path::new(&out).exists(), "{what}: wrote {}", out.display());
-    }
+    common::assert_each_refused("plane-strip", CASES, &fresh_dir("bad"));
 }
 
 /// A drawn figure is more than its headers: the smallest plausible PNG or SVG of a map.

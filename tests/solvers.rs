@@ -3,10 +3,9 @@
 //! solution converging to the exact one as ε → 0.
 
 mod common;
-use common::{COMPLEMENTARITY_TOL, GAP_TOL, REACTION_TOL};
+use common::{COMPLEMENTARITY_TOL, GAP_TOL, REACTION_TOL, viscobar};
 
 use std::path::Path;
-use std::process::Command;
 
 use osqp::Status;
 use viscobar::RunError;
@@ -448,13 +447,6 @@ fn runs_are_bit_identical_in_process(method: Method) {
         contact |= ra.reaction.iter().any(|r| *r > 0.0);
     }
     assert!(contact, "the comparison covers steps in contact");
-}
-
-fn viscobar(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_viscobar"))
-        .args(args)
-        .output()
-        .expect("binary runs")
 }
 
 /// `viscobar run SCENE --solver SOLVER [--set SETTING]... --out OUT`, which must succeed.

@@ -51,3 +51,38 @@ pub fn spd_tridiag(max_n: usize) -> impl Strategy<Value = SymTridiag> {
 /// beside their measurement in the tolerance registry (`viscobar verify --tolerances`).
 #[allow(unused_imports)] // each test file uses some of them
 pub use viscobar::study::tolerances::{kkt, kkt_ratio, stream};
+
+// ---- the `viscobar` binary ------------------------------------------------------------------
+
+/// Runs the `viscobar` binary built for the tests with `args`.
+pub fn viscobar(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_viscobar"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+/// `viscobar-{group}-{pid}-{name}` in the temporary folder, removed if a run left it (not
+/// created: a run must create its own output folder).
+pub fn fresh_dir(group: &str, name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("viscobar-{group}-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// `viscobar run SCENE --out OUT --set …` for each case `(what, settings, text)`: exit code 2,
+/// a message containing `text`, and no output folder.
+pub fn assert_each_refused(scene: &str, cases: &[(&str, &[&str], &str)], out: &std::path::Path) {
+    for (what, sets, needle) in cases {
+        let _ = std::fs::remove_dir_all(out);
+        let mut args = vec!["run", scene, "--out", out.to_str().unwrap()];
+        for s in *sets {
+            args.extend(["--set", s]);
+        }
+        let o = viscobar(&args);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{what}: {stderr}");
+        assert!(stderr.contains(needle), "{what}: {stderr}");
+        assert!(!out.exists(), "{what}: wrote {}", out.display());
+    }
+}
