@@ -208,6 +208,23 @@ fn penalty_solver_passes_the_generic_checker() {
     check_solver(Method::Penalty);
 }
 
+/// On the coarsest meshes `C_jj` (mass over Δt²) is large but still softer than the spring
+/// `1/ε`, so the reaction is taken from stationarity, whose row `(Cz − b)_j` cancels: the law's
+/// audit must weigh that row's rounding (`u ε (|C||z| + |b|)_j`), which it once did not (the
+/// forced scenes failed it at J = 2 and 3, the falling bar at J = 2).
+#[test]
+fn penalty_passes_its_audit_on_the_coarsest_meshes() {
+    for name in ["both-ends-forced", "one-end-forced", "falling-bar", "both-ends"] {
+        for elements in 1..=8 {
+            let setting = format!("mesh.elements={elements}");
+            let scene = with_method(name, Method::Penalty, &[&setting]);
+            if let Err(e) = run_in_memory(name, &scene) {
+                panic!("{name} with {elements} elements: {e}");
+            }
+        }
+    }
+}
+
 // ---- penalty → exact as ε → 0 -----------------------------------------------------------
 
 /// Observed order in ε of the penalty solution's distance to the exact one: first order in

@@ -17,6 +17,7 @@
 use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite};
 use crate::linalg::norms::max_abs;
 use crate::linalg::tridiag::SymTridiag;
+use crate::step::penalty::reaction_from_gap;
 use crate::step::report::{AuditReport, StepFailure, Worst};
 
 /// Margin over OSQP's own stopping test: OSQP evaluates its residuals on its scaled copy of the
@@ -180,8 +181,15 @@ impl KktAudit {
                     let v = (epsilon * r[j] - (-gap).max(0.0)).abs();
                     // `gap` is rounded to ulps of |z⁰_j| + |lo_j|, `ε r_j` to ulps of itself.
                     let coupled: f64 = (0..k).map(|i| self.schur_abs[j * k + i] * r[i].abs()).sum();
-                    let t =
-                        ulp * (z[node].abs() + coupled + lower[j].abs() + (epsilon * r[j]).abs());
+                    // A reaction taken from stationarity, `(Cz − b)_j`, brings that row's
+                    // rounding, `u (|C||z| + |b|)_j`, times ε (`penalty::reaction_from_gap`).
+                    let row = if reaction_from_gap(self.c.diag[node], 1.0 / epsilon) {
+                        0.0
+                    } else {
+                        epsilon * (abs_row_product(&self.c, node, z) + b[node].abs())
+                    };
+                    let t = ulp
+                        * (z[node].abs() + coupled + lower[j].abs() + (epsilon * r[j]).abs() + row);
                     if ratio(v, t) >= ratio(law_res, law_tol) {
                         law_res = v;
                         law_tol = t;
@@ -206,6 +214,13 @@ impl KktAudit {
             Some(("penalty law |eps r_j - (lo_j - z_j)+|", law_res, law_tol)),
         )
     }
+}
+
+/// `(|C||z|)_i`: the magnitudes the row `(C z)_i` is summed from.
+fn abs_row_product(c: &SymTridiag, i: usize, z: &[f64]) -> f64 {
+    let left = i.checked_sub(1).map_or(0.0, |h| (c.off[h] * z[h]).abs());
+    let right = c.off.get(i).map_or(0.0, |o| (o * z[i + 1]).abs());
+    (c.diag[i] * z[i]).abs() + left + right
 }
 
 /// One audited residual: what it measures, its value and its tolerance.

@@ -111,7 +111,11 @@ impl PenaltySolver {
             matrix,
             stiffness,
             rows: constraint_rows(c, nodes),
-            from_gap: [0, 1].map(|j| nodes.get(j).is_some_and(|&i| c.diag[i] >= stiffness)),
+            from_gap: [0, 1].map(|j| {
+                nodes
+                    .get(j)
+                    .is_some_and(|&i| reaction_from_gap(c.diag[i], stiffness))
+            }),
             springs,
             previous: 0,
             audit,
@@ -145,7 +149,9 @@ impl PenaltySolver {
     /// NaN). On the support `r_j = (lo_j − z_j)/ε = (C z − b)_j` up to the solve's residual
     /// `δ ~ u (‖C‖ + 1/ε) |z|` (`u` the unit round-off). Taken from the gap, the penalty law
     /// holds to round-off and stationarity is off by `δ` plus the gap's rounding times `1/ε`;
-    /// taken from stationarity, stationarity holds and the law is off by `ε δ`. Each node
+    /// taken from stationarity, stationarity holds and the law is off by `ε δ`, where `δ`
+    /// includes the rounding of the row `(C z − b)_j` itself, `u (|C||z| + |b|)_j`: with a stiff
+    /// `C` (a coarse mesh) its terms cancel to a much smaller reaction. Each node
     /// uses the form whose error is round-off of what the audit weighs it against: the gap
     /// when its spring `1/ε` is softer than `C_jj`, stationarity otherwise. Round-off below
     /// zero is clamped.
@@ -183,6 +189,13 @@ impl PenaltySolver {
         }
         met
     }
+}
+
+/// Whether a constrained node's reaction is taken from its gap, `(lo_j − z_j)/ε`: when the
+/// spring `1/ε` (`stiffness`) is no stiffer than `C_jj`; otherwise from stationarity,
+/// `(C z − b)_j` ([`PenaltySolver::solve_on_support`]). The audit weighs each form's round-off.
+pub(crate) fn reaction_from_gap(c_jj: f64, stiffness: f64) -> bool {
+    c_jj >= stiffness
 }
 
 impl StepSolver for PenaltySolver {
