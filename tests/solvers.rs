@@ -214,7 +214,12 @@ fn penalty_solver_passes_the_generic_checker() {
 /// forced scenes failed it at J = 2 and 3, the falling bar at J = 2).
 #[test]
 fn penalty_passes_its_audit_on_the_coarsest_meshes() {
-    for name in ["both-ends-forced", "one-end-forced", "falling-bar", "both-ends"] {
+    for name in [
+        "both-ends-forced",
+        "one-end-forced",
+        "falling-bar",
+        "both-ends",
+    ] {
         for elements in 1..=8 {
             let setting = format!("mesh.elements={elements}");
             let scene = with_method(name, Method::Penalty, &[&setting]);
