@@ -17,7 +17,6 @@
 use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite};
 use crate::linalg::norms::max_abs;
 use crate::linalg::tridiag::SymTridiag;
-use crate::step::penalty::reaction_from_gap;
 use crate::step::report::{AuditReport, StepFailure, Worst};
 
 /// Margin over OSQP's own stopping test: OSQP evaluates its residuals on its scaled copy of the
@@ -182,7 +181,7 @@ impl KktAudit {
                     // `gap` is rounded to ulps of |z⁰_j| + |lo_j|, `ε r_j` to ulps of itself.
                     let coupled: f64 = (0..k).map(|i| self.schur_abs[j * k + i] * r[i].abs()).sum();
                     // A reaction taken from stationarity, `(Cz − b)_j`, brings that row's
-                    // rounding, `u (|C||z| + |b|)_j`, times ε (`penalty::reaction_from_gap`).
+                    // rounding, `u (|C||z| + |b|)_j`, times ε ([`reaction_from_gap`]).
                     let row = if reaction_from_gap(self.c.diag[node], 1.0 / epsilon) {
                         0.0
                     } else {
@@ -214,6 +213,14 @@ impl KktAudit {
             Some(("penalty law |eps r_j - (lo_j - z_j)+|", law_res, law_tol)),
         )
     }
+}
+
+/// Whether the penalty solver takes a constrained node's reaction from its gap,
+/// `(lo_j − z_j)/ε`: when the spring `1/ε` (`stiffness`) is no stiffer than `C_jj`; otherwise
+/// from stationarity, `(C z − b)_j` (`PenaltySolver::solve_on_support`). The solver and the
+/// audit, which weighs each form's round-off, share this rule.
+pub fn reaction_from_gap(c_jj: f64, stiffness: f64) -> bool {
+    c_jj >= stiffness
 }
 
 /// `(|C||z|)_i`: the magnitudes the row `(C z)_i` is summed from.

@@ -17,7 +17,7 @@
 
 use crate::linalg::ldlt::{Ldlt, RowChange};
 use crate::linalg::tridiag::SymTridiag;
-use crate::step::audit::{KktAudit, Law};
+use crate::step::audit::{KktAudit, Law, reaction_from_gap};
 use crate::step::schur::{
     Column, constraint_rows, factor_each_subset, inverse_columns, least_violating, masked_solve,
     row_product, schur_complement,
@@ -189,13 +189,6 @@ impl PenaltySolver {
         }
         met
     }
-}
-
-/// Whether a constrained node's reaction is taken from its gap, `(lo_j − z_j)/ε`: when the
-/// spring `1/ε` (`stiffness`) is no stiffer than `C_jj`; otherwise from stationarity,
-/// `(C z − b)_j` ([`PenaltySolver::solve_on_support`]). The audit weighs each form's round-off.
-pub(crate) fn reaction_from_gap(c_jj: f64, stiffness: f64) -> bool {
-    c_jj >= stiffness
 }
 
 impl StepSolver for PenaltySolver {
