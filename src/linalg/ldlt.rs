@@ -915,8 +915,6 @@ mod tests {
         (top, bottom, 1.0 / g)
     }
 
-    /// The sweeps that carry the odd nodes' quotients and the reduced off-diagonals from row to
-    /// row give the bits of the formulas, at every size from 1 to 13 and at 100, 101 and 1000.
     /// The solve compiled for AVX gives the bits of the baseline build (see [`dispatch`]),
     /// for every parity and small size (empty halves, the outer odd node) and a large one,
     /// separate and in place, with and without the fused `u += x`.
@@ -1042,6 +1040,8 @@ mod tests {
         }
     }
 
+    /// The sweeps that carry the odd nodes' quotients and the reduced off-diagonals from row to
+    /// row give the bits of the formulas, at every size from 1 to 13 and at 100, 101 and 1000.
     #[test]
     fn the_carried_sweeps_equal_the_formulas_bit_for_bit() {
         for n in (1usize..=13).chain([100, 101, 1000]) {

@@ -48,7 +48,8 @@ fn rounded_digits(t: f64) -> Option<(i64, u32)> {
 
 /// `y.round()` (half away from zero) for finite `y`, inline rather than a libm call: `y` minus
 /// its truncation is exact, and `|y| >= 2^52` is a whole number (up to `2^63`, where the
-/// truncation saturates; callers refuse such `y` anyway).
+/// truncation saturates; callers refuse such `y` anyway). A `y` in `(−0.5, 0)` gives `+0`
+/// where `round` gives `−0`; the caller converts to an integer, which drops that sign.
 fn round_half_away(y: f64) -> f64 {
     let whole = y as i64 as f64;
     let frac = y - whole;
