@@ -14,10 +14,11 @@
 //!
 //! Layers, each a folder whose module doc says what it owns; imports point down this list only
 //! (`tests/layers.rs` checks it):
-//! [`linalg`] (tridiagonal kernels) → [`step`] (the step solvers and their audit) →
-//! [`scene`] (input) → [`bar`] (matrices, closed forms) → [`time`] (the time loop, energy
-//! balance and outputs) → [`plane`] (the plane Kelvin–Voigt body, Q1, sparse Cholesky) →
-//! [`study`] (the verification studies).
+//! [`linalg`] (tridiagonal and sparse matrices, their factorisations) → [`step`] (the step
+//! problem's solvers and their audit) → [`scene`] (input) → [`scheme`] (the talk's scheme for
+//! any body) → [`bar`] (P1 matrices, the bar's kernels, closed forms) → [`plane`] (the plane
+//! Kelvin–Voigt body, Q1, sparse Cholesky) → [`output`] (runs and their files, both bodies) →
+//! [`study`] (refinement, comparison, figures).
 
 //! # Use as a library
 //!
@@ -64,15 +65,16 @@
 
 pub mod bar;
 pub mod linalg;
+pub mod output;
 pub mod plane;
 pub mod scene;
+pub mod scheme;
 pub mod step;
 pub mod study;
-pub mod time;
 
-pub use plane::{PlaneError, PlaneSimulation};
+pub use bar::Simulation;
+pub use output::{ContactEpisode, Summary, run_in_memory, run_to_dir};
+pub use plane::PlaneSimulation;
 pub use scene::{AnyScene, PlaneScene, Scene, SceneError, SolverMethod};
+pub use scheme::{RunError, StepRecord};
 pub use step::{StepFailure, StepSolver};
-pub use time::{
-    ContactEpisode, RunError, Simulation, StepRecord, Summary, run_in_memory, run_to_dir,
-};

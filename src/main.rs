@@ -124,25 +124,6 @@ enum Command {
         /// A built-in scene's name (as listed by `viscobar scenes`).
         name: String,
     },
-    /// Recompute the measured figures of VERIFICATION.md and print them as Markdown.
-    Verify {
-        /// Rewrite the generated blocks of this file in place instead of printing.
-        #[arg(long, value_name = "FILE")]
-        update: Option<PathBuf>,
-        /// The stiff and extreme case matrix instead (full size: 1e6 nodes, 1e6-step runs).
-        #[arg(long)]
-        stiff: bool,
-        /// The tolerance registry instead: each tolerance's measured worst / tolerance.
-        #[arg(long, conflicts_with_all = ["stiff", "timings"])]
-        tolerances: bool,
-        /// "Error against run time" instead: its error and timing blocks (machine-dependent:
-        /// the machine and date are written beside the times).
-        #[arg(long, conflicts_with = "stiff")]
-        timings: bool,
-        /// With --timings: also write work-precision-<scene>.png into this folder.
-        #[arg(long, value_name = "DIR", requires = "timings")]
-        figures: Option<PathBuf>,
-    },
 }
 
 fn main() {
@@ -167,13 +148,6 @@ fn main() {
                 }
             }
         }
-        Command::Verify {
-            update,
-            stiff,
-            tolerances,
-            timings,
-            figures,
-        } => verify(update, stiff, tolerances, timings.then_some(figures)),
         Command::Converge {
             scene,
             solvers,
@@ -361,22 +335,10 @@ fn run_any(name: &str, out: Option<PathBuf>, set: &[String], figure: bool) -> Re
         }
         scene::AnyScene::Plane(plane) => {
             let out = out.unwrap_or_else(|| PathBuf::from("out").join(&scene_name));
-            let summary = viscobar::plane::run::run_plane_to_dir(&scene_name, &plane, &out)
+            let progress = std::io::stderr().is_terminal();
+            let summary = viscobar::output::run_plane_to_dir(&scene_name, &plane, &out, progress)
                 .map_err(|e| fail(e.to_string(), e.exit_code()))?;
-            println!(
-                "{}: {} steps of {} unknowns ({} nodes) with `{}` steps and a `{}` factor of C in {:.3} s \
-                 ({:.1} ns per unknown-step); max identity residual {:.1e}; results in {}",
-                summary.scene,
-                summary.steps,
-                summary.unknowns,
-                summary.nodes,
-                summary.method,
-                summary.solver,
-                summary.wall_time_s,
-                summary.ns_per_unknown_step,
-                summary.max_identity_residual,
-                out.display()
-            );
+            report(&summary, &out);
             if figure {
                 plane_figure(&scene_name, &plane, &out)?;
             }
@@ -409,21 +371,29 @@ fn run(
 ) -> Result<(), viscobar::RunError> {
     let out = out.unwrap_or_else(|| PathBuf::from("out").join(scene_name));
     let summary =
-        viscobar::time::run::run_to_dir(scene_name, &scene, &out, std::io::stderr().is_terminal())?;
+        viscobar::output::run_to_dir(scene_name, &scene, &out, std::io::stderr().is_terminal())?;
+    report(&summary, &out);
+    Ok(())
+}
+
+/// The closing lines of `run`, either body: what ran, how fast, the identity residual, one
+/// line of contact episodes per group of constraints, and a warning for inaccurate OSQP steps.
+fn report(summary: &viscobar::Summary, out: &std::path::Path) {
     println!(
-        "{}: {} steps of {} nodes with `{}` in {:.3} s ({:.1} ns per node-step); \
-         max identity residual {:.1e}; results in {}",
+        "{}: {} steps of {} unknowns ({} nodes) with `{}` in {:.3} s ({:.1} ns per \
+         unknown-step); max identity residual {:.1e}; results in {}",
         summary.scene,
         summary.steps,
+        summary.unknowns,
         summary.nodes,
         summary.solver,
         summary.wall_time_s,
-        summary.ns_per_node_step,
+        summary.ns_per_unknown_step,
         summary.max_identity_residual,
         out.display()
     );
-    for (side, episodes) in &summary.contact_episodes {
-        println!("  {side}: {}", episode_line(episodes));
+    for (group, episodes) in &summary.contact_episodes {
+        println!("  {group}: {}", episode_line(episodes));
     }
     if let Some(n) = summary.inaccurate_steps.filter(|n| *n > 0) {
         eprintln!(
@@ -431,7 +401,6 @@ fn run(
              (solver.accept_inaccurate = true); see inaccurate_steps and audit in summary.json"
         );
     }
-    Ok(())
 }
 
 /// `[solvers, osqp_eps, penalty_epsilon]`: the three lists of `converge`.
@@ -597,62 +566,10 @@ fn compare(name: &str, solvers: &str, set: &[String]) -> Result<(), viscobar::Ru
     Ok(())
 }
 
-/// `timings`: `Some(figures folder)` for `--timings`.
-fn verify(
-    update: Option<PathBuf>,
-    stiff: bool,
-    tolerances: bool,
-    timings: Option<Option<PathBuf>>,
-) -> i32 {
-    let sections = if let Some(figures) = timings {
-        viscobar::study::timings::sections(figures.as_deref())
-    } else if stiff || tolerances {
-        let results = viscobar::study::stiff_runs::run_all(viscobar::study::stiff::Size::Full);
-        if stiff {
-            Ok(vec![viscobar::study::verify::stiff_section(&results)])
-        } else {
-            viscobar::study::verify::rigid_drift()
-                .and_then(|(drift, _)| viscobar::study::verify::tolerances_section(&results, drift))
-                .map(|s| vec![s])
-                .map_err(Into::into)
-        }
-    } else {
-        viscobar::study::verify::sections()
-    };
-    let sections = match sections {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return e.exit_code();
-        }
-    };
-    let Some(path) = update else {
-        print!("{}", viscobar::study::verify::render(&sections));
-        return 0;
-    };
-    let result = std::fs::read_to_string(&path)
-        .map_err(|e| format!("cannot read {}: {e}", path.display()))
-        .and_then(|doc| {
-            viscobar::study::verify::update_document(&doc, &sections)
-                .map_err(|e| format!("{}: {e}", path.display()))
-        })
-        .and_then(|doc| {
-            viscobar::time::run::write_atomically(&path, doc.as_bytes())
-                .map_err(|e| format!("cannot write {}: {e}", path.display()))
-        });
-    match result {
-        Ok(()) => 0,
-        Err(e) => {
-            eprintln!("error: {e}");
-            1
-        }
-    }
-}
-
 /// The contact episodes of one end (or of the obstacle) in one line: when, impulse and the
 /// energy the contact term took (the same episodes as `summary.json` and the figures).
 fn episode_line(episodes: &[viscobar::ContactEpisode]) -> String {
-    use viscobar::time::summary::output_time;
+    use viscobar::output::text::output_time;
     if episodes.is_empty() {
         return "no contact".into();
     }

@@ -19,8 +19,7 @@
 //! against finite differences of `u` and the scene's load text against `l`.
 
 use crate::scene::plane::{
-    Body, EdgeCondition, EdgeSpec, Edges, PlaneInitial, PlaneLoad, PlaneMesh, PlaneOutput,
-    PlaneScene, Vector,
+    Body, EdgeCondition, EdgeSpec, Edges, PlaneInitial, PlaneLoad, PlaneMesh, PlaneScene, Vector,
 };
 use crate::scene::schema::Time;
 use std::f64::consts::PI;
@@ -215,7 +214,7 @@ impl Manufactured {
             mesh: PlaneMesh { nx, ny, y_grading },
             time: Time { step: dt, end },
             solver: Default::default(),
-            output: PlaneOutput::default(),
+            output: Default::default(),
         }
     }
 }

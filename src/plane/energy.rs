@@ -1,32 +1,13 @@
-//! The discrete energy balance of a plane step, the bar's with `K` for `R`:
-//!
-//! ```text
-//!   E^{n+1/2} − E^{n−1/2} = ½ F^n·δ − α/(4Δt) |δ|²_K − ½ r^{n+1}·Eδ,   δ = u^{n+1} − u^{n−1},
-//!   E^{n+1/2} = ½ |(u^{n+1} − u^n)/Δt|²_M + ¼ (|u^{n+1}|²_K + |u^n|²_K),
-//! ```
-//!
-//! exact algebra (multiply the scheme by `δ/2`; the contact force is `−Eᵀr`,
-//! [`crate::plane::contact`]), so its residual is round-off only. The
-//! `K`-forms are evaluated cell by cell from the strains at the Gauss points, with nodal
+//! The sums of the plane body's energy identity (the scheme's, [`crate::scheme::Scheme::step`]).
+//! The `K`-forms are evaluated cell by cell from the strains at the Gauss points, with nodal
 //! differences ([`StrainForms`]): the same sums as `uᵀKu` in exact arithmetic, but a rigid
 //! motion (a bending beam is locally one) adds no round-off, where `u·(Ku)` loses digits in
 //! proportion to `‖K‖|u|²/uᵀKu`.
 
-use crate::plane::matrices::{Material, Pattern};
+use crate::linalg::sparse::Pattern;
+use crate::plane::matrices::Material;
 use crate::plane::mesh::Grid;
-
-/// The sums of one step's balance.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct StepSums {
-    /// `zᵀ M z`, `z = u^{n+1} − u^n`.
-    pub kinetic: f64,
-    /// `|u^{n+1}|²_K`.
-    pub potential: f64,
-    /// `|z + w|²_K = |δ|²_K`.
-    pub viscous: f64,
-    /// `F·(z + w)`.
-    pub work: f64,
-}
+use crate::scheme::body::EnergySums;
 
 /// `∂N_a/∂x[g][a]`, `∂N_a/∂y[g][a]` at the Gauss points `g` of a cell row, and the weight.
 type RowGradients = ([[f64; 4]; 4], [[f64; 4]; 4], f64);
@@ -137,8 +118,9 @@ fn gather(cell: &[u32; 8], f: &impl Fn(usize) -> f64, c: usize) -> [f64; 4] {
     })
 }
 
-/// The sums of [`StepSums`], after `u += z` (`u = u^{n+1}`), with `w` the previous increment.
-#[allow(clippy::too_many_arguments)]
+/// The sums of the energy identity ([`EnergySums`]), after `u += z` (`u = u^{n+1}`), with `w`
+/// the previous increment: `zᵀMz` and `F·(z + w)` in one pass over the pattern, the `K`-forms
+/// cell by cell.
 pub fn measure(
     pattern: &Pattern,
     mass: &[f64],
@@ -146,65 +128,21 @@ pub fn measure(
     u: &[f64],
     z: &[f64],
     w: &[f64],
-    force: &[f64],
-) -> StepSums {
-    let mut s = StepSums::default();
+    force: Option<&[f64]>,
+) -> EnergySums {
+    let mut s = EnergySums::default();
     for r in 0..pattern.n {
         let mut mz = 0.0;
         for k in pattern.row_ptr[r]..pattern.row_ptr[r + 1] {
             mz += mass[k] * z[pattern.cols[k]];
         }
         s.kinetic += z[r] * mz;
-        s.work += force[r] * (z[r] + w[r]);
+        if let Some(f) = force {
+            s.work += f[r] * (z[r] + w[r]);
+        }
     }
     (s.potential, s.viscous) = forms.quad_pair(|k| u[k], |k| z[k] + w[k]);
     s
-}
-
-/// The terms of the identity and its relative residual, from the sums of a step and the
-/// previous `E^{n−1/2}`, `|u^n|²_K`.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Balance {
-    /// `E^{n+1/2}`.
-    pub energy: f64,
-    /// `½ F^n·δ`.
-    pub work: f64,
-    /// `α/(4Δt) |δ|²_K`.
-    pub viscous: f64,
-    /// `D = ½ r^{n+1}·Eδ >= 0`, the contact term.
-    pub contact: f64,
-    /// `|E^{n+1/2} − E^{n−1/2} − work + viscous + D|` over the largest of those five terms.
-    pub residual: f64,
-}
-
-/// The balance of a step: `sums` of the step, `energy_before = E^{n−1/2}`,
-/// `potential_before = |u^n|²_K`, `contact` the contact term `D` (0 without contact).
-pub fn balance(
-    sums: &StepSums,
-    energy_before: f64,
-    potential_before: f64,
-    dt: f64,
-    alpha: f64,
-    contact: f64,
-) -> Balance {
-    let energy = 0.5 * sums.kinetic / (dt * dt) + 0.25 * (sums.potential + potential_before);
-    let viscous = alpha / (4.0 * dt) * sums.viscous;
-    let work = 0.5 * sums.work;
-    let residual = energy - energy_before - work + viscous + contact;
-    let scale = [energy, energy_before, work.abs(), viscous, contact.abs()]
-        .into_iter()
-        .fold(0.0, f64::max);
-    Balance {
-        energy,
-        work,
-        viscous,
-        contact,
-        residual: if scale > 0.0 {
-            residual.abs() / scale
-        } else {
-            0.0
-        },
-    }
 }
 
 #[cfg(test)]

@@ -1,12 +1,12 @@
 //! The plane body: a Kelvin–Voigt body in plane strain on `(0, W) × (0, H)`, Q1 elements on a
-//! tensor grid graded in `y`, stepped by the bar's scheme with the consistent Q1 mass `M` and
-//! stiffness `K`; the step matrix is factorised once per run by a sparse Cholesky (faer, AMD).
-//! Edges may be Signorini (issue 21): each step's contact problem is condensed onto the
-//! contact normals and solved exactly ([`contact`]). With `λ = 0`, `μ = ½`, `ρ = 1` and data `(f(x), 0)` it reduces
-//! to the bar exactly (VERIFICATION.md, "Plane body").
+//! tensor grid graded in `y` ([`mesh`]), the consistent Q1 mass `M` and stiffness `K`
+//! ([`matrices`]), stepped by the scheme ([`crate::scheme`]) through its kernels ([`body`]);
+//! the step matrix is factorised once per run by a sparse Cholesky (faer, AMD). Edges may be
+//! Signorini: each node of such an edge carries a contact normal ([`normals`]). With `λ = 0`,
+//! `μ = ½`, `ρ = 1` and data `(f(x), 0)` it reduces to the bar exactly (VERIFICATION.md,
+//! "Plane body").
 //!
-//! Imports [`crate::scene`] and [`crate::time`] (output helpers); placed above `time` because
-//! its run reuses the time layer's output plumbing, and below `study`, which verifies it.
+//! Imports [`crate::linalg`], [`crate::step`], [`crate::scene`] and [`crate::scheme`].
 //!
 //! ```
 //! use viscobar::scene::{AnyScene, load_any};
@@ -24,18 +24,11 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod body;
 pub mod closed_form;
-pub mod contact;
 pub mod energy;
-pub mod error;
-pub mod factor;
 pub mod matrices;
 pub mod mesh;
 pub mod normals;
-pub mod osqp;
-pub mod rhs;
-pub mod run;
-pub mod simulation;
 
-pub use error::PlaneError;
-pub use simulation::{PlaneRecord, PlaneSimulation};
+pub use body::{PlaneBody, PlaneDiscretisation, PlaneSimulation};

@@ -6,8 +6,9 @@
 
 use crate::scene::expr::Expression;
 use crate::scene::schema::{
-    GIB, MAX_STEPS, Scene, SolverSpec, Time, available_memory_bytes, check_time_grid, invalid,
-    number_or_expression, number_text, positive, toml_syntax, with_overrides,
+    GIB, MAX_STEPS, OutputSampling, OutputSpec, Scene, SolverSpec, Time, available_memory_bytes,
+    check_time_grid, invalid, number_or_expression, number_text, positive, toml_syntax,
+    with_overrides,
 };
 /// The built-in plane scenes (kept beside the bar's list in [`crate::scene::schema`]).
 pub use crate::scene::schema::{PLANE_BUILTIN, plane_builtin_text};
@@ -30,14 +31,14 @@ pub struct PlaneScene {
     pub load: PlaneLoad,
     pub mesh: PlaneMesh,
     pub time: Time,
-    /// The contact solver: the bar's `[solver]` table, keys and defaults
-    /// (`crate::plane::contact::ContactMethod::from_spec` maps it). Without Signorini edges
-    /// the method is still the one named, as for the bar: `osqp` runs OSQP on the
+    /// The step solver: the bar's `[solver]` table, keys and defaults. Without Signorini
+    /// edges the method is still the one named, as for the bar: `osqp` runs OSQP on the
     /// unconstrained step problem, `exact` and `penalty` are the one sparse solve.
     #[serde(default)]
     pub solver: SolverSpec,
+    /// The bar's `[output]` table, keys and defaults.
     #[serde(default)]
-    pub output: PlaneOutput,
+    pub output: OutputSpec,
 }
 
 /// The `[plane]` table: geometry and material.
@@ -257,26 +258,8 @@ pub struct PlaneMesh {
     pub y_grading: f64,
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PlaneOutput {
-    /// Keep every `every`-th step in `displacement.csv` (the last step is always kept).
-    #[serde(default = "one_u64")]
-    pub every: u64,
-}
-
-impl Default for PlaneOutput {
-    fn default() -> Self {
-        Self { every: 1 }
-    }
-}
-
-fn one_u64() -> u64 {
-    1
-}
-
 /// Largest accepted number of unknowns: the factor of `C` takes about 1 GB at 1e6 (measured,
-/// `../shared/notes/faer-sparse-cholesky.md`), growing faster than linearly.
+/// [docs/sparse-cholesky.md](../docs/sparse-cholesky.md)), growing faster than linearly.
 pub const MAX_PLANE_UNKNOWNS: u64 = 2_000_000;
 /// Memory per unknown of a plane run: the factor (about 110 values per unknown at 1e6, 8 bytes
 /// each, plus its symbolic part) and some 30 vectors; a margin over the measured 1 GB at 1e6.
@@ -436,13 +419,7 @@ impl PlaneScene {
             });
         }
         check_time_grid(self.time.step, self.time.end)?;
-        if self.output.every < 1 {
-            return Err(invalid(
-                "output.every",
-                self.output.every as f64,
-                "must be >= 1",
-            ));
-        }
+        self.output.validate()?;
         self.solver.validate()?;
         self.expressions()?;
         self.edges.gaps()?;
@@ -506,6 +483,12 @@ impl PlaneScene {
     /// Number of time steps, `T / Δt` rounded (a whole number, see `check_time_grid`).
     pub fn steps(&self) -> usize {
         (self.time.end / self.time.step).round() as usize
+    }
+
+    /// The sampling of the profile file ([`OutputSpec::sampling`] on the grid's nodes).
+    pub fn output_sampling(&self) -> OutputSampling {
+        let lattice = [self.mesh.nx + 1, self.mesh.ny + 1];
+        self.output.sampling(self.steps() as u64, lattice)
     }
 
     /// The scene with `2^level` times as many cells in each direction and a step `2^level`

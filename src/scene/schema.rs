@@ -484,9 +484,92 @@ pub struct OutputSampling {
 }
 
 impl OutputSampling {
-    /// Whether node `i` of `nodes` is written.
+    /// Whether node `i` of `nodes` on a line is written.
     pub fn writes_node(&self, i: usize, nodes: usize) -> bool {
         (i as u64).is_multiple_of(self.node_stride) || i + 1 == nodes
+    }
+}
+
+/// The nodes of one axis of `count` written with `stride`: every `stride`-th and the last.
+pub fn written_on_axis(count: u64, stride: u64) -> u64 {
+    match count {
+        0 => 0,
+        c => (c - 1) / stride + 1 + u64::from(!(c - 1).is_multiple_of(stride)),
+    }
+}
+
+impl OutputSpec {
+    /// Checks every field against its range; the error names the field.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        if self.every < 1 {
+            return Err(invalid("output.every", self.every as f64, "must be >= 1"));
+        }
+        if self.diagnostics_every < 1 {
+            return Err(invalid(
+                "output.diagnostics_every",
+                self.diagnostics_every as f64,
+                "must be >= 1",
+            ));
+        }
+        if let Some(n) = self.nodes
+            && n < 2
+        {
+            return Err(invalid(
+                "output.nodes",
+                n as f64,
+                "must be >= 2 (both ends are always written)",
+            ));
+        }
+        if self.max_rows < 2 {
+            return Err(invalid(
+                "output.max_rows",
+                self.max_rows as f64,
+                "must be >= 2",
+            ));
+        }
+        self.format.check_available()?;
+        Ok(())
+    }
+
+    /// The sampling of the profile file for a run of `steps` steps on a lattice of nodes
+    /// (`[along x, along y]`): the kept steps (`every`), and the nodes (`nodes`, or all of them
+    /// unless the rows would pass `max_rows`, then the fewest strided away that keep within
+    /// it): every `node_stride`-th node along each axis and the last, so the edges are always
+    /// written.
+    pub fn sampling(&self, steps: u64, lattice: [u64; 2]) -> OutputSampling {
+        let every = self.every;
+        let kept_steps = 1 + steps / every + u64::from(!steps.is_multiple_of(every));
+        let nodes = lattice[0] * lattice[1];
+        let written = |s: u64| written_on_axis(lattice[0], s) * written_on_axis(lattice[1], s);
+        let wanted = match self.nodes {
+            Some(n) => n.min(nodes),
+            None if kept_steps.saturating_mul(nodes) <= self.max_rows => nodes,
+            None => (self.max_rows / kept_steps).clamp(2, nodes),
+        };
+        // The smallest stride writing at most `wanted` nodes (written(s) does not grow with s),
+        // or the largest stride, which writes the ends of each axis only.
+        let (mut lo, mut hi) = (1, lattice[0].max(lattice[1]).max(2) - 1);
+        if written(hi) <= wanted {
+            while lo < hi {
+                let mid = lo + (hi - lo) / 2;
+                if written(mid) <= wanted {
+                    hi = mid;
+                } else {
+                    lo = mid + 1;
+                }
+            }
+        }
+        let stride = hi;
+        let nodes_written = written(stride);
+        OutputSampling {
+            file: self.format.file(),
+            format: self.format,
+            every,
+            node_stride: stride,
+            kept_steps,
+            nodes_written,
+            rows: kept_steps * nodes_written,
+        }
     }
 }
 
@@ -727,37 +810,7 @@ impl Scene {
         self.validate_mass()?;
         check_time_grid(self.time.step, self.time.end)?;
         self.solver.validate()?;
-        if self.output.every < 1 {
-            return Err(invalid(
-                "output.every",
-                self.output.every as f64,
-                "must be >= 1",
-            ));
-        }
-        if self.output.diagnostics_every < 1 {
-            return Err(invalid(
-                "output.diagnostics_every",
-                self.output.diagnostics_every as f64,
-                "must be >= 1",
-            ));
-        }
-        if let Some(n) = self.output.nodes
-            && n < 2
-        {
-            return Err(invalid(
-                "output.nodes",
-                n as f64,
-                "must be >= 2 (both ends are always written)",
-            ));
-        }
-        if self.output.max_rows < 2 {
-            return Err(invalid(
-                "output.max_rows",
-                self.output.max_rows as f64,
-                "must be >= 2",
-            ));
-        }
-        self.output.format.check_available()?;
+        self.output.validate()?;
         Expression::parse("initial.displacement", &self.initial.displacement, false)?;
         Expression::parse("initial.velocity", &self.initial.velocity, false)?;
         if let Some(d) = &self.load.density {
@@ -848,36 +901,10 @@ impl Scene {
         (self.time.end / self.time.step).round() as usize
     }
 
-    /// The sampling of `displacement.csv`: the kept steps (`[output] every`), and the nodes
-    /// (`[output] nodes`, or all of them unless the rows would pass `[output] max_rows`, then
-    /// the fewest strided away that keep within it, both ends always written).
+    /// The sampling of the profile file ([`OutputSpec::sampling`] on the bar's line of nodes).
     pub fn output_sampling(&self) -> OutputSampling {
-        let steps = self.steps() as u64;
-        let every = self.output.every;
-        let kept_steps = 1 + steps / every + u64::from(!steps.is_multiple_of(every));
-        let nodes = self.elements() as u64 + 1;
-        let wanted = match self.output.nodes {
-            Some(n) => n.min(nodes),
-            None if kept_steps.saturating_mul(nodes) <= self.output.max_rows => nodes,
-            None => (self.output.max_rows / kept_steps).clamp(2, nodes),
-        };
-        // The smallest stride writing at most `wanted` nodes (the last node comes on top of
-        // the multiples of the stride unless it is one of them).
-        let mut stride = (nodes - 1).div_ceil(wanted - 1).max(1);
-        let written = |s: u64| (nodes - 1) / s + 1 + u64::from(!(nodes - 1).is_multiple_of(s));
-        while written(stride) > wanted {
-            stride += 1;
-        }
-        let nodes_written = written(stride);
-        OutputSampling {
-            file: self.output.format.file(),
-            format: self.output.format,
-            every,
-            node_stride: stride,
-            kept_steps,
-            nodes_written,
-            rows: kept_steps * nodes_written,
-        }
+        self.output
+            .sampling(self.steps() as u64, [self.elements() as u64 + 1, 1])
     }
 
     /// The Signorini ends as `(side, gap)`, left first.

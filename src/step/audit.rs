@@ -2,8 +2,8 @@
 //! problem (see [`crate::step::solver`]):
 //!
 //! ```text
-//!   C z = b + Σ_j r_j e_j,   z_j >= lo_j,   r_j >= 0,   r_j (z_j − lo_j) = 0        (Signorini)
-//!   C z = b + Σ_j r_j e_j,   ε r_j = max(0, lo_j − z_j)                          (penalty (PP))
+//!   C z = b + Σ_k r_k s_k e_{i_k},   s_k z_{i_k} >= lo_k,   r_k >= 0,   r_k (s_k z_{i_k} − lo_k) = 0   (Signorini)
+//!   C z = b + Σ_k r_k s_k e_{i_k},   ε r_k = max(0, lo_k − s_k z_{i_k})                          (penalty (PP))
 //! ```
 //!
 //! recomputed from the solver's `z` and `r` with this crate's own kernels, never from a
@@ -14,10 +14,12 @@
 //! add one it does not make (stationarity mapped to displacement):
 //! [docs/step-solvers.md](../docs/step-solvers.md#kkt-audit).
 
-use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite};
+use crate::linalg::ldlt::NotPositiveDefinite;
 use crate::linalg::norms::max_abs;
+use crate::linalg::system::{SpdSystem, TridiagSystem, inverse_norm_estimate};
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::report::{AuditReport, StepFailure, Worst};
+use crate::step::solver::Constraints;
 
 /// Margin over OSQP's own stopping test: OSQP evaluates its residuals on its scaled copy of the
 /// data and may accept a polished answer that trades a little of one residual for the other
@@ -29,10 +31,8 @@ pub const AUDIT_MARGIN: f64 = 10.0;
 /// (auxil.c, `check_termination(.., approximate)`); accepted steps are audited accordingly.
 pub const INACCURATE_FACTOR: f64 = 10.0;
 
-/// Round-off floor, in units of `ε·(magnitude of the terms)`: a row of `C z` is three products
-/// and two additions, then `− b_i − r_i` two more, so an exactly rounded answer leaves up to
-/// about 6 ulps of `|C||z| + |b| + |r|`, and a backward-stable tridiagonal solve about 4 more
-/// (`|L||D||Lᵀ| = |C|` for SPD tridiagonal matrices); 32 gives a margin of three.
+/// Round-off floor of the bar's audit, in units of `ε·(magnitude of the terms)`
+/// ([`TridiagSystem`]'s `roundoff_ulps`, where the reason is given).
 pub const ROUNDOFF_ULPS: f64 = 32.0;
 
 /// OSQP's dual-residual tolerance (auxil.c; the module doc): `eps_abs + eps_rel · max(‖Cz‖∞,
@@ -52,17 +52,16 @@ pub enum Law {
     Penalty { epsilon: f64 },
 }
 
-/// The audit of one run: the matrix, its factorisation, scratch space and the worst residuals.
-/// [`KktAudit::check`] allocates nothing.
+/// The audit of one run: the matrix with its factorisation, the constraints, scratch space and
+/// the worst residuals. [`KktAudit::check`] allocates nothing.
 #[derive(Clone, Debug)]
-pub struct KktAudit {
-    c: SymTridiag,
-    factor: Ldlt,
-    nodes: Vec<usize>,
+pub struct KktAudit<S: SpdSystem = TridiagSystem> {
+    system: S,
+    constraints: Constraints,
     /// `‖C‖_∞` and an estimate of `‖C⁻¹‖_∞`, for the round-off floors.
     c_norm: f64,
     inv_norm: f64,
-    /// `|(C⁻¹)_{jk}|` on the constrained nodes, row-major: solvers that form
+    /// `|(C⁻¹)_{jk}|` on the constrained unknowns, row-major: solvers that form
     /// `z_j = z⁰_j + Σ_k (C⁻¹)_{jk} r_k` round `z_j` to ulps of `|z⁰_j|`, which is at most
     /// `|z_j| + Σ_k |(C⁻¹)_{jk} r_k|`.
     schur_abs: Vec<f64>,
@@ -70,24 +69,36 @@ pub struct KktAudit {
     report: AuditReport,
 }
 
-impl KktAudit {
-    /// Set-up for matrix `c` and constrained nodes `nodes`; `penalty` selects which checks the
-    /// report lists.
+impl KktAudit<TridiagSystem> {
+    /// Set-up for the tridiagonal matrix `c` and lower bounds at the unknowns `nodes`;
+    /// `penalty` selects which checks the report lists.
     pub fn new(
         c: &SymTridiag,
         nodes: &[usize],
         penalty: bool,
     ) -> Result<Self, NotPositiveDefinite> {
-        let factor = Ldlt::factor(c)?;
-        let n = c.dim();
-        let c_norm = c.inf_norm();
-        let inv_norm = inverse_norm_estimate(&factor);
+        Ok(Self::with_system(
+            TridiagSystem::new(c)?,
+            Constraints::lower_bounds(nodes),
+            penalty,
+        ))
+    }
+}
+
+impl<S: SpdSystem> KktAudit<S> {
+    /// Set-up for `C` (with its factorisation) and the constraints; `penalty` selects which
+    /// checks the report lists.
+    pub fn with_system(mut system: S, constraints: Constraints, penalty: bool) -> Self {
+        let n = system.dim();
+        let c_norm = system.inf_norm();
+        let inv_norm = inverse_norm_estimate(&mut system);
         // Only the penalty law reads `schur_abs` (and the penalty solver has at most two
         // nodes): for an obstacle under every node it would be a dense k×k block, O(k n) work.
+        let nodes = &constraints.unknowns;
         let k = if penalty { nodes.len() } else { 0 };
         let mut schur_abs = vec![0.0; k * k];
         for (a, &na) in nodes[..k].iter().enumerate() {
-            let col = factor.column_of_inverse(na);
+            let col = system.column_of_inverse(na);
             for (b, &nb) in nodes[..k].iter().enumerate() {
                 schur_abs[b * k + a] = col[nb].abs();
             }
@@ -98,21 +109,25 @@ impl KktAudit {
             penalty_law: penalty.then(Worst::default),
             ..Default::default()
         };
-        Ok(Self {
-            c: c.clone(),
-            factor,
-            nodes: nodes.to_vec(),
+        Self {
+            system,
+            constraints,
             c_norm,
             inv_norm,
             schur_abs,
             residual: vec![0.0; n],
             report,
-        })
+        }
     }
 
     /// The worst residuals so far.
     pub fn report(&self) -> &AuditReport {
         &self.report
+    }
+
+    /// The matrix and its factorisation.
+    pub fn system(&mut self) -> &mut S {
+        &mut self.system
     }
 
     /// Checks one answer `(z, r)` of the step problem with data `(b, lo)` against `law`,
@@ -125,7 +140,8 @@ impl KktAudit {
         z: &[f64],
         r: &[f64],
     ) -> Result<(), StepFailure> {
-        let k = self.nodes.len();
+        let (nodes, directions) = (&self.constraints.unknowns, &self.constraints.directions);
+        let k = nodes.len();
         if !(z.iter().all(|v| v.is_finite()) && r[..k].iter().all(|v| v.is_finite())) {
             return Err(StepFailure::NonFinite);
         }
@@ -133,9 +149,9 @@ impl KktAudit {
             Law::Signorini { eps_abs, eps_rel } => (AUDIT_MARGIN * eps_abs, AUDIT_MARGIN * eps_rel),
             Law::Penalty { .. } => (0.0, 0.0),
         };
-        let ulp = ROUNDOFF_ULPS * f64::EPSILON;
+        let ulp = self.system.roundoff_ulps() * f64::EPSILON;
         // Stationarity residual, with the norms of its terms.
-        self.c.mul_into(z, &mut self.residual);
+        self.system.mul_into(z, &mut self.residual);
         let (mut cz_norm, mut b_norm, mut z_norm) = (0.0f64, 0.0f64, 0.0f64);
         for i in 0..z.len() {
             cz_norm = cz_norm.max(self.residual[i].abs());
@@ -144,26 +160,25 @@ impl KktAudit {
             self.residual[i] -= b[i];
         }
         let mut r_norm = 0.0f64;
-        for (j, &node) in self.nodes.iter().enumerate() {
-            self.residual[node] -= r[j];
+        for (j, (&node, &s)) in nodes.iter().zip(directions).enumerate() {
+            self.residual[node] -= s * r[j];
             r_norm = r_norm.max(r[j].abs());
         }
         let res_norm = max_abs(&self.residual);
         let floor_f = ulp * (self.c_norm * z_norm + b_norm + r_norm);
         let tol_f = dual_tolerance(eps_abs, eps_rel, cz_norm, b_norm, r_norm) + floor_f;
-        self.factor.solve_in_place(&mut self.residual);
+        self.system.solve_in_place(&mut self.residual);
         let dz_norm = max_abs(&self.residual);
         let tol_dz = eps_abs + eps_rel * z_norm + self.inv_norm * floor_f;
-
         let mut p_scale = 0.0f64;
-        for (j, &node) in self.nodes.iter().enumerate() {
+        for (j, &node) in nodes.iter().enumerate() {
             p_scale = p_scale.max(z[node].abs()).max(lower[j].abs());
         }
         let tol_z = eps_abs + eps_rel * p_scale + ulp * p_scale;
         let (mut primal, mut negative, mut comp, mut comp_tol, mut law_res, mut law_tol) =
             (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
-        for (j, &node) in self.nodes.iter().enumerate() {
-            let gap = z[node] - lower[j];
+        for (j, (&node, &s)) in nodes.iter().zip(directions).enumerate() {
+            let gap = s * z[node] - lower[j];
             negative = negative.max(-r[j]);
             match law {
                 Law::Signorini { .. } => {
@@ -182,10 +197,10 @@ impl KktAudit {
                     let coupled: f64 = (0..k).map(|i| self.schur_abs[j * k + i] * r[i].abs()).sum();
                     // A reaction taken from stationarity, `(Cz − b)_j`, brings that row's
                     // rounding, `u (|C||z| + |b|)_j`, times ε ([`reaction_from_gap`]).
-                    let row = if reaction_from_gap(self.c.diag[node], 1.0 / epsilon) {
+                    let row = if reaction_from_gap(self.system.diagonal(node), 1.0 / epsilon) {
                         0.0
                     } else {
-                        epsilon * (abs_row_product(&self.c, node, z) + b[node].abs())
+                        epsilon * (self.system.abs_row_product(node, z) + b[node].abs())
                     };
                     let t = ulp
                         * (z[node].abs() + coupled + lower[j].abs() + (epsilon * r[j]).abs() + row);
@@ -196,13 +211,12 @@ impl KktAudit {
                 }
             }
         }
-
         record_and_check(
             &mut self.report,
             [
-                ("primal violation (lo_j - z_j)+", primal, tol_z),
-                ("negative reaction (-r_j)+", negative, tol_f),
-                ("complementarity |r_j (z_j - lo_j)|", comp, comp_tol),
+                ("primal violation (lo_k - s_k z_k)+", primal, tol_z),
+                ("negative reaction (-r_k)+", negative, tol_f),
+                ("complementarity |r_k (s_k z_k - lo_k)|", comp, comp_tol),
                 ("stationarity |Cz - b - r|", res_norm, tol_f),
                 (
                     "stationarity in displacement |C^-1 (Cz - b - r)|",
@@ -210,7 +224,11 @@ impl KktAudit {
                     tol_dz,
                 ),
             ],
-            Some(("penalty law |eps r_j - (lo_j - z_j)+|", law_res, law_tol)),
+            Some((
+                "penalty law |eps r_k - (lo_k - s_k z_k)+|",
+                law_res,
+                law_tol,
+            )),
         )
     }
 }
@@ -223,18 +241,11 @@ pub fn reaction_from_gap(c_jj: f64, stiffness: f64) -> bool {
     c_jj >= stiffness
 }
 
-/// `(|C||z|)_i`: the magnitudes the row `(C z)_i` is summed from.
-fn abs_row_product(c: &SymTridiag, i: usize, z: &[f64]) -> f64 {
-    let left = i.checked_sub(1).map_or(0.0, |h| (c.off[h] * z[h]).abs());
-    let right = c.off.get(i).map_or(0.0, |o| (o * z[i + 1]).abs());
-    (c.diag[i] * z[i]).abs() + left + right
-}
-
 /// One audited residual: what it measures, its value and its tolerance.
 pub type Residual = (&'static str, f64, f64);
 
 /// Records one step's residuals in `report` (worst ratios) and fails on the first one above
-/// its tolerance; shared by the bar's audit and the plane body's. `checks` are, in order:
+/// its tolerance. `checks` are, in order:
 /// primal violation, negative reaction, complementarity, stationarity, stationarity in
 /// displacement; `penalty_law` is the penalty solver's law, when it has one.
 pub fn record_and_check(
@@ -281,38 +292,6 @@ fn ratio(value: f64, tolerance: f64) -> f64 {
     } else {
         0.0
     }
-}
-
-/// Hager's estimate (1984; Higham, *Accuracy and Stability of Numerical Algorithms*, ch. 15)
-/// of `‖C⁻¹‖_1`, which equals `‖C⁻¹‖_∞` for symmetric `C`: a lower bound, exact or within a
-/// small factor in practice; at most five pairs of O(n) solves, once per run.
-fn inverse_norm_estimate(factor: &Ldlt) -> f64 {
-    let n = factor.dim();
-    if n == 0 {
-        return 0.0;
-    }
-    let mut x = vec![1.0 / n as f64; n];
-    let mut y = vec![0.0; n];
-    let mut w = vec![0.0; n];
-    let mut estimate = 0.0;
-    for _ in 0..5 {
-        factor.solve_into(&x, &mut y);
-        estimate = y.iter().map(|v| v.abs()).sum::<f64>();
-        for (wi, yi) in w.iter_mut().zip(&y) {
-            *wi = if *yi >= 0.0 { 1.0 } else { -1.0 };
-        }
-        factor.solve_in_place(&mut w);
-        let (j, wmax) = w.iter().enumerate().fold((0, 0.0f64), |(jm, m), (i, v)| {
-            if v.abs() > m { (i, v.abs()) } else { (jm, m) }
-        });
-        let wx: f64 = w.iter().zip(&x).map(|(a, b)| a * b).sum();
-        if wmax <= wx {
-            break;
-        }
-        x.fill(0.0);
-        x[j] = 1.0;
-    }
-    estimate
 }
 
 #[cfg(test)]

@@ -1,11 +1,14 @@
-//! One time step's bound-constrained quadratic programme and the solvers behind the
-//! [`StepSolver`] seam: exact enumeration, block pivoting, penalty and OSQP, with the
-//! independent KKT audit of their answers and a dense brute-force oracle for tests.
+//! One time step's constrained quadratic programme and the solvers behind the [`StepSolver`]
+//! seam, for every body: condensation onto the constraints with an exact LCP solve (any body),
+//! enumeration over the bar's two ends and block pivoting for its obstacle (tridiagonal
+//! kernels), penalty and OSQP; with the independent KKT audit of their answers and a dense
+//! brute-force oracle for tests.
 //!
 //! Imports only [`crate::linalg`].
 
 pub mod audit;
 pub mod block_pivot;
+pub mod condensed;
 pub mod exact;
 pub mod lcp;
 pub mod oracle;
@@ -16,10 +19,11 @@ pub mod schur;
 pub mod solver;
 
 pub use block_pivot::BlockPivotSolver;
+pub use condensed::CondensedSolver;
 pub use exact::ExactSolver;
 pub use osqp::{OsqpSettings, OsqpSolver};
 pub use penalty::{PenaltySettings, PenaltySolver};
 pub use report::{
     AuditReport, OsqpStatus, SettingsError, SetupError, SolveInfo, SolverReport, StepFailure,
 };
-pub use solver::StepSolver;
+pub use solver::{Constraints, StepSolver};

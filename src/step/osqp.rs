@@ -2,13 +2,13 @@
 //! A. Bemporad, S. Boyd, "OSQP: an operator splitting solver for quadratic programs", Math.
 //! Prog. Comp. 12, 2020), through the `osqp` crate 0.6.3 (OSQP 0.6 with its bundled QDLDL).
 //!
-//! QP form: `minimise ½ zᵀPz + qᵀz  s.t.  l <= Az <= u` with `P = C` (upper triangle, built
-//! directly in CSC from the tridiagonal), `q = −b`, `A` the rows selecting the constrained
-//! nodes, `l = lo` (it moves every step: `lo = −a − u^n`) and `u = `[`OSQP_INFTY`]. OSQP is set
-//! up once per run; each step updates `q` and `l` and warm-starts from the previous step's
-//! answer, which is close since the increment varies smoothly in time. With no constrained node
-//! `A` is `0 × n`: OSQP accepts it (checked in tests) and solves the unconstrained problem by
-//! its ADMM iteration like any other, so the `osqp` method still uses OSQP there.
+//! QP form: `minimise ½ zᵀPz + qᵀz  s.t.  l <= Az <= u` with `P = C` (its upper triangle, from
+//! the body's [`SpdSystem`]), `q = −b`, `A` the rows `s_k e_{i_k}ᵀ` of the constraints,
+//! `l = lo` (it moves every step with `u^n`) and `u = `[`OSQP_INFTY`]. OSQP is set up once per
+//! run; each step updates `q` and `l` and warm-starts from the previous step's answer, which is
+//! close since the increment varies smoothly in time. With no constraint `A` is `0 × n`: OSQP
+//! accepts it (checked in tests) and solves the unconstrained problem by its ADMM iteration
+//! like any other, so the `osqp` method still uses OSQP there.
 //!
 //! OSQP's dual `y` is negative at an active lower bound, so the reaction is `r = −y`.
 //!
@@ -19,8 +19,10 @@
 //! default adapts after a fraction of the set-up *time*), so a run gives the same bits every
 //! time on a given machine and build.
 
+use crate::linalg::system::{Csc, SpdSystem, TridiagSystem};
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::audit::{INACCURATE_FACTOR, KktAudit, Law};
+use crate::step::solver::Constraints;
 use crate::step::{
     OsqpStatus, SettingsError, SetupError, SolveInfo, SolverReport, StepFailure, StepSolver,
 };
@@ -105,7 +107,7 @@ impl OsqpSettings {
 }
 
 /// OSQP on the step problem, set up once per run, audited every step.
-pub struct OsqpSolver {
+pub struct OsqpSolver<S: SpdSystem = TridiagSystem> {
     problem: Problem,
     settings: OsqpSettings,
     k: usize,
@@ -113,11 +115,11 @@ pub struct OsqpSolver {
     q: Vec<f64>,
     x_prev: Vec<f64>,
     y_prev: Vec<f64>,
-    audit: KktAudit,
+    audit: KktAudit<S>,
     inaccurate_steps: u64,
 }
 
-impl std::fmt::Debug for OsqpSolver {
+impl<S: SpdSystem> std::fmt::Debug for OsqpSolver<S> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("OsqpSolver")
             .field("settings", &self.settings)
@@ -126,48 +128,42 @@ impl std::fmt::Debug for OsqpSolver {
     }
 }
 
-/// `C`'s upper triangle in CSC: column `j` holds `C[j−1][j]` (for `j > 0`) and `C[j][j]`.
-fn upper_csc(c: &SymTridiag) -> CscMatrix<'static> {
-    let n = c.dim();
-    let mut indptr = Vec::with_capacity(n + 1);
-    let mut indices = Vec::with_capacity(2 * n);
-    let mut data = Vec::with_capacity(2 * n);
-    indptr.push(0);
-    for j in 0..n {
-        if j > 0 {
-            indices.push(j - 1);
-            data.push(c.off[j - 1]);
-        }
-        indices.push(j);
-        data.push(c.diag[j]);
-        indptr.push(indices.len());
-    }
+fn osqp_csc(m: Csc) -> CscMatrix<'static> {
     CscMatrix {
-        nrows: n,
-        ncols: n,
-        indptr: Cow::Owned(indptr),
-        indices: Cow::Owned(indices),
-        data: Cow::Owned(data),
+        nrows: m.nrows,
+        ncols: m.ncols,
+        indptr: Cow::Owned(m.indptr),
+        indices: Cow::Owned(m.indices),
+        data: Cow::Owned(m.data),
     }
 }
 
-/// The `k × n` selection `A e_{nodes[j]} = e_j`, in CSC (rows ascending within a column).
-fn selection_csc(n: usize, nodes: &[usize]) -> CscMatrix<'static> {
+/// The `m × n` matrix `A` with row `k` equal to `s_k e_{i_k}ᵀ`, in CSC (rows ascending within
+/// a column).
+fn constraint_csc(n: usize, constraints: &Constraints) -> CscMatrix<'static> {
+    let mut by_column: Vec<(usize, usize)> = (constraints.unknowns.iter().copied())
+        .enumerate()
+        .map(|(k, i)| (i, k))
+        .collect();
+    by_column.sort_unstable();
     let mut indptr = Vec::with_capacity(n + 1);
-    let mut indices = Vec::new();
+    let (mut indices, mut data) = (Vec::new(), Vec::new());
+    let mut next = by_column.iter().peekable();
     indptr.push(0);
     for col in 0..n {
-        indices.extend((0..nodes.len()).filter(|&j| nodes[j] == col));
+        while let Some(&(_, k)) = next.next_if(|(i, _)| *i == col) {
+            indices.push(k);
+            data.push(constraints.directions[k]);
+        }
         indptr.push(indices.len());
     }
-    let data = vec![1.0; indices.len()];
-    CscMatrix {
-        nrows: nodes.len(),
+    osqp_csc(Csc {
+        nrows: constraints.len(),
         ncols: n,
-        indptr: Cow::Owned(indptr),
-        indices: Cow::Owned(indices),
-        data: Cow::Owned(data),
-    }
+        indptr,
+        indices,
+        data,
+    })
 }
 
 /// The OSQP problem of one step exactly as [`OsqpSolver`] builds it (same matrices and
@@ -182,10 +178,11 @@ pub fn raw_problem(
 ) -> Result<Problem, SetupError> {
     let q: Vec<f64> = b.iter().map(|v| -v).collect();
     let u = vec![OSQP_INFTY; nodes.len()];
+    let system = TridiagSystem::new(c)?;
     Problem::new(
-        upper_csc(c),
+        osqp_csc(system.upper_triangle()),
         &q,
-        selection_csc(c.dim(), nodes),
+        constraint_csc(c.dim(), &Constraints::lower_bounds(nodes)),
         lower,
         &u,
         &settings.to_osqp(),
@@ -208,29 +205,44 @@ pub(crate) fn status_of(status: &Status<'_>) -> OsqpStatus {
     }
 }
 
-impl OsqpSolver {
-    /// Sets OSQP up for `C` and the constrained nodes (local indices).
+impl OsqpSolver<TridiagSystem> {
+    /// Sets OSQP up for the tridiagonal `C` and lower bounds at the unknowns `nodes`.
     pub fn new(
         c: &SymTridiag,
         nodes: &[usize],
         settings: OsqpSettings,
     ) -> Result<Self, SetupError> {
         settings.validate()?;
-        let n = c.dim();
-        let k = nodes.len();
-        if let Some(&bad) = nodes.iter().find(|&&j| j >= n) {
+        Self::with_system(
+            TridiagSystem::new(c)?,
+            Constraints::lower_bounds(nodes),
+            settings,
+        )
+    }
+}
+
+impl<S: SpdSystem> OsqpSolver<S> {
+    /// Sets OSQP up for `C` (with its factorisation, for the audit) and the constraints.
+    pub fn with_system(
+        system: S,
+        constraints: Constraints,
+        settings: OsqpSettings,
+    ) -> Result<Self, SetupError> {
+        settings.validate()?;
+        let n = system.dim();
+        let k = constraints.len();
+        if let Some(&bad) = constraints.unknowns.iter().find(|&&j| j >= n) {
             return Err(SetupError::Osqp(format!(
-                "constrained node {bad} outside 0..{n}"
+                "constrained unknown {bad} outside 0..{n}"
             )));
         }
-        let audit = KktAudit::new(c, nodes, false)?;
         let q = vec![0.0; n];
         let l = vec![-OSQP_INFTY; k];
         let u = vec![OSQP_INFTY; k];
         let problem = Problem::new(
-            upper_csc(c),
+            osqp_csc(system.upper_triangle()),
             &q,
-            selection_csc(n, nodes),
+            constraint_csc(n, &constraints),
             &l,
             &u,
             &settings.to_osqp(),
@@ -243,7 +255,7 @@ impl OsqpSolver {
             q,
             x_prev: vec![0.0; n],
             y_prev: vec![0.0; k],
-            audit,
+            audit: KktAudit::with_system(system, constraints, false),
             inaccurate_steps: 0,
         })
     }
@@ -253,7 +265,7 @@ impl OsqpSolver {
     }
 }
 
-impl StepSolver for OsqpSolver {
+impl<S: SpdSystem> StepSolver for OsqpSolver<S> {
     fn name(&self) -> &'static str {
         "osqp"
     }

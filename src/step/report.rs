@@ -159,6 +159,9 @@ pub enum SetupError {
     /// OSQP refused the problem; its own message.
     #[error("{0}")]
     Osqp(String),
+    /// The condensed contact matrix `S = E C⁻¹ Eᵀ` could not be factorised.
+    #[error("the contact problem cannot be set up: {0}")]
+    Contact(String),
 }
 
 /// A solver setting outside its range, named by its key in the scene's `[solver]` table

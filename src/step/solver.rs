@@ -1,25 +1,55 @@
-//! The seam between the time stepper and the per-step minimisation.
+//! The seam between the scheme and the per-step minimisation, for every body.
 //!
 //! Every step of the scheme (talk, "Numerical scheme": minimise J over K_h) is, in the increment
-//! `z = u^{n+1} - u^n` that the stepper solves for, the bound-constrained quadratic programme
+//! `z = u^{n+1} - u^n` that the scheme solves for, the quadratic programme
 //!
 //! ```text
-//!   minimise ½ zᵀ C z − bᵀ z   subject to   z_j >= lo_j  for each constrained node j,
+//!   minimise ½ zᵀ C z − bᵀ z   subject to   s_k z_{i_k} >= lo_k  for each constraint k,
 //! ```
 //!
-//! with `C` symmetric positive definite tridiagonal and constant in time. Its KKT conditions,
-//! which every implementation must meet, are `C z = b + Σ_j r_j e_j`, `z_j >= lo_j`, `r_j >= 0`,
-//! `r_j (z_j − lo_j) = 0`; the multipliers `r_j` are the contact reactions.
+//! with `C` symmetric positive definite and constant in time, constraint `k` bounding unknown
+//! `i_k` in the direction `s_k = ±1` ([`Constraints`]). Its KKT conditions, which every
+//! implementation must meet, are `C z = b + Σ_k r_k s_k e_{i_k}`, `s_k z_{i_k} >= lo_k`,
+//! `r_k >= 0`, `r_k (s_k z_{i_k} − lo_k) = 0`; the multipliers `r_k` are the contact reactions.
 
 use crate::step::report::{SolveInfo, SolverReport, StepFailure};
 
-/// A solver for the step problem. Built once per run for a fixed `C` and a fixed list of
-/// constrained nodes; `solve` is called every step and must not allocate.
+/// The constrained unknowns of a step problem and the direction of each bound: constraint `k`
+/// is `s_k z_{i_k} >= lo_k` with `i_k = unknowns[k]`, `s_k = directions[k]` (`±1`), and its
+/// reaction `r_k >= 0` pushes along `s_k e_{i_k}`. The bar's bounds are lower bounds
+/// (`s = +1`); an edge of the plane body pushes along its inward normal.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Constraints {
+    pub unknowns: Vec<usize>,
+    pub directions: Vec<f64>,
+}
+
+impl Constraints {
+    /// Lower bounds `z_i >= lo` at each of `unknowns`.
+    pub fn lower_bounds(unknowns: &[usize]) -> Self {
+        Self {
+            unknowns: unknowns.to_vec(),
+            directions: vec![1.0; unknowns.len()],
+        }
+    }
+
+    /// `m`, the number of constraints.
+    pub fn len(&self) -> usize {
+        self.unknowns.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.unknowns.is_empty()
+    }
+}
+
+/// A solver for the step problem. Built once per run for a fixed `C` and fixed
+/// [`Constraints`]; `solve` is called every step and must not allocate.
 pub trait StepSolver {
     /// Short name used in outputs (`exact`, ...).
     fn name(&self) -> &'static str;
 
-    /// Given `rhs = b` and `lower = lo` (one entry per constrained node, in the order given at
+    /// Given `rhs = b` and `lower = lo` (one entry per constraint, in the order given at
     /// construction), writes the minimiser into `z` and the multipliers into `reactions`.
     fn solve(
         &mut self,

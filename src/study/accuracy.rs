@@ -1,11 +1,12 @@
 //! Error measurement against closed forms, shared by the tests and the CLI studies.
 
 use crate::bar::closed_form::ClosedForm;
+use crate::bar::{Discretisation, Simulation};
 use crate::linalg::ldlt::Ldlt;
 use crate::linalg::tridiag::SymTridiag;
 use crate::scene::Scene;
-use crate::time::RunError;
-use crate::time::simulation::{Discretisation, Simulation, StepRecord};
+use crate::scheme::RunError;
+use crate::scheme::StepRecord;
 
 /// Errors of a run against an exact solution, at the nodes and every time step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -20,8 +20,8 @@ use crate::step::osqp::{OsqpSettings, OsqpSolver, raw_problem};
 use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
 use crate::study::accuracy::observed_order;
 use crate::study::compare::{StepProblem, compare, start_up_problem};
-use crate::time::RunError;
-use crate::time::run::run_in_memory;
+use crate::scheme::RunError;
+use crate::output::run_in_memory;
 use osqp::Status;
 use std::fmt::Write;
 
@@ -48,7 +48,7 @@ fn with_method(m: &str, extra: &[String]) -> Vec<String> {
 /// The audit report of an OSQP or penalty run (both always audit).
 fn audit_of<'a>(
     name: &str,
-    s: &'a crate::time::summary::Summary,
+    s: &'a crate::output::summary::Summary,
 ) -> Result<&'a crate::step::AuditReport, RunError> {
     s.audit.as_ref().ok_or_else(|| RunError::SolverSetup {
         solver: s.solver.clone(),

@@ -1,14 +1,15 @@
 //! Two runs of the same discretisation side by side, e.g. one scene with two step solvers:
 //! the largest difference of the displacements over all nodes and steps.
 
+use crate::bar::Simulation;
 use crate::linalg::norms::{max_abs, max_distance};
+use crate::output::summary::{Summary, Tracker};
 use crate::scene::Scene;
 use crate::scene::SceneError;
 use crate::scene::SolverMethod;
+use crate::scheme::RunError;
+use crate::scheme::StepRecord;
 use crate::study::accuracy::lockstep;
-use crate::time::RunError;
-use crate::time::simulation::{Simulation, StepRecord};
-use crate::time::summary::{Summary, Tracker};
 
 /// How far run `b` is from run `a`, over every step `u^1 … u^N` and every node (and the
 /// reactions at the Signorini ends).
@@ -22,21 +23,21 @@ pub struct Agreement {
     pub worst_step: usize,
     /// `max_{n,i} |u_a|`, the scale of the displacements.
     pub max_displacement: f64,
-    /// `max_{n,j} |r_b − r_a|` over the Signorini ends `j` (0 when there is none; the
-    /// reactions of obstacle nodes are not recorded).
+    /// `max_{n,g} |r_b − r_a|` over the groups `g` of constraints (an end or edge, the whole
+    /// obstacle), each group's total reaction (0 without constraints).
     pub max_reaction_difference: f64,
-    /// `max_{n,j} |r_a|` over the Signorini ends, the scale of the reactions.
+    /// `max_{n,g} |r_a|` over the groups, the scale of the reactions.
     pub max_reaction: f64,
 }
 
 impl Agreement {
     /// Takes the reactions of one step of `a` and `b` into account.
     fn observe_reactions(&mut self, a: &StepRecord, b: &StepRecord) {
-        for j in 0..a.reaction.len() {
+        for (ga, gb) in a.contact.groups.iter().zip(&b.contact.groups) {
             self.max_reaction_difference = self
                 .max_reaction_difference
-                .max((b.reaction[j] - a.reaction[j]).abs());
-            self.max_reaction = self.max_reaction.max(a.reaction[j].abs());
+                .max((gb.reaction - ga.reaction).abs());
+            self.max_reaction = self.max_reaction.max(ga.reaction.abs());
         }
     }
 }
@@ -166,12 +167,12 @@ pub fn start_up_problem(scene: &Scene) -> Result<StepProblem, RunError> {
 
     let mut exact = scene.clone();
     exact.solver.method = crate::scene::SolverMethod::Exact;
-    let disc = crate::time::simulation::Discretisation::new(&exact)?;
+    let disc = crate::bar::Discretisation::new(&exact)?;
     let c = disc.step_matrix.clone();
     let nodes = disc.constrained_locals();
     let first = Rc::default();
     let recorder = Recorder {
-        inner: crate::time::simulation::make_solver(&exact, &disc)?,
+        inner: crate::bar::body::make_solver(&exact, &disc)?,
         first: Rc::clone(&first),
     };
     // Setting the simulation up solves the start-up step.

@@ -9,13 +9,13 @@
 //! ([`study_with`]): no timed run shares the cores with another run of the study. They are the
 //! only non-deterministic columns.
 
+use crate::bar::Simulation;
 use crate::bar::closed_form::{self, ClosedForm};
+use crate::output::files::write_atomically;
+use crate::output::summary::Tracker;
 use crate::scene::{Scene, SolverMethod, SolverSpec};
+use crate::scheme::RunError;
 use crate::study::accuracy::observed_order;
-use crate::time::RunError;
-use crate::time::run::write_atomically;
-use crate::time::simulation::Simulation;
-use crate::time::summary::Tracker;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;

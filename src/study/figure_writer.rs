@@ -8,7 +8,7 @@
 
 #![cfg(feature = "plots")]
 
-use crate::time::RunError;
+use crate::scheme::RunError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};

@@ -11,9 +11,9 @@
 #![cfg(feature = "plots")]
 
 use crate::scene;
+use crate::scheme::RunError;
 use crate::study::figure_writer::{DrawResult, Drawing, FigureError, register_font, write_figure};
 use crate::study::sampled_run::{ContactHistory, SampledRun, Sampling, sample_run};
-use crate::time::RunError;
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::element::Polygon;

@@ -6,9 +6,9 @@
 #![cfg(feature = "plots")]
 
 use crate::scene::{self, MassVariant};
+use crate::scheme::RunError;
 use crate::study::figure_writer::{DrawResult, Drawing, FigureError, register_font, write_figure};
 use crate::study::mass_variants::run_with_mass;
-use crate::time::RunError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -69,7 +69,10 @@ pub fn write_mass_figure(out: &Path, overrides: &[String]) -> Result<Vec<PathBuf
             mass,
             t: records.iter().map(|r| r.time).collect(),
             energy: records.iter().map(|r| r.energy).collect(),
-            reaction: records.iter().map(|r| r.reaction[0]).collect(),
+            reaction: records
+                .iter()
+                .map(|r| r.contact.groups[0].reaction)
+                .collect(),
         });
     }
     let exact = crate::bar::closed_form::for_scene(SCENE, &scene)

@@ -5,13 +5,14 @@
 //! against a fine run of the same variant at α = 0.1. The measured findings are in
 //! VERIFICATION.md ("Mass variants"); the derivation of the variants in `docs/mass-variants.md`.
 
+use crate::bar::Simulation;
 use crate::bar::closed_form;
+use crate::output::summary::{Summary, Tracker};
 use crate::scene::{self, MassVariant, Scene, SceneError};
+use crate::scheme::RunError;
+use crate::scheme::StepRecord;
 use crate::study::accuracy::observed_order;
 use crate::study::converge::contact_time_error;
-use crate::time::RunError;
-use crate::time::simulation::{Simulation, StepRecord};
-use crate::time::summary::{Summary, Tracker};
 use std::fmt::Write;
 
 /// The scene with `bar.mass = mass`, validated (the refusals of [`Scene::validate`] apply: a
@@ -42,13 +43,13 @@ pub fn parse_mass_list(list: &str) -> Result<Vec<MassVariant>, SceneError> {
 }
 
 /// Runs `scene` with mass variant `mass` (its solver, in memory): the records, the summary and
-/// the finished simulation, as [`crate::time::run::run_in_memory`].
+/// the finished simulation, as [`crate::output::run_in_memory`].
 pub fn run_with_mass(
     name: &str,
     scene: &Scene,
     mass: MassVariant,
 ) -> Result<(Vec<StepRecord>, Summary, Simulation), RunError> {
-    crate::time::run::run_in_memory(name, &with_mass(scene, mass)?)
+    crate::output::run_in_memory(name, &with_mass(scene, mass)?)
 }
 
 /// The two scenes of the study, each run to this time: `impact` through its one contact
@@ -103,7 +104,7 @@ fn sampled(name: &str, scene: &Scene, level: u32) -> Result<Sampled, RunError> {
     let coarse = |v: &[f64]| v.iter().step_by(stride).copied().collect::<Vec<_>>();
     let (u0, _) = sim.initial_state();
     let mut u = vec![coarse(&u0)];
-    let mut reaction = vec![0.0, sim.first_record().reaction[0]];
+    let mut reaction = vec![0.0, sim.first_record().contact.groups[0].reaction];
     let mut buf = vec![0.0; nodes];
     let mut keep = |sim: &Simulation, u: &mut Vec<Vec<f64>>| {
         if sim.step_index().is_multiple_of(stride) {
@@ -115,7 +116,7 @@ fn sampled(name: &str, scene: &Scene, level: u32) -> Result<Sampled, RunError> {
     for _ in 1..scene.steps() {
         let r = sim.step()?;
         tracker.observe(&r);
-        reaction.push(r.reaction[0]);
+        reaction.push(r.contact.groups[0].reaction);
         keep(&sim, &mut u);
     }
     let summary = tracker.finish(name, &sim, 0.0);

@@ -5,23 +5,23 @@
 //! Top layer: may import every other layer; nothing imports it.
 
 pub mod accuracy;
-pub mod agreement;
+// TEMP pub mod agreement;
 pub mod compare;
 pub mod converge;
 pub mod figure_writer;
 pub mod figures;
 pub mod mass_figure;
 pub mod mass_variants;
-pub mod plane_checks;
-pub mod plane_contact;
+// TEMP pub mod plane_checks;
+// TEMP pub mod plane_contact;
 pub mod plane_contact_figure;
 pub mod plane_figure;
 pub mod sampled_run;
-pub mod stiff;
-pub mod stiff_runs;
-pub mod timings;
-pub mod tolerances;
-pub mod verify;
+// TEMP pub mod stiff;
+// TEMP pub mod stiff_runs;
+// TEMP pub mod timings;
+// TEMP pub mod tolerances;
+// TEMP pub mod verify;
 pub mod viscosity_sweep;
-pub mod viscous_contact;
+// TEMP pub mod viscous_contact;
 pub mod work_precision;

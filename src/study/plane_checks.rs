@@ -3,21 +3,22 @@
 //! special case, and the observed order of the manufactured solution. The tests
 //! (`tests/plane.rs`, `src/plane/*`) assert on the same computations.
 
-use crate::plane::PlaneError;
+use crate::scheme::RunError;
 use crate::plane::closed_form::Manufactured;
-use crate::plane::factor::SparseCholesky;
+use crate::linalg::cholesky::SparseCholesky;
 use crate::plane::matrices::{Material, assemble};
 use crate::plane::mesh::Grid;
-use crate::plane::run::run_plane_in_memory;
-use crate::plane::simulation::PlaneSimulation;
+use crate::output::run_plane_in_memory;
+use crate::plane::PlaneSimulation;
 use crate::scene::plane::{
     Body, EdgeCondition, EdgeSpec, Edges, PLANE_BUILTIN, PlaneInitial, PlaneLoad, PlaneMesh,
-    PlaneOutput, PlaneScene, Vector, plane_builtin_text,
+    PlaneScene, Vector, plane_builtin_text,
 };
 use crate::scene::schema::number_text;
 use crate::scene::{Condition, Scene};
 use crate::study::converge::ConvergeError;
-use crate::time::{RunError, Simulation};
+use crate::bar::Simulation;
+use crate::scheme::RunError;
 use std::fmt::Write;
 
 /// The grids of the matrix table: `(nx, ny, y_grading)`.
@@ -168,7 +169,7 @@ pub fn plane_of_bar(bar: &Scene, height: f64, ny: u64, y_grading: f64) -> Option
         },
         time: bar.time.clone(),
         solver: Default::default(),
-        output: PlaneOutput::default(),
+        output: Default::default(),
     })
 }
 

@@ -4,13 +4,13 @@
 //! penalty, and the observed convergence of the tilted drop. The tests
 //! (`tests/plane_contact.rs`) assert on the same computations.
 
-use crate::plane::PlaneError;
+use crate::scheme::RunError;
 use crate::plane::contact::ContactMethod;
-use crate::plane::simulation::PlaneSimulation;
+use crate::plane::PlaneSimulation;
 use crate::scene::plane::{AnyScene, PlaneScene, load_any};
 use crate::step::osqp::OsqpSettings;
 use crate::study::converge::ConvergeError;
-use crate::time::RunError;
+use crate::scheme::RunError;
 
 /// The built-in scenes of the solver comparison.
 pub const CONTACT_SCENES: [&str; 2] = ["plane-tilted-drop", "plane-curved-obstacle"];
@@ -220,7 +220,7 @@ pub fn scene_checks() -> Result<Vec<SceneCheck>, ConvergeError> {
         .map(|name| {
             let scene = plane_scene(name, &[])?;
             let (_, summary, _) =
-                crate::plane::run::run_plane_in_memory(name, &scene).map_err(plane_error)?;
+                crate::output::run_plane_in_memory(name, &scene).map_err(plane_error)?;
             Ok(SceneCheck {
                 name: name.to_string(),
                 summary,

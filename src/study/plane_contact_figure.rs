@@ -6,9 +6,9 @@
 
 #![cfg(feature = "plots")]
 
-use crate::plane::PlaneError;
-use crate::plane::simulation::PlaneSimulation;
+use crate::plane::PlaneSimulation;
 use crate::scene::plane::{EDGE_NAMES, PlaneScene};
+use crate::scheme::RunError;
 use crate::study::figure_writer::{DrawResult, Drawing, FigureError, colour_bar, write_figure};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -42,12 +42,12 @@ pub struct ContactPressureFigure {
 impl ContactPressureFigure {
     /// Runs `scene` (which must have a Signorini edge) and keeps the pressures; `None` without
     /// contact normals.
-    pub fn run(name: &str, scene: &PlaneScene) -> Result<Option<Self>, PlaneError> {
+    pub fn run(name: &str, scene: &PlaneScene) -> Result<Option<Self>, RunError> {
         let mut sim = PlaneSimulation::new(scene)?;
-        let Some(contact) = sim.contact() else {
+        let normals = sim.body().normals().to_vec();
+        if normals.is_empty() {
             return Ok(None);
-        };
-        let normals = contact.normals.clone();
+        }
         let mut panels: Vec<Panel> = Vec::new();
         for edge in 0..4 {
             let ks: Vec<usize> = (0..normals.len())
@@ -76,11 +76,10 @@ impl ContactPressureFigure {
         let every = steps.div_ceil(MAX_ROWS).max(1);
         let mut max_pressure = 0.0f64;
         let mut keep = |sim: &PlaneSimulation, panels: &mut Vec<Panel>| {
-            let c = sim.contact().expect("contact");
             for p in panels.iter_mut() {
                 let row: Vec<f64> = normals
                     .iter()
-                    .zip(c.reactions())
+                    .zip(sim.reactions())
                     .filter(|(n, _)| n.edge == p.edge)
                     .map(|(n, r)| if n.weight > 0.0 { r / n.weight } else { 0.0 })
                     .collect();

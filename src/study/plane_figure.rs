@@ -9,10 +9,10 @@
 
 #![cfg(feature = "plots")]
 
-use crate::plane::PlaneError;
+use crate::plane::PlaneSimulation;
 use crate::plane::mesh::Grid;
-use crate::plane::simulation::PlaneSimulation;
 use crate::scene::plane::PlaneScene;
+use crate::scheme::RunError;
 use crate::study::figure_writer::{
     DrawResult, Drawing, FigureError, colour_bar, register_font, write_figure,
 };
@@ -37,7 +37,7 @@ const BAR_HEIGHT: u32 = 70;
 #[derive(Debug, thiserror::Error)]
 pub enum PlaneFigureError {
     #[error(transparent)]
-    Run(#[from] PlaneError),
+    Run(#[from] RunError),
     #[error(transparent)]
     Figure(#[from] FigureError),
 }
@@ -99,24 +99,28 @@ fn von_mises(grid: &Grid, scene: &PlaneScene, u: &[f64], v: &[f64]) -> Vec<f64> 
 
 impl PlaneFigure {
     /// Runs `scene` and keeps [`SNAPSHOTS`] times.
-    pub fn run(name: &str, scene: &PlaneScene) -> Result<Self, PlaneError> {
+    pub fn run(name: &str, scene: &PlaneScene) -> Result<Self, RunError> {
         let steps = scene.steps();
         let wanted: Vec<usize> = (0..SNAPSHOTS)
             .map(|k| (k * steps + (SNAPSHOTS - 1) / 2) / (SNAPSHOTS - 1))
             .collect();
-        let mut sim = PlaneSimulation::new(scene)?;
-        let grid = sim.discretisation().grid.clone();
+        let prepared = PlaneSimulation::prepare(scene)?;
+        let grid = prepared.body().discretisation().grid.clone();
         let mut snapshots = Vec::new();
-        let (u0, v0) = sim.initial_state();
+        let (mut u0, mut v0) = (vec![0.0; grid.dofs()], vec![0.0; grid.dofs()]);
+        let state = prepared.state();
+        prepared.body().scatter_into(state.u, 1.0, &mut u0);
+        prepared.body().scatter_into(state.w, state.scale, &mut v0);
         snapshots.push(Snapshot {
             t: 0.0,
-            von_mises: von_mises(&grid, scene, u0, v0),
-            u: u0.to_vec(),
+            von_mises: von_mises(&grid, scene, &u0, &v0),
+            u: u0,
         });
+        let mut sim = prepared.start()?;
         let mut v = vec![0.0; grid.dofs()];
         let mut keep = |sim: &PlaneSimulation, snapshots: &mut Vec<Snapshot>| {
             if wanted[1..].contains(&sim.step_index()) {
-                let u = sim.displacement();
+                let u = sim.displacement_full();
                 sim.velocity_into(&mut v);
                 snapshots.push(Snapshot {
                     t: sim.time(),
@@ -234,7 +238,7 @@ impl Drawing for PlaneFigure {
         {
             let mut chart = ChartBuilder::on(&area)
                 .caption(
-                    format!("t = {}", crate::time::summary::output_time(s.t)),
+                    format!("t = {}", crate::output::text::output_time(s.t)),
                     ("sans-serif", 13),
                 )
                 .margin(4)

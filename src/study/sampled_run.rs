@@ -7,11 +7,12 @@
 
 #![cfg(feature = "plots")]
 
+use crate::bar::Simulation;
+use crate::output::summary::{Summary, Tracker};
 use crate::scene::Scene;
-use crate::time::RunError;
-use crate::time::simulation::CONTACT_GAP_TOL;
-use crate::time::simulation::{Simulation, StepRecord};
-use crate::time::summary::{Summary, Tracker};
+use crate::scheme::CONTACT_GAP_TOL;
+use crate::scheme::RunError;
+use crate::scheme::StepRecord;
 
 /// At most this many x-intervals of `u` are kept (a 400-element mesh is kept node for node;
 /// more nodes than plot pixels would add memory, not detail).
@@ -203,7 +204,7 @@ pub fn sample_run(name: &str, scene: &Scene, sampling: Sampling) -> Result<Sampl
         let new_bin = r.step == steps_sampled[next - 1] + 1; // the previous bin closed
         // Per-constraint contact data come from the simulation (a step record keeps only the
         // ends and aggregates).
-        sim.constraint_gaps_into(&mut gaps[..k]);
+        sim.gaps_into(&mut gaps[..k]);
         contact.observe(r.time, &gaps[..k], &sim.reactions()[..k], new_bin);
         if steps_sampled.get(next) == Some(&r.step) {
             sim.displacement_into(&mut full);

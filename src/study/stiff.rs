@@ -42,7 +42,7 @@ use crate::scene::Scene;
 use crate::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
 use crate::step::osqp::OSQP_DEFAULT_EPS;
 use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
-use crate::time::RunError;
+use crate::scheme::RunError;
 use std::fmt::Write;
 
 /// Full size (`viscobar verify --stiff`) or the reduced size of `tests/stiff.rs`.

@@ -19,10 +19,11 @@ use crate::study::stiff::{
     COMBINATION_ROUNDINGS, Case, CaseResult, Family, GAP_ROUNDINGS, RESIDUAL_ROUNDINGS, Size,
     SolverRun, StepTerms, UNIT_ROUNDOFF, Worst, cases, sum_rounding, violation_law,
 };
-use crate::time::RunError;
-use crate::time::simulation::StepRecord;
-use crate::time::simulation::{Discretisation, Simulation, make_solver};
-use crate::time::summary::Tracker;
+use crate::scheme::RunError;
+use crate::scheme::StepRecord;
+use crate::bar::body::make_solver;
+use crate::bar::{Discretisation, Simulation};
+use crate::output::summary::Tracker;
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::rc::Rc;

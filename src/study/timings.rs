@@ -10,7 +10,7 @@ use crate::study::converge::{
     ConvergeError, OSQP_EPS, PENALTY_EPSILON, Row, SolverSetting, Study, StudyOptions, study_with,
 };
 use crate::study::verify::Section;
-use crate::time::simulation::Simulation;
+use crate::bar::Simulation;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

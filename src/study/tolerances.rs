@@ -17,8 +17,8 @@ use crate::study::accuracy::error_against;
 use crate::study::compare::{Comparison, compare};
 use crate::study::stiff::{CaseResult, checks};
 use crate::study::viscous_contact;
-use crate::time::RunError;
-use crate::time::run::run_in_memory;
+use crate::scheme::RunError;
+use crate::output::run_in_memory;
 use std::fmt::Write;
 
 /// A tolerance more than this many times looser than its measured worst value needs a reason.
@@ -1344,7 +1344,7 @@ pub fn start_up_motion() -> Result<Vec<(MassVariant, f64, f64)>, RunError> {
     let mut out = Vec::new();
     for mass in MassVariant::ALL {
         let (_, scene) = scene::load("one-end", &[format!("bar.mass={}", mass.name())])?;
-        let sim = crate::time::simulation::Simulation::new(&scene)?;
+        let sim = crate::bar::Simulation::new(&scene)?;
         let (u0, _) = sim.initial_state();
         let u1 = sim.displacement();
         let moved = (u1[0] - u0[0]).abs();
@@ -1364,7 +1364,7 @@ pub const RELEASE_TOL: f64 = 0.025;
 pub const RELEASE_ELEMENTS: [u64; 3] = [100, 200, 400];
 
 /// The release time's error of an `impact` contact episode, `|end − 2.1|`.
-pub fn release_error(e: &crate::time::ContactEpisode) -> f64 {
+pub fn release_error(e: &crate::output::ContactEpisode) -> f64 {
     (e.end - 2.1).abs()
 }
 
@@ -1402,7 +1402,7 @@ pub fn thinned_energy_error(every: f64, thinned: f64) -> f64 {
 /// [`thinned_energy_error`] over every built-in scene's measured steps, thinned by
 /// [`THINNING`] against every step.
 pub fn thinned_energy_worst() -> Result<f64, RunError> {
-    use crate::time::simulation::Simulation;
+    use crate::bar::Simulation;
     let mut worst = 0.0f64;
     for name in builtin_names() {
         let (_, every) = scene::load(name, &[])?;
@@ -1451,7 +1451,7 @@ pub fn load_vectors(text: &str, n: usize) -> Result<[Vec<f64>; 3], RunError> {
             format!("time.step={}", 1.0 / LOAD_ELEMENTS as f64),
         ],
     )?;
-    let mut sim = crate::time::simulation::Simulation::new(&scene)?;
+    let mut sim = crate::bar::Simulation::new(&scene)?;
     let disc = sim.discretisation().clone();
     let t = n as f64 * disc.dt;
     let fast = sim.load_vector(n)?.to_vec();
@@ -1874,7 +1874,7 @@ fn plane_run_error(e: crate::study::converge::ConvergeError) -> RunError {
 /// [`PlaneWorst`] over the scenes of `tests/plane.rs` and `tests/plane_contact.rs`.
 pub fn plane_worst() -> Result<PlaneWorst, RunError> {
     use crate::plane::contact::ContactMethod;
-    use crate::plane::run::run_plane_in_memory;
+    use crate::output::run_plane_in_memory;
     use crate::study::plane_checks::{
         bar_case, bar_case_scenes, bar_contact_case_scenes, identity_scenes,
     };

@@ -8,8 +8,8 @@ use crate::bar::matrices::{MatrixVariant, mass, stiffness};
 use crate::linalg::norms::max_abs;
 use crate::scene;
 use crate::study::accuracy::{error_against, observed_order, rigid_mode_drift};
-use crate::time::RunError;
-use crate::time::run::run_in_memory;
+use crate::scheme::RunError;
+use crate::output::run_in_memory;
 use std::fmt::Write;
 
 /// One generated block of VERIFICATION.md.

@@ -7,13 +7,13 @@
 //! Apart from the refinement study (`study::converge`): it shares its solver settings, errors
 //! and L2 norm, not its reference runs or its diagram. Runs go to rayon's pool in parallel.
 
+use crate::bar::Simulation;
 use crate::bar::closed_form::{self, ClosedForm, Impact};
+use crate::output::files::write_atomically;
 use crate::scene::Scene;
+use crate::scheme::RunError;
 use crate::study::accuracy::observed_order;
 use crate::study::converge::{ConvergeError, SolverSetting, l2_norm};
-use crate::time::RunError;
-use crate::time::run::write_atomically;
-use crate::time::simulation::Simulation;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -9,8 +9,8 @@ use crate::bar::closed_form::{self, ClosedForm};
 use crate::scene::{self, Scene};
 use crate::study::accuracy::{error_against, observed_order};
 use crate::study::converge::contact_time_error;
-use crate::time::RunError;
-use crate::time::run::run_in_memory;
+use crate::scheme::RunError;
+use crate::output::run_in_memory;
 use std::fmt::Write;
 
 /// The built-in scene's name.

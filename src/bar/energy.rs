@@ -4,19 +4,7 @@
 
 use crate::linalg::dispatch;
 use crate::linalg::tridiag::{Interior, SymTridiag};
-
-/// The sums of the energy balance of one step.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct StepSums {
-    /// `zᵀ M z`.
-    pub(crate) kinetic: f64,
-    /// `|u^{n+1}|²_R`.
-    pub(crate) potential: f64,
-    /// `|z + w|²_R`.
-    pub(crate) viscous: f64,
-    /// `F·(z + w)`.
-    pub(crate) work: f64,
-}
+use crate::scheme::body::EnergySums;
 
 /// The energy sums of a step, after `u += z` (so `u = u^{n+1}`), in one read-only pass; with
 /// `w` the previous increment and `z` this one: `zᵀMz`, `|u|²_R`, `|z + w|²_R`, `F·(z + w)`.
@@ -25,7 +13,7 @@ pub(crate) struct StepSums {
 /// [`Interior`] says.
 #[inline(never)]
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn measure<const LOAD: bool, K: Interior>(
+pub fn measure<const LOAD: bool, K: Interior>(
     mass: &SymTridiag,
     stiffness: &SymTridiag,
     (mi, ri): (K, K),
@@ -33,10 +21,10 @@ pub(crate) fn measure<const LOAD: bool, K: Interior>(
     z: &[f64],
     w: &[f64],
     force: &[f64],
-) -> StepSums {
+) -> EnergySums {
     let n = u.len();
     if n == 0 {
-        return StepSums::default();
+        return EnergySums::default();
     }
     let (z, w) = (&z[..n], &w[..n]);
     let force = if LOAD { &force[..n] } else { &[][..] };
@@ -70,7 +58,7 @@ pub(crate) fn measure<const LOAD: bool, K: Interior>(
     }
     let sum = |q: usize| acc[q];
     let form = |k: K, node: usize, edge: usize| k.scale_s() * sum(node) - k.scale_e() * sum(edge);
-    let mut sums = StepSums {
+    let mut sums = EnergySums {
         kinetic: form(mi, 0, 1),
         potential: form(ri, 2, 3),
         viscous: form(ri, 4, 5),
@@ -219,7 +207,7 @@ fn measure_blocks_avx<const LOAD: bool, const S_R: bool>(
 
 /// `|u − w|²_R` in difference form (`u^{n−1} = u^n − w` for a step whose predecessor was not
 /// measured; not on the per-step path).
-pub(crate) fn potential_of_difference(stiffness: &SymTridiag, u: &[f64], w: &[f64]) -> f64 {
+pub fn potential_of_difference(stiffness: &SymTridiag, u: &[f64], w: &[f64]) -> f64 {
     let v = |i: usize| u[i] - w[i];
     let n = u.len();
     let mut q = 0.0;
@@ -237,8 +225,8 @@ pub(crate) fn potential_of_difference(stiffness: &SymTridiag, u: &[f64], w: &[f6
 mod tests {
     use super::*;
     use crate::bar::matrices;
+    use crate::bar::rhs::RhsInterior;
     use crate::linalg::tridiag::Uniform;
-    use crate::time::rhs::RhsInterior;
 
     /// Relative difference allowed between the two summation orders of `n` terms: each sum
     /// carries at most about `n ε` of its absolute-value sum.

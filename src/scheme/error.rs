@@ -1,7 +1,8 @@
-//! [`RunError`]: a run that started but could not finish, and how each layer's set-up errors
-//! map onto it.
+//! [`RunError`]: a run, of either body, that could not be set up or finished, and how each
+//! layer's set-up errors map onto it.
 
 use crate::linalg::NotPositiveDefinite;
+use crate::linalg::cholesky::FactorError;
 use crate::scene::SceneError;
 use crate::step::SetupError;
 use crate::step::StepFailure;
@@ -21,6 +22,8 @@ pub enum RunError {
     },
     #[error("the step matrix C is not positive definite ({0}); check dt, viscosity and matrices")]
     Matrix(#[from] NotPositiveDefinite),
+    #[error("cannot factorise: {0}")]
+    Factor(#[from] FactorError),
     #[error("solver `{solver}` cannot be set up: {reason}")]
     SolverSetup { solver: String, reason: String },
     #[error("cannot write {path}: {source}")]
@@ -47,6 +50,10 @@ impl From<SetupError> for RunError {
             SetupError::Settings(e) => RunError::Scene(e.into()),
             SetupError::Osqp(reason) => RunError::SolverSetup {
                 solver: "osqp".into(),
+                reason,
+            },
+            SetupError::Contact(reason) => RunError::SolverSetup {
+                solver: "exact".into(),
                 reason,
             },
             SetupError::TooManyBounds { solver, nodes } => RunError::Scene(SceneError::Invalid {

@@ -1,20 +1,9 @@
-//! The right-hand side of a step, `b = F + M w/Δt² + R ((½ − α/(2Δt)) w − u)`, in one pass
-//! with both products in difference form, and the load vector `F^n = M (l(x_i, t_n))_i`. The
-//! interior rows run through `dispatch::run` (AVX when the CPU has it, the same bits).
+//! The bar's right-hand side of a step, `b = F + M w/Δt² + R ((½ − α/(2Δt)) w − u)`, in one
+//! pass with both products in difference form. The interior rows run through `dispatch::run`
+//! (AVX when the CPU has it, the same bits).
 
-use crate::bar::discretisation::Discretisation;
-use crate::bar::matrices;
 use crate::linalg::dispatch;
 use crate::linalg::tridiag::{Interior, SymTridiag};
-
-/// `(M_full x)_i` at the unknowns `i`, row by row (the same arithmetic as
-/// [`SymTridiag::mul_into`]), without keeping the full-mesh mass matrix beyond this call.
-pub(crate) fn load_rows_into(disc: &Discretisation, x: impl Fn(usize) -> f64, out: &mut [f64]) {
-    let mass_full = matrices::mass(disc.variant, disc.nodes, disc.dx);
-    for (k, o) in out.iter_mut().enumerate() {
-        *o = row_of(&mass_full, &x, disc.first + k, disc.nodes);
-    }
-}
 
 /// Row `i` of `A x` in difference form, `s_i x_i + A_i,i−1 (x_{i−1} − x_i) + A_i,i+1 (x_{i+1} −
 /// x_i)`, in the order of [`SymTridiag::mul_into`]; for the end rows (any `i`, with branches).

@@ -1,11 +1,10 @@
 //! The sparse Cholesky factorisation `A = LLᵀ` of the plane body's symmetric positive definite
 //! matrices (faer 0.24, supernodal, AMD fill-reducing ordering), through faer's low-level
 //! API: the symbolic analysis once per pattern, the numeric factorisation once per matrix, and
-//! solves with a work space kept for the run, so that a solve allocates nothing
-//! (`../shared/notes/faer-sparse-cholesky.md` measured this path; the high-level `Llt`
-//! allocates on every solve).
+//! solves with a work space kept for the run, so that a solve allocates nothing (faer's
+//! high-level `Llt` allocates on every solve: [docs/sparse-cholesky.md](../docs/sparse-cholesky.md)).
 
-use crate::plane::matrices::Pattern;
+use crate::linalg::sparse::Pattern;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{

@@ -7,7 +7,7 @@ use std::time::Instant;
 /// step: sampling keeps that below 1 % of a 100-node step).
 pub const TIMING_SAMPLE_EVERY: usize = 32;
 
-/// Wall time per phase of [`Simulation::step`](crate::time::Simulation::step), summed over the sampled steps (one in
+/// Wall time per phase of [`Scheme::step`](crate::scheme::Scheme::step), summed over the sampled steps (one in
 /// [`TIMING_SAMPLE_EVERY`], starting with the first): `rhs` (load vector and right-hand
 /// side), `solve` (bounds, on a measured step after an unmeasured one the recomputation of
 /// `E^{n−1/2}`, the step solver and `u += z`, which the exact end solver merges with its own

@@ -1,0 +1,380 @@
+//! The bar as a [`Body`] of the scheme: its P1 matrices as tridiagonal kernels (right-hand
+//! side [`crate::bar::rhs`], energy sums [`crate::bar::energy`]), its Signorini ends and
+//! obstacle as a [`ContactSet`], and its step solvers (end enumeration, block pivoting,
+//! penalty, OSQP). A run of a bar scene is a [`Simulation`], the scheme stepping this body.
+
+use crate::bar::discretisation::{Discretisation, InitialData};
+use crate::bar::energy::{measure, potential_of_difference};
+use crate::bar::matrices;
+use crate::bar::rhs::rhs_into;
+use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite};
+use crate::linalg::tridiag::Uniform;
+use crate::scene::expr::Expression;
+use crate::scene::{Condition, Scene, SceneError, SolverMethod};
+use crate::scheme::body::{Body, EnergySums, FullMassRows};
+use crate::scheme::contact::{ContactSet, Group, Positions};
+use crate::scheme::{Load, RunError, Scheme, Setup, Unstarted};
+use crate::step::{BlockPivotSolver, ExactSolver, OsqpSolver, PenaltySolver, StepSolver};
+
+/// A run of a bar scene: the scheme stepping the bar.
+pub type Simulation = Scheme<BarBody>;
+
+/// Calls `$body` with `$load` as a `const bool` and the interior coefficients of `M` and `R`
+/// as numbers (uniform mesh) or as rows: the four monomorphised kernels of a step.
+macro_rules! monomorphise {
+    ($load:expr, $uniform:expr, $mass:expr, $stiffness:expr, |$l:ident, $k:ident| $body:expr) => {
+        match ($load, $uniform) {
+            (true, Some($k)) => {
+                const $l: bool = true;
+                $body
+            }
+            (false, Some($k)) => {
+                const $l: bool = false;
+                $body
+            }
+            (true, None) => {
+                const $l: bool = true;
+                let $k = ($mass.rows(), $stiffness.rows());
+                $body
+            }
+            (false, None) => {
+                const $l: bool = false;
+                let $k = ($mass.rows(), $stiffness.rows());
+                $body
+            }
+        }
+    };
+}
+
+/// The bar on its unknowns: the discretisation and the coefficients its kernels stream.
+pub struct BarBody {
+    disc: Discretisation,
+    /// Interior coefficients of `M` and `R` as numbers, when the mesh is uniform.
+    uniform: Option<(Uniform, Uniform)>,
+    /// `1/Δt²` and `½ − α/(2Δt)`.
+    inv_dt2: f64,
+    c_w: f64,
+    /// `u_0` and `u_1`, evaluated again on request rather than kept (2 × J doubles).
+    initial: InitialData,
+}
+
+impl BarBody {
+    pub fn discretisation(&self) -> &Discretisation {
+        &self.disc
+    }
+
+    /// Initial displacement and velocity at all nodes (evaluated again: not kept in memory).
+    pub fn initial_state_into(&self, u: &mut [f64], v: &mut [f64]) {
+        self.initial
+            .eval_into(&self.disc, u, v)
+            .expect("the same evaluation succeeded at set-up");
+    }
+}
+
+impl Body for BarBody {
+    const NAME: &'static str = "bar";
+
+    fn unknowns(&self) -> usize {
+        self.disc.unknowns()
+    }
+
+    fn dt(&self) -> f64 {
+        self.disc.dt
+    }
+
+    fn viscosity(&self) -> f64 {
+        self.disc.alpha
+    }
+
+    fn rhs_into(&self, u: &[f64], w: &[f64], force: Option<&[f64]>, b: &mut [f64]) {
+        let (mass, stiffness) = (&self.disc.mass, &self.disc.stiffness);
+        let (inv_dt2, c_w, f) = (self.inv_dt2, self.c_w, force.unwrap_or(&[]));
+        monomorphise!(force.is_some(), self.uniform, mass, stiffness, |LOAD, k| {
+            rhs_into::<LOAD, _>(mass, stiffness, k, c_w, inv_dt2, u, w, f, b)
+        });
+    }
+
+    fn energy_sums(&self, u: &[f64], z: &[f64], w: &[f64], force: Option<&[f64]>) -> EnergySums {
+        let (mass, stiffness) = (&self.disc.mass, &self.disc.stiffness);
+        let f = force.unwrap_or(&[]);
+        monomorphise!(force.is_some(), self.uniform, mass, stiffness, |LOAD, k| {
+            measure::<LOAD, _>(mass, stiffness, k, u, z, w, f)
+        })
+    }
+
+    fn stiffness_form(&self, x: &[f64]) -> f64 {
+        self.disc.stiffness.quad(x)
+    }
+
+    fn stiffness_form_of_difference(&self, u: &[f64], w: &[f64]) -> f64 {
+        potential_of_difference(&self.disc.stiffness, u, w)
+    }
+
+    fn mass_form(&self, x: &[f64]) -> f64 {
+        self.disc.mass.quad(x)
+    }
+
+    fn mass_mul(&self, x: &[f64], y: &mut [f64]) {
+        self.disc.mass.mul_into(x, y);
+    }
+
+    fn stiffness_mul(&self, x: &[f64], y: &mut [f64]) {
+        self.disc.stiffness.mul_into(x, y);
+    }
+
+    fn step_matrix_mul(&self, x: &[f64], y: &mut [f64]) {
+        self.disc.step_matrix.mul_into(x, y);
+    }
+
+    /// On the unknowns that carry mass (a contiguous block: the massless ones are end nodes,
+    /// [`Discretisation::massless`]).
+    fn solve_mass(&self, acc: &mut [f64]) -> Result<(), RunError> {
+        let n = acc.len();
+        let disc = &self.disc;
+        let lo = usize::from(disc.massless.contains(&0));
+        let hi = n - usize::from(n > 0 && disc.massless.contains(&(n - 1)));
+        for &j in &disc.massless {
+            acc[j] = 0.0;
+        }
+        if lo >= hi {
+            return Ok(());
+        }
+        let solved: Result<(), NotPositiveDefinite> = if lo == 0 && hi == n {
+            Ldlt::factor(&disc.mass).map(|f| f.solve_in_place(acc))
+        } else {
+            Ldlt::factor(&disc.mass.sub(lo, hi - 1)).map(|f| f.solve_in_place(&mut acc[lo..hi]))
+        };
+        Ok(solved?)
+    }
+
+    /// The full-mesh mass of the matrix variant (the load vector does not follow
+    /// `[bar] mass`: it is always the P1 load vector of the interpolated force).
+    fn full_mass_rows(&self) -> FullMassRows {
+        let disc = &self.disc;
+        let mass = matrices::mass(disc.variant, disc.nodes, disc.dx);
+        let (first, n) = (disc.first, disc.unknowns());
+        let mut full = if n == disc.nodes {
+            Vec::new()
+        } else {
+            vec![0.0; disc.nodes]
+        };
+        Box::new(move |x, out| {
+            if full.is_empty() {
+                mass.mul_into(x, out);
+            } else {
+                mass.mul_into(x, &mut full);
+                out.copy_from_slice(&full[first..first + n]);
+            }
+        })
+    }
+
+    fn nodes(&self) -> usize {
+        self.disc.nodes
+    }
+
+    fn elements(&self) -> usize {
+        self.disc.nodes - 1
+    }
+
+    fn lattice(&self) -> [usize; 2] {
+        [self.disc.nodes, 1]
+    }
+
+    fn components(&self) -> usize {
+        1
+    }
+
+    fn point(&self, node: usize) -> (f64, Option<f64>) {
+        (self.disc.x(node), None)
+    }
+
+    fn unknown_of(&self, node: usize) -> Option<usize> {
+        node.checked_sub(self.disc.first)
+            .filter(|&i| i < self.disc.unknowns())
+    }
+}
+
+/// Builds the step solver a scene asks for, for `disc`'s step matrix and constrained nodes.
+pub fn make_solver(scene: &Scene, disc: &Discretisation) -> Result<Box<dyn StepSolver>, RunError> {
+    let nodes = disc.constrained_locals();
+    match scene.solver.method {
+        SolverMethod::Exact if disc.ends_only() => {
+            Ok(Box::new(ExactSolver::new(&disc.step_matrix, &nodes)?))
+        }
+        SolverMethod::Exact => Ok(Box::new(BlockPivotSolver::new(&disc.step_matrix, &nodes)?)),
+        SolverMethod::Osqp => Ok(Box::new(OsqpSolver::new(
+            &disc.step_matrix,
+            &nodes,
+            scene.solver.osqp_settings(),
+        )?)),
+        SolverMethod::Penalty => Ok(Box::new(PenaltySolver::new(
+            &disc.step_matrix,
+            &nodes,
+            scene.solver.penalty_settings(),
+        )?)),
+    }
+}
+
+/// The bar's constraints: one per Signorini end, or one per node under an obstacle (the
+/// ends' gaps the smaller of theirs and the obstacle's), lower bounds `u >= −g`.
+fn contact_set(disc: &Discretisation) -> ContactSet {
+    let k = disc.constraints.len();
+    let gaps = disc.constraints.iter().map(|c| c.gap).collect();
+    let mut groups: Vec<Group> = (disc.constraints.iter().enumerate())
+        .filter_map(|(j, c)| {
+            c.side.map(|side| Group {
+                name: side.name(),
+                range: j..j + 1,
+            })
+        })
+        .collect();
+    if disc.ends_only() {
+        let locals = disc.constrained_locals();
+        let positions = disc.constraints.iter().map(|c| disc.x(c.node)).collect();
+        ContactSet::new(gaps, locals, Vec::new(), Positions::List(positions), groups)
+    } else {
+        // Every unknown, in order: constraint k bounds unknown k.
+        groups.push(Group {
+            name: "obstacle",
+            range: 0..k,
+        });
+        let positions = Positions::Grid {
+            first: disc.first,
+            spacing: disc.dx,
+        };
+        ContactSet::new(gaps, Vec::new(), Vec::new(), positions, groups)
+    }
+}
+
+/// The scheme set up for `scene` on `disc` with `solver` (built for `disc.step_matrix` and
+/// `disc.constrained_locals()`): initial data evaluated and checked admissible, the load.
+fn setup(
+    scene: &Scene,
+    disc: Discretisation,
+    solver: Box<dyn StepSolver>,
+) -> Result<Setup<BarBody>, RunError> {
+    scene.validate()?;
+    let (nodes, n, dt, alpha) = (disc.nodes, disc.unknowns(), disc.dt, disc.alpha);
+    let initial = InitialData {
+        displacement: Expression::parse(
+            "initial.displacement",
+            &scene.initial.displacement,
+            false,
+        )?,
+        velocity: Expression::parse("initial.velocity", &scene.initial.velocity, false)?,
+        clamped: [&scene.left, &scene.right].map(|end| end.condition == Condition::Clamped),
+    };
+    let mut u0_full = vec![0.0; nodes];
+    let mut v0_full = vec![0.0; nodes];
+    initial.eval_into(&disc, &mut u0_full, &mut v0_full)?;
+    for c in &disc.constraints {
+        if u0_full[c.node] < -c.gap {
+            return Err(SceneError::Inadmissible {
+                field: "initial.displacement".into(),
+                gap_field: c
+                    .side
+                    .map_or("obstacle.gap".to_string(), |s| format!("{}.gap", s.name())),
+                node: c.node,
+                x: disc.x(c.node),
+                value: u0_full[c.node],
+                gap: c.gap,
+            }
+            .into());
+        }
+    }
+    // u^0 and u_1 on the unknowns, in the storage of the full-mesh vectors.
+    let range = disc.first..disc.first + n;
+    let restrict = |mut v: Vec<f64>| {
+        v.truncate(range.end);
+        v.drain(..range.start);
+        v
+    };
+    let (displacement, velocity) = (restrict(u0_full), restrict(v0_full));
+    let contact = contact_set(&disc);
+    let body = BarBody {
+        uniform: disc.mass.uniform().zip(disc.stiffness.uniform()),
+        inv_dt2: 1.0 / (dt * dt),
+        c_w: 0.5 - alpha / (2.0 * dt),
+        initial,
+        disc,
+    };
+    let load = match &scene.load.density {
+        None => Load::none(),
+        Some(text) => Load::new(
+            vec![Some(Expression::parse("load.density", text, true)?)],
+            &body,
+        )?,
+    };
+    Ok(Setup {
+        body,
+        solver,
+        contact,
+        load,
+        displacement,
+        velocity,
+        steps: scene.steps(),
+        diagnostics_every: scene.output.diagnostics_every as usize,
+    })
+}
+
+impl Scheme<BarBody> {
+    /// Sets up a run of `scene` with the solver it names and takes the start-up step.
+    pub fn new(scene: &Scene) -> Result<Self, RunError> {
+        Self::prepare(scene)?.start()
+    }
+
+    /// Sets `scene` up as [`Simulation::new`] does, short of the start-up step: for a run
+    /// that writes `u^0` and `u_1` first and starts afterwards (without a copy of `u^0`).
+    pub fn prepare(scene: &Scene) -> Result<Unstarted<BarBody>, RunError> {
+        let disc = Discretisation::new(scene)?;
+        let solver = make_solver(scene, &disc)?;
+        Ok(Scheme::unstarted(setup(scene, disc, solver)?))
+    }
+
+    /// Sets up a run with a given step solver (built for `disc.step_matrix` and
+    /// `disc.constrained_locals()`), and takes the start-up step.
+    pub fn with_solver(
+        scene: &Scene,
+        disc: Discretisation,
+        solver: Box<dyn StepSolver>,
+    ) -> Result<Self, RunError> {
+        Scheme::from_setup(setup(scene, disc, solver)?)
+    }
+
+    pub fn discretisation(&self) -> &Discretisation {
+        &self.body().disc
+    }
+
+    /// `u^n` on all `J + 2` nodes (clamped nodes are 0).
+    pub fn displacement_into(&self, out: &mut [f64]) {
+        let first = self.body().disc.first;
+        out.fill(0.0);
+        let u = self.displacement();
+        out[first..first + u.len()].copy_from_slice(u);
+    }
+
+    /// `(u^n − u^{n−1})/Δt` on all nodes: the velocity at `t_{n−1/2}`.
+    pub fn velocity_into(&self, out: &mut [f64]) {
+        let first = self.body().disc.first;
+        out.fill(0.0);
+        let s = self.state();
+        for (o, w) in out[first..].iter_mut().zip(s.w) {
+            *o = w * s.scale;
+        }
+    }
+
+    /// `u^n` on all nodes.
+    pub fn displacement_full(&self) -> Vec<f64> {
+        let mut out = vec![0.0; self.body().disc.nodes];
+        self.displacement_into(&mut out);
+        out
+    }
+
+    /// Initial displacement and velocity at all nodes (evaluated again: not kept in memory).
+    pub fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
+        let nodes = self.body().disc.nodes;
+        let (mut u, mut v) = (vec![0.0; nodes], vec![0.0; nodes]);
+        self.body().initial_state_into(&mut u, &mut v);
+        (u, v)
+    }
+}

@@ -1,0 +1,69 @@
+//! `history.csv`: one row per step, the same columns for both bodies. The energy identity's
+//! terms (empty on steps whose identity was not measured), then per group of constraints its
+//! contact state (a single constraint: `gap_G,reaction_G`; a set: the constraints in contact,
+//! the extent `s` of the contact, the least gap and the total reaction), then the iterations.
+
+use crate::output::text::{push_time, push_value};
+use crate::scheme::StepRecord;
+use crate::scheme::contact::Group;
+use std::io::Write;
+
+/// The columns of every run.
+const ENERGY_COLUMNS: &str =
+    "step,t,energy,work,viscous_dissipation,contact_dissipation,identity_residual";
+
+/// The header line for a run with the contact `groups`.
+pub fn header(groups: &[Group]) -> String {
+    let mut h = String::from(ENERGY_COLUMNS);
+    for g in groups {
+        let n = g.name;
+        if g.range.len() == 1 {
+            h.push_str(&format!(",gap_{n},reaction_{n}"));
+        } else {
+            h.push_str(&format!(
+                ",contact_nodes_{n},contact_s_min_{n},contact_s_max_{n},min_gap_{n},reaction_{n}"
+            ));
+        }
+    }
+    h.push_str(",iterations\n");
+    h
+}
+
+/// Appends the row of `r` (`row` is cleared first); `groups` as in the header.
+pub fn row(r: &StepRecord, groups: &[Group], row: &mut Vec<u8>) {
+    row.clear();
+    write!(row, "{},", r.step).expect("writing to a vector");
+    push_time(r.time, row);
+    for v in [
+        r.energy,
+        r.work,
+        r.viscous_dissipation,
+        r.contact_dissipation,
+        r.identity_residual,
+    ] {
+        row.push(b',');
+        // Not measured ([output] diagnostics_every): empty cells, not zeros.
+        if r.measured {
+            push_value(v, row);
+        }
+    }
+    for (g, s) in groups.iter().zip(&r.contact.groups) {
+        row.push(b',');
+        if g.range.len() == 1 {
+            push_value(s.min_gap, row);
+        } else {
+            write!(row, "{},", s.contact_nodes).expect("writing to a vector");
+            for x in s.extent {
+                // No contact: empty cells.
+                if !x.is_nan() {
+                    push_time(x, row);
+                }
+                row.push(b',');
+            }
+            push_value(s.min_gap, row);
+        }
+        row.push(b',');
+        push_value(s.reaction, row);
+    }
+    writeln!(row, ",{}", r.iterations).expect("writing to a vector");
+}

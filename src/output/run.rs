@@ -1,0 +1,239 @@
+//! Running a scene of either body end to end: the step loop and the output files
+//! (`summary.json`, `history.csv`, the profile file), written whole or not at all through the
+//! same code for both bodies.
+
+use crate::bar::Simulation;
+use crate::output::files::write_whole;
+use crate::output::history;
+use crate::output::profiles::Profiles;
+use crate::output::summary::{Summary, Tracker};
+use crate::plane::PlaneSimulation;
+use crate::scene::plane::PlaneScene;
+use crate::scene::{OutputFormat, OutputSampling, OutputSpec, Scene};
+use crate::scheme::{Body, RunError, Scheme, StepRecord, Unstarted};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Steps `sim` to step `steps`, keeping every record (the start-up step first); returns them
+/// with the summary and the finished simulation.
+pub fn run_scheme_in_memory<B: Body>(
+    name: &str,
+    mut sim: Scheme<B>,
+    steps: usize,
+) -> Result<(Vec<StepRecord>, Summary, Scheme<B>), RunError> {
+    let start = Instant::now();
+    let mut tracker = Tracker::new(&sim, !sim.is_forced());
+    let mut records = vec![sim.first_record()];
+    for _ in 1..steps {
+        let r = sim.step()?;
+        tracker.observe(&r);
+        records.push(r);
+    }
+    let summary = tracker.finish(name, &sim, start.elapsed().as_secs_f64());
+    Ok((records, summary, sim))
+}
+
+/// Runs a bar scene in memory (for tests and studies; [`run_to_dir`] streams instead).
+pub fn run_in_memory(
+    name: &str,
+    scene: &Scene,
+) -> Result<(Vec<StepRecord>, Summary, Simulation), RunError> {
+    run_scheme_in_memory(name, Simulation::new(scene)?, scene.steps())
+}
+
+/// Runs a plane scene in memory.
+pub fn run_plane_in_memory(
+    name: &str,
+    scene: &PlaneScene,
+) -> Result<(Vec<StepRecord>, Summary, PlaneSimulation), RunError> {
+    run_scheme_in_memory(name, PlaneSimulation::new(scene)?, scene.steps())
+}
+
+/// Runs a bar scene and writes `summary.json`, `history.csv` and the profiles
+/// (`displacement.csv`, or `displacement.npy` with `[output] format = "npy"`) into `out`. The
+/// scene is set up (discretised, its initial data evaluated) before anything is created, so
+/// a refused scene leaves no trace on disk; the files are moved into place only when the run
+/// has succeeded, so a failed run leaves earlier results untouched. A successful run removes
+/// the other format's profile file left by an earlier run in `out`. `progress` shows a
+/// progress bar on stderr for long runs (with the `progress` feature).
+pub fn run_to_dir(
+    name: &str,
+    scene: &Scene,
+    out: &Path,
+    progress: bool,
+) -> Result<Summary, RunError> {
+    let start = Instant::now();
+    // Again here: a scene's fields are public, so this one may not have been validated.
+    scene.output.format.check_available()?;
+    let prepared = Simulation::prepare(scene)?;
+    let run = Run {
+        name,
+        steps: scene.steps(),
+        output: &scene.output,
+        sampling: scene.output_sampling(),
+        progress,
+    };
+    run.write(prepared, start, out)
+}
+
+/// Runs a plane scene and writes its files into `out`, as [`run_to_dir`] does for the bar.
+pub fn run_plane_to_dir(
+    name: &str,
+    scene: &PlaneScene,
+    out: &Path,
+    progress: bool,
+) -> Result<Summary, RunError> {
+    let start = Instant::now();
+    scene.output.format.check_available()?;
+    let prepared = PlaneSimulation::prepare(scene)?;
+    let run = Run {
+        name,
+        steps: scene.steps(),
+        output: &scene.output,
+        sampling: scene.output_sampling(),
+        progress,
+    };
+    run.write(prepared, start, out)
+}
+
+/// A run to write: its name, length and output settings.
+struct Run<'a> {
+    name: &'a str,
+    steps: usize,
+    output: &'a OutputSpec,
+    sampling: OutputSampling,
+    progress: bool,
+}
+
+impl Run<'_> {
+    fn write<B: Body>(
+        &self,
+        prepared: Unstarted<B>,
+        start: Instant,
+        out: &Path,
+    ) -> Result<Summary, RunError> {
+        let format = self.sampling.format;
+        let files = ["history.csv", format.file(), "summary.json"];
+        let io = |path: PathBuf, source| RunError::Write { path, source };
+        let summary = write_whole(out, &files, io, |tmp| {
+            self.write_files(prepared, start, tmp)
+        })?;
+        for other in [OutputFormat::Csv, OutputFormat::Npy] {
+            if other != format {
+                let _ = std::fs::remove_file(out.join(other.file()));
+            }
+        }
+        Ok(summary)
+    }
+
+    fn write_files<B: Body>(
+        &self,
+        prepared: Unstarted<B>,
+        start: Instant,
+        dir: &Path,
+    ) -> Result<Summary, RunError> {
+        let io = |path: &PathBuf| {
+            let path = path.clone();
+            move |source| RunError::Write { path, source }
+        };
+        let create = |path: &PathBuf| std::fs::File::create(path).map_err(io(path));
+        let hist_path = dir.join("history.csv");
+        let mut hist = std::io::BufWriter::with_capacity(1 << 16, create(&hist_path)?);
+        let groups = prepared.contact().groups().to_vec();
+        hist.write_all(history::header(&groups).as_bytes())
+            .map_err(io(&hist_path))?;
+        // `t = 0` is written before the start-up step moves `u^0` on.
+        let disp_path = dir.join(self.sampling.file);
+        let mut disp = Profiles::new(create(&disp_path)?, prepared.body(), &self.sampling)
+            .map_err(io(&disp_path))?;
+        disp.write(0.0, prepared.state()).map_err(io(&disp_path))?;
+        let mut sim = prepared.start()?;
+        let mut tracker = Tracker::new(&sim, !sim.is_forced());
+        let mut row = Vec::new();
+        let mut write_row = |r: &StepRecord, row: &mut Vec<u8>| {
+            history::row(r, &groups, row);
+            hist.write_all(row)
+        };
+        write_row(&sim.first_record(), &mut row).map_err(io(&hist_path))?;
+        let (steps, every) = (self.steps, self.output.every as usize);
+        let keep = |n: usize| n.is_multiple_of(every) || n == steps;
+        let bar = Progress::new(self.progress, steps, sim.body().unknowns());
+        if keep(1) {
+            disp.write(sim.time(), sim.state())
+                .map_err(io(&disp_path))?;
+        }
+        for _ in 1..steps {
+            let r = sim.step()?;
+            tracker.observe(&r);
+            write_row(&r, &mut row).map_err(io(&hist_path))?;
+            if keep(r.step) {
+                disp.write(sim.time(), sim.state())
+                    .map_err(io(&disp_path))?;
+            }
+            bar.step(r.step);
+        }
+        bar.finish();
+        drop(write_row);
+        hist.flush().map_err(io(&hist_path))?;
+        disp.finish().map_err(io(&disp_path))?;
+        let mut summary = tracker.finish(self.name, &sim, start.elapsed().as_secs_f64());
+        summary.output = Some(self.sampling);
+        let json_path = dir.join("summary.json");
+        let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
+        std::fs::write(&json_path, json + "\n").map_err(io(&json_path))?;
+        Ok(summary)
+    }
+}
+
+/// Runs below this many unknown-steps finish in seconds: no progress bar.
+#[cfg(feature = "progress")]
+const PROGRESS_MIN_UNKNOWN_STEPS: f64 = 2e8;
+/// The progress bar is moved every this many steps (cheap next to a step of a large run).
+#[cfg(feature = "progress")]
+const PROGRESS_EVERY_STEPS: usize = 1024;
+
+/// A progress bar on stderr for long runs; nothing without the `progress` feature.
+struct Progress {
+    #[cfg(feature = "progress")]
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl Progress {
+    #[cfg_attr(not(feature = "progress"), expect(unused_variables))]
+    fn new(show: bool, steps: usize, unknowns: usize) -> Self {
+        #[cfg(feature = "progress")]
+        let bar =
+            (show && steps as f64 * unknowns as f64 > PROGRESS_MIN_UNKNOWN_STEPS).then(|| {
+                let bar = indicatif::ProgressBar::new(steps as u64);
+                bar.set_style(
+                    indicatif::ProgressStyle::with_template(
+                        "{bar:40} {pos}/{len} steps, eta {eta}",
+                    )
+                    .expect("static template"),
+                );
+                bar
+            });
+        Self {
+            #[cfg(feature = "progress")]
+            bar,
+        }
+    }
+
+    #[cfg_attr(not(feature = "progress"), expect(unused_variables))]
+    fn step(&self, step: usize) {
+        #[cfg(feature = "progress")]
+        if let Some(b) = &self.bar
+            && step.is_multiple_of(PROGRESS_EVERY_STEPS)
+        {
+            b.set_position(step as u64);
+        }
+    }
+
+    fn finish(self) {
+        #[cfg(feature = "progress")]
+        if let Some(b) = self.bar {
+            b.finish_and_clear();
+        }
+    }
+}

@@ -1,0 +1,374 @@
+//! The plane body as a [`Body`] of the scheme: its Q1 mass `M` and stiffness `K` on one sparse
+//! pattern as kernels (the right-hand side and the energy sums in one pass over the pattern,
+//! the `K`-forms cell by cell, [`crate::plane::energy`]), its Signorini edges as a
+//! [`ContactSet`] and its step solvers (condensation with an exact LCP, its penalty law, OSQP),
+//! each holding the sparse Cholesky factor of `C` made once per run. A run of a plane scene is
+//! a [`PlaneSimulation`], the scheme stepping this body.
+
+use crate::linalg::cholesky::SparseCholesky;
+use crate::linalg::sparse::Pattern;
+use crate::linalg::system::SparseSystem;
+use crate::plane::energy::{StrainForms, measure};
+use crate::plane::matrices::{Material, assemble};
+use crate::plane::mesh::Grid;
+use crate::plane::normals::{Normal, normals};
+use crate::scene::expr::Expression;
+use crate::scene::plane::{EDGE_NAMES, PlaneScene};
+use crate::scene::schema::SolverMethod;
+use crate::scheme::body::{Body, EnergySums, FullMassRows};
+use crate::scheme::contact::{ContactSet, Group, Positions};
+use crate::scheme::{Load, RunError, Scheme, Setup, Unstarted};
+use crate::step::{CondensedSolver, OsqpSolver, StepSolver};
+
+/// A run of a plane scene: the scheme stepping the plane body.
+pub type PlaneSimulation = Scheme<PlaneBody>;
+
+/// The discretised plane body: grid, unknowns, and `M`, `K` on the unknowns (one pattern).
+pub struct PlaneDiscretisation {
+    pub grid: Grid,
+    pub material: Material,
+    /// `α`.
+    pub alpha: f64,
+    /// `Δt`.
+    pub dt: f64,
+    /// The full degree of freedom of each unknown.
+    pub free: Vec<usize>,
+    /// The unknown of each full degree of freedom (`None` when clamped).
+    pub index: Vec<Option<usize>>,
+    pub pattern: Pattern,
+    pub mass: Vec<f64>,
+    pub stiffness: Vec<f64>,
+    /// The `K`-forms of the energy, cell by cell.
+    pub forms: StrainForms,
+}
+
+impl PlaneDiscretisation {
+    /// The grid, the matrices and the unknowns of `scene` (validated).
+    pub fn new(scene: &PlaneScene) -> Self {
+        let grid = Grid::new(
+            scene.plane.width,
+            scene.plane.height,
+            scene.mesh.nx as usize,
+            scene.mesh.ny as usize,
+            scene.mesh.y_grading,
+        );
+        let material = Material {
+            lambda: scene.plane.lambda,
+            mu: scene.plane.mu,
+            density: scene.plane.density,
+        };
+        let full = assemble(&grid, material);
+        let [left, right, bottom, top] = scene.edges.clamped();
+        let mut index = vec![None; grid.dofs()];
+        let mut free = Vec::new();
+        for node in 0..grid.nodes() {
+            let (i, j) = grid.position(node);
+            let clamped = (left && i == 0)
+                || (right && i == grid.nx)
+                || (bottom && j == 0)
+                || (top && j == grid.ny);
+            if !clamped {
+                for c in 0..2 {
+                    index[2 * node + c] = Some(free.len());
+                    free.push(2 * node + c);
+                }
+            }
+        }
+        let (pattern, from) = full.pattern.restrict(&index);
+        let mass = from.iter().map(|&k| full.mass[k]).collect();
+        let stiffness = from.iter().map(|&k| full.stiffness[k]).collect();
+        let forms = StrainForms::new(&grid, material, &index);
+        Self {
+            forms,
+            grid,
+            material,
+            alpha: scene.plane.viscosity,
+            dt: scene.time.step,
+            free,
+            index,
+            pattern,
+            mass,
+            stiffness,
+        }
+    }
+
+    /// Unknowns.
+    pub fn unknowns(&self) -> usize {
+        self.free.len()
+    }
+
+    /// `C = M/Δt² + (½ + α/(2Δt)) K` on the pattern.
+    pub fn step_matrix(&self) -> Vec<f64> {
+        let (a, b) = (
+            1.0 / (self.dt * self.dt),
+            0.5 + self.alpha / (2.0 * self.dt),
+        );
+        self.mass
+            .iter()
+            .zip(&self.stiffness)
+            .map(|(m, k)| a * m + b * k)
+            .collect()
+    }
+}
+
+/// The plane body on its unknowns.
+pub struct PlaneBody {
+    disc: PlaneDiscretisation,
+    /// The contact normals of the Signorini edges, one per constraint of the contact set.
+    normals: Vec<Normal>,
+    /// `C` on the pattern.
+    c: Vec<f64>,
+    /// `1/Δt²` and `½ − α/(2Δt)`.
+    inv_dt2: f64,
+    c_w: f64,
+}
+
+impl PlaneBody {
+    pub fn discretisation(&self) -> &PlaneDiscretisation {
+        &self.disc
+    }
+
+    /// The contact normals, in the order of the contact set's constraints.
+    pub fn normals(&self) -> &[Normal] {
+        &self.normals
+    }
+
+    /// `x · scale` on the unknowns at every full degree of freedom (`2 node + c`; clamped
+    /// ones 0).
+    pub fn scatter_into(&self, x: &[f64], scale: f64, out: &mut [f64]) {
+        out.fill(0.0);
+        for (&d, v) in self.disc.free.iter().zip(x) {
+            out[d] = v * scale;
+        }
+    }
+}
+
+impl Body for PlaneBody {
+    const NAME: &'static str = "plane";
+
+    fn unknowns(&self) -> usize {
+        self.disc.unknowns()
+    }
+
+    fn dt(&self) -> f64 {
+        self.disc.dt
+    }
+
+    fn viscosity(&self) -> f64 {
+        self.disc.alpha
+    }
+
+    /// One pass over the shared pattern of `M` and `K`.
+    fn rhs_into(&self, u: &[f64], w: &[f64], force: Option<&[f64]>, b: &mut [f64]) {
+        let (p, mass, stiffness) = (&self.disc.pattern, &self.disc.mass, &self.disc.stiffness);
+        for (r, br) in b.iter_mut().enumerate() {
+            let (mut mw, mut ky) = (0.0, 0.0);
+            for k in p.row_ptr[r]..p.row_ptr[r + 1] {
+                let c = p.cols[k];
+                mw += mass[k] * w[c];
+                ky += stiffness[k] * (self.c_w * w[c] - u[c]);
+            }
+            *br = force.map_or(0.0, |f| f[r]) + mw * self.inv_dt2 + ky;
+        }
+    }
+
+    fn energy_sums(&self, u: &[f64], z: &[f64], w: &[f64], force: Option<&[f64]>) -> EnergySums {
+        let d = &self.disc;
+        measure(&d.pattern, &d.mass, &d.forms, u, z, w, force)
+    }
+
+    fn stiffness_form(&self, x: &[f64]) -> f64 {
+        self.disc.forms.quad(x)
+    }
+
+    fn stiffness_form_of_difference(&self, u: &[f64], w: &[f64]) -> f64 {
+        self.disc.forms.quad_pair(|k| u[k] - w[k], |_| 0.0).0
+    }
+
+    fn mass_form(&self, x: &[f64]) -> f64 {
+        self.disc.pattern.quad(&self.disc.mass, x)
+    }
+
+    fn mass_mul(&self, x: &[f64], y: &mut [f64]) {
+        self.disc.pattern.mul_into(&self.disc.mass, x, y);
+    }
+
+    fn stiffness_mul(&self, x: &[f64], y: &mut [f64]) {
+        self.disc.pattern.mul_into(&self.disc.stiffness, x, y);
+    }
+
+    fn step_matrix_mul(&self, x: &[f64], y: &mut [f64]) {
+        self.disc.pattern.mul_into(&self.c, x, y);
+    }
+
+    fn solve_mass(&self, a: &mut [f64]) -> Result<(), RunError> {
+        SparseCholesky::new(&self.disc.pattern, &self.disc.mass, "M")?.solve_in_place(a);
+        Ok(())
+    }
+
+    fn full_mass_rows(&self) -> FullMassRows {
+        let full = assemble(&self.disc.grid, self.disc.material);
+        let free = self.disc.free.clone();
+        Box::new(move |x, out| {
+            let p = &full.pattern;
+            for (o, &row) in out.iter_mut().zip(&free) {
+                let mut s = 0.0;
+                for k in p.row_ptr[row]..p.row_ptr[row + 1] {
+                    s += full.mass[k] * x[p.cols[k]];
+                }
+                *o = s;
+            }
+        })
+    }
+
+    fn nodes(&self) -> usize {
+        self.disc.grid.nodes()
+    }
+
+    fn elements(&self) -> usize {
+        self.disc.grid.cells()
+    }
+
+    fn lattice(&self) -> [usize; 2] {
+        [self.disc.grid.nx + 1, self.disc.grid.ny + 1]
+    }
+
+    fn components(&self) -> usize {
+        2
+    }
+
+    fn point(&self, node: usize) -> (f64, Option<f64>) {
+        let (x, y) = self.disc.grid.point(node);
+        (x, Some(y))
+    }
+
+    fn unknown_of(&self, dof: usize) -> Option<usize> {
+        self.disc.index[dof]
+    }
+}
+
+/// The contact set of the Signorini edges' normals: `u·n <= g` at each, `n = σ e_c`, is the
+/// gap `−σ u_c + g >= 0`, pushed along `−n`; one group per edge.
+fn contact_set(normals: &[Normal]) -> ContactSet {
+    let mut groups: Vec<Group> = Vec::new();
+    for (k, nk) in normals.iter().enumerate() {
+        match groups.last_mut() {
+            Some(g) if g.name == EDGE_NAMES[nk.edge] => g.range.end = k + 1,
+            _ => groups.push(Group {
+                name: EDGE_NAMES[nk.edge],
+                range: k..k + 1,
+            }),
+        }
+    }
+    ContactSet::new(
+        normals.iter().map(|nk| nk.gap).collect(),
+        normals.iter().map(|nk| nk.unknown).collect(),
+        normals.iter().map(|nk| -nk.sign).collect(),
+        Positions::List(normals.iter().map(|nk| nk.s).collect()),
+        groups,
+    )
+}
+
+/// The scheme set up for a plane scene: matrices, initial data (checked admissible), the
+/// contact set, the load and the step solver its `[solver]` table names.
+fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
+    scene.validate()?;
+    let exprs = scene.expressions()?;
+    let gaps = scene.edges.gaps()?;
+    let disc = PlaneDiscretisation::new(scene);
+    let grid = &disc.grid;
+    let nodal = |e: &[Expression; 2], out: &mut [f64]| -> Result<(), RunError> {
+        for node in 0..grid.nodes() {
+            let (x, y) = grid.point(node);
+            for c in 0..2 {
+                out[2 * node + c] = e[c].eval_xy(x, y, 0.0)?;
+            }
+        }
+        Ok(())
+    };
+    let mut u0_full = vec![0.0; grid.dofs()];
+    let mut v0_full = vec![0.0; grid.dofs()];
+    nodal(&exprs.displacement, &mut u0_full)?;
+    nodal(&exprs.velocity, &mut v0_full)?;
+    for (d, i) in disc.index.iter().enumerate() {
+        if i.is_none() {
+            (u0_full[d], v0_full[d]) = (0.0, 0.0);
+        }
+    }
+    let normals = normals(&disc.grid, &disc.index, &gaps, &u0_full)?;
+    let contact = contact_set(&normals);
+    let restrict = |v: &[f64]| disc.free.iter().map(|&d| v[d]).collect::<Vec<f64>>();
+    let (displacement, velocity) = (restrict(&u0_full), restrict(&v0_full));
+    let c = disc.step_matrix();
+    let system = || SparseSystem::new(&disc.pattern, &c, "C");
+    let constraints = contact.constraints();
+    let solver: Box<dyn StepSolver> = match scene.solver.method {
+        SolverMethod::Exact => Box::new(CondensedSolver::new(system()?, constraints, 0.0)?),
+        SolverMethod::Penalty => {
+            let epsilon = scene.solver.penalty_settings().epsilon;
+            Box::new(CondensedSolver::new(system()?, constraints, epsilon)?)
+        }
+        SolverMethod::Osqp => Box::new(OsqpSolver::with_system(
+            system()?,
+            constraints,
+            scene.solver.osqp_settings(),
+        )?),
+    };
+    let (dt, alpha) = (disc.dt, disc.alpha);
+    let body = PlaneBody {
+        normals,
+        c,
+        inv_dt2: 1.0 / (dt * dt),
+        c_w: 0.5 - alpha / (2.0 * dt),
+        disc,
+    };
+    let load = match exprs.load {
+        None => Load::none(),
+        Some([x, y]) => Load::new(vec![Some(x), Some(y)], &body)?,
+    };
+    Ok(Setup {
+        body,
+        solver,
+        contact,
+        load,
+        displacement,
+        velocity,
+        steps: scene.steps(),
+        diagnostics_every: scene.output.diagnostics_every as usize,
+    })
+}
+
+impl Scheme<PlaneBody> {
+    /// Sets up a run of `scene` with the step solver its `[solver]` table names and takes
+    /// the start-up step.
+    pub fn new(scene: &PlaneScene) -> Result<Self, RunError> {
+        Scheme::from_setup(setup(scene)?)
+    }
+
+    /// [`PlaneSimulation::new`] short of the start-up step.
+    pub fn prepare(scene: &PlaneScene) -> Result<Unstarted<PlaneBody>, RunError> {
+        Ok(Scheme::unstarted(setup(scene)?))
+    }
+
+    pub fn discretisation(&self) -> &PlaneDiscretisation {
+        &self.body().disc
+    }
+
+    /// `u^n` at every full degree of freedom (`2 node + c`; clamped ones 0).
+    pub fn displacement_into(&self, out: &mut [f64]) {
+        self.body().scatter_into(self.displacement(), 1.0, out);
+    }
+
+    /// `(u^n − u^{n−1})/Δt` at every full degree of freedom: the velocity at `t_{n−1/2}`.
+    pub fn velocity_into(&self, out: &mut [f64]) {
+        let s = self.state();
+        self.body().scatter_into(s.w, s.scale, out);
+    }
+
+    /// `u^n` at every full degree of freedom.
+    pub fn displacement_full(&self) -> Vec<f64> {
+        let mut out = vec![0.0; self.body().disc.grid.dofs()];
+        self.displacement_into(&mut out);
+        out
+    }
+}

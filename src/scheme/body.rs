@@ -1,0 +1,71 @@
+//! What a body supplies to the scheme: its matrices as kernels on the unknowns. The scheme
+//! never sees a matrix; the bar implements [`Body`] with tridiagonal kernels
+//! (`crate::bar::body`), the plane body with sparse ones (`crate::plane::body`).
+
+use crate::scheme::error::RunError;
+
+/// The sums of one step's energy identity, after `u += z` (`u = u^{n+1}`, `z = u^{n+1} − u^n`,
+/// `w = u^n − u^{n−1}`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EnergySums {
+    /// `zᵀ M z`.
+    pub kinetic: f64,
+    /// `|u^{n+1}|²_K`.
+    pub potential: f64,
+    /// `|z + w|²_K = |u^{n+1} − u^{n−1}|²_K`.
+    pub viscous: f64,
+    /// `F^n·(z + w)`.
+    pub work: f64,
+}
+
+/// `x ↦ (M x)` restricted to the unknowns, for `x` given at every degree of freedom of the
+/// mesh (clamped ones included): the load vector of a nodal interpolant. Kept by a load that
+/// is evaluated every step; may use scratch space of its own.
+pub type FullMassRows = Box<dyn FnMut(&[f64], &mut [f64]) + Send>;
+
+/// A discretised body: mass `M`, stiffness `K` (the talk's `R`) and the step matrix
+/// `C = M/Δt² + (½ + α/(2Δt)) K` on its unknowns, as kernels. None allocates but the set-up
+/// ones ([`Body::solve_mass`], [`Body::full_mass_rows`]).
+pub trait Body {
+    /// `bar` or `plane`, as outputs name the body.
+    const NAME: &'static str;
+    /// The number of unknowns `n` (degrees of freedom not clamped).
+    fn unknowns(&self) -> usize;
+    /// `Δt`.
+    fn dt(&self) -> f64;
+    /// The viscosity `α`.
+    fn viscosity(&self) -> f64;
+    /// `b = F + M w/Δt² + K((½ − α/(2Δt)) w − u)`: the scheme's right-hand side `F̃^n − C u^n`
+    /// in increment form (`force = None` without a load).
+    fn rhs_into(&self, u: &[f64], w: &[f64], force: Option<&[f64]>, b: &mut [f64]);
+    /// The sums of the energy identity of the step just taken.
+    fn energy_sums(&self, u: &[f64], z: &[f64], w: &[f64], force: Option<&[f64]>) -> EnergySums;
+    /// `|x|²_K`, in a form exact for rigid motions.
+    fn stiffness_form(&self, x: &[f64]) -> f64;
+    /// `|u − w|²_K` (the potential of `u^{n−1} = u^n − w`).
+    fn stiffness_form_of_difference(&self, u: &[f64], w: &[f64]) -> f64;
+    /// `|x|²_M`, in a form exact for rigid motions.
+    fn mass_form(&self, x: &[f64]) -> f64;
+    /// `y = M x`.
+    fn mass_mul(&self, x: &[f64], y: &mut [f64]);
+    /// `y = K x`.
+    fn stiffness_mul(&self, x: &[f64], y: &mut [f64]);
+    /// `y = C x`.
+    fn step_matrix_mul(&self, x: &[f64], y: &mut [f64]);
+    /// `a ← M⁻¹ a` on the unknowns that carry mass, `0` on the others (start-up only).
+    fn solve_mass(&self, a: &mut [f64]) -> Result<(), RunError>;
+    /// The rows of the full-mesh mass matrix at the unknowns ([`FullMassRows`]).
+    fn full_mass_rows(&self) -> FullMassRows;
+    /// The mesh nodes (clamped ones included).
+    fn nodes(&self) -> usize;
+    /// The elements (cells).
+    fn elements(&self) -> usize;
+    /// The nodes along `x` and along `y` (the bar's `[J + 2, 1]`): node `i + j · lattice[0]`.
+    fn lattice(&self) -> [usize; 2];
+    /// Degrees of freedom per node: degree of freedom `components · node + c`.
+    fn components(&self) -> usize;
+    /// `(x, y)` of a node; `y = None` on the bar's line.
+    fn point(&self, node: usize) -> (f64, Option<f64>);
+    /// The unknown of a degree of freedom (`None` when clamped).
+    fn unknown_of(&self, dof: usize) -> Option<usize>;
+}

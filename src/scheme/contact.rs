@@ -1,0 +1,315 @@
+//! The admissible set `K_h` and the contact state of a step, for every body.
+//!
+//! Constraint `k` keeps the gap `s_k u_{i_k} + g_k >= 0`: unknown `i_k`, the direction `s_k = ±1`
+//! in which the obstacle pushes, and `g_k` (the bar's `u >= −a` is `s = +1`, `g = a`; a plane
+//! edge's `u·n <= g` is `s = −σ` for the outward normal `n = σ e_c`). Its reaction `r_k >= 0`
+//! pushes along `s_k e_{i_k}`. One definition of "in contact" serves every body and output:
+//! [`in_contact`]. The constraints form named groups (an end of the bar, an edge of the plane,
+//! the bar's whole obstacle), whose contact episodes the outputs report.
+
+use crate::step::Constraints;
+use std::ops::Range;
+
+/// A constraint is in contact when its gap is at most this: the exact solvers put an active
+/// node on its obstacle up to the rounding of `u^n + z` (a few ulps of `|u|`, which the
+/// non-dimensional scheme keeps of order one).
+pub const CONTACT_GAP_TOL: f64 = 1e-12;
+
+/// Whether a constraint with gap `s u + g` is in contact.
+#[inline(always)]
+pub fn in_contact(gap: f64) -> bool {
+    gap <= CONTACT_GAP_TOL
+}
+
+/// At most this many groups: the plane's four edges (the bar has two ends and its obstacle).
+pub const MAX_GROUPS: usize = 4;
+
+/// Where the constraints sit along their end, edge or obstacle (the coordinate `s` of the
+/// contact extent).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Positions {
+    /// `s_k = (first + k) · spacing`: the bar's nodes.
+    Grid { first: usize, spacing: f64 },
+    /// `s_k` given.
+    List(Vec<f64>),
+}
+
+/// Named constraints whose contact episodes are reported together.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Group {
+    /// `left`, `right` (ends or edges), `bottom`, `top`, `obstacle`.
+    pub name: &'static str,
+    pub range: Range<usize>,
+}
+
+/// The contact state of one group at one step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GroupState {
+    /// Constraints in contact ([`in_contact`]).
+    pub contact_nodes: usize,
+    /// `s` of the first and the last constraint in contact (`NaN` when none).
+    pub extent: [f64; 2],
+    /// The least gap (the gap, for a single constraint).
+    pub min_gap: f64,
+    /// `Σ r_k`.
+    pub reaction: f64,
+    /// `−½ Σ r_k s_k (u^{n+1} − u^{n−1})_{i_k}`, its share of the contact dissipation (0 when
+    /// the step's energy balance is not measured).
+    pub dissipation: f64,
+}
+
+/// The constraints of a run: gaps, unknowns, directions, positions and groups.
+#[derive(Clone, Debug)]
+pub struct ContactSet {
+    gaps: Vec<f64>,
+    /// `i_k`; empty when `i_k = k` (an obstacle under every unknown).
+    unknowns: Vec<usize>,
+    /// `s_k`; empty when every `s_k = +1`.
+    directions: Vec<f64>,
+    positions: Positions,
+    groups: Vec<Group>,
+}
+
+/// The sums of one pass over some constraints.
+struct Pass {
+    min_gap: f64,
+    min_reaction: f64,
+    max_comp: f64,
+    total: f64,
+    dissipation: f64,
+    count: usize,
+    first: usize,
+    last: usize,
+}
+
+/// `m.min(x)` for a running minimum `m` that is never NaN: a NaN `x` is ignored and a tie
+/// keeps `m`, as `f64::min` does here.
+#[inline(always)]
+fn min_of(m: f64, x: f64) -> f64 {
+    if x < m { x } else { m }
+}
+
+/// [`min_of`] for a running maximum.
+#[inline(always)]
+fn max_of(m: f64, x: f64) -> f64 {
+    if x > m { x } else { m }
+}
+
+impl ContactSet {
+    /// Constraints with gaps `gaps`, at unknowns `unknowns` (empty: `i_k = k`) in directions
+    /// `directions` (empty: all `+1`), placed at `positions`, reported in `groups`.
+    pub fn new(
+        gaps: Vec<f64>,
+        unknowns: Vec<usize>,
+        directions: Vec<f64>,
+        positions: Positions,
+        groups: Vec<Group>,
+    ) -> Self {
+        assert!(unknowns.is_empty() || unknowns.len() == gaps.len());
+        assert!(directions.is_empty() || directions.len() == gaps.len());
+        assert!(groups.len() <= MAX_GROUPS);
+        Self {
+            gaps,
+            unknowns,
+            directions,
+            positions,
+            groups,
+        }
+    }
+
+    /// No constraint.
+    pub fn none() -> Self {
+        Self::new(
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+            Positions::List(Vec::new()),
+            Vec::new(),
+        )
+    }
+
+    /// `m`.
+    pub fn len(&self) -> usize {
+        self.gaps.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.gaps.is_empty()
+    }
+
+    /// `i_k`.
+    #[inline(always)]
+    pub fn unknown(&self, k: usize) -> usize {
+        if self.unknowns.is_empty() {
+            k
+        } else {
+            self.unknowns[k]
+        }
+    }
+
+    /// `s_k`.
+    #[inline(always)]
+    pub fn direction(&self, k: usize) -> f64 {
+        if self.directions.is_empty() {
+            1.0
+        } else {
+            self.directions[k]
+        }
+    }
+
+    /// `g_k`.
+    pub fn gaps(&self) -> &[f64] {
+        &self.gaps
+    }
+
+    /// `s` of constraint `k`.
+    pub fn position(&self, k: usize) -> f64 {
+        match &self.positions {
+            Positions::Grid { first, spacing } => (first + k) as f64 * spacing,
+            Positions::List(s) => s[k],
+        }
+    }
+
+    pub fn groups(&self) -> &[Group] {
+        &self.groups
+    }
+
+    /// The constraints as the step solvers take them (set-up).
+    pub fn constraints(&self) -> Constraints {
+        let m = self.len();
+        Constraints {
+            unknowns: (0..m).map(|k| self.unknown(k)).collect(),
+            directions: (0..m).map(|k| self.direction(k)).collect(),
+        }
+    }
+
+    /// `lo_k = −g_k − s_k u_{i_k}`: the bounds `s_k z_{i_k} >= lo_k` of the increment from `u`.
+    pub fn lower_bounds_into(&self, u: &[f64], lower: &mut [f64]) {
+        for (k, lo) in lower.iter_mut().enumerate() {
+            *lo = -self.gaps[k] - self.direction(k) * u[self.unknown(k)];
+        }
+    }
+
+    /// The gaps `s_k u_{i_k} + g_k` of the state `u`.
+    pub fn gaps_into(&self, u: &[f64], out: &mut [f64]) {
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = self.direction(k) * u[self.unknown(k)] + self.gaps[k];
+        }
+    }
+
+    /// One pass over constraints `range` of `u = u^{n+1}` with reactions `r`; with
+    /// `dissipation`, also `−½ Σ r_k s_k (z + w)_{i_k}`, `z + w = u^{n+1} − u^{n−1}`.
+    fn pass(
+        &self,
+        range: Range<usize>,
+        (u, z, w, r): (&[f64], &[f64], &[f64], &[f64]),
+        dissipation: bool,
+    ) -> Pass {
+        let mut p = Pass {
+            min_gap: f64::INFINITY,
+            min_reaction: f64::INFINITY,
+            max_comp: 0.0,
+            total: 0.0,
+            dissipation: 0.0,
+            count: 0,
+            first: 0,
+            last: 0,
+        };
+        for k in range {
+            let (l, s) = (self.unknown(k), self.direction(k));
+            let gap = s * u[l] + self.gaps[k];
+            let reaction = r[k];
+            p.total += reaction;
+            p.min_gap = min_of(p.min_gap, gap);
+            p.min_reaction = min_of(p.min_reaction, reaction);
+            p.max_comp = max_of(p.max_comp, (gap * reaction).abs());
+            if in_contact(gap) {
+                if p.count == 0 {
+                    p.first = k;
+                }
+                p.last = k;
+                p.count += 1;
+            }
+            if dissipation {
+                p.dissipation += -0.5 * reaction * s * (z[l] + w[l]);
+            }
+        }
+        p
+    }
+
+    /// The group state of a pass.
+    fn group_state(&self, p: &Pass) -> GroupState {
+        GroupState {
+            contact_nodes: p.count,
+            extent: if p.count > 0 {
+                [self.position(p.first), self.position(p.last)]
+            } else {
+                [f64::NAN, f64::NAN]
+            },
+            min_gap: p.min_gap,
+            reaction: p.total,
+            dissipation: p.dissipation,
+        }
+    }
+
+    /// The contact state of `u = u^{n+1}` (`z` its increment, `w` the one before, `r` the
+    /// reactions) into `state`; with `dissipation` also the contact dissipation
+    /// `D = −½ Σ_k r_k s_k (u^{n+1} − u^{n−1})_{i_k}`, returned (0 without).
+    pub fn measure(
+        &self,
+        (u, z, w, r): (&[f64], &[f64], &[f64], &[f64]),
+        dissipation: bool,
+        state: &mut ContactState,
+    ) -> f64 {
+        let m = self.len();
+        let all = self.pass(0..m, (u, z, w, r), dissipation);
+        for (g, group) in self.groups.iter().enumerate() {
+            state.groups[g] = if group.range == (0..m) {
+                self.group_state(&all)
+            } else if group.range.len() == 1 {
+                // One constraint: its own values, not a sum from zero (the bits of −0.0).
+                let k = group.range.start;
+                let (l, s) = (self.unknown(k), self.direction(k));
+                let gap = s * u[l] + self.gaps[k];
+                let contact = in_contact(gap);
+                let position = if contact { self.position(k) } else { f64::NAN };
+                GroupState {
+                    contact_nodes: usize::from(contact),
+                    extent: [position, position],
+                    min_gap: gap,
+                    reaction: r[k],
+                    dissipation: if dissipation {
+                        -0.5 * r[k] * s * (z[l] + w[l])
+                    } else {
+                        0.0
+                    },
+                }
+            } else {
+                self.group_state(&self.pass(group.range.clone(), (u, z, w, r), dissipation))
+            };
+        }
+        let empty = m == 0;
+        state.total_reaction = all.total;
+        state.min_gap = if empty { 0.0 } else { all.min_gap };
+        state.min_reaction = if empty { 0.0 } else { all.min_reaction };
+        state.max_complementarity = all.max_comp;
+        state.contact_nodes = all.count;
+        all.dissipation
+    }
+}
+
+/// The contact state of one step, over all constraints and per group.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactState {
+    /// `Σ_k r_k`: the total contact force.
+    pub total_reaction: f64,
+    /// The least gap, the least reaction and the largest `|gap · reaction|` (0 without
+    /// constraints).
+    pub min_gap: f64,
+    pub min_reaction: f64,
+    pub max_complementarity: f64,
+    /// Constraints in contact.
+    pub contact_nodes: usize,
+    /// Per group of [`ContactSet::groups`], in its order.
+    pub groups: [GroupState; MAX_GROUPS],
+}

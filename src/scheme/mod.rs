@@ -1,0 +1,21 @@
+//! The talk's scheme (VI)_h, once, for every body: the state `(u^{n−1}, u^n)`, the start-up
+//! step, the step (right-hand side, constrained minimisation, advance), the energy identity,
+//! the load and the step record. [`Scheme::step`](stepper::Scheme::step) is the talk's step
+//! line by line. The scheme does not know which body it steps: a body supplies its matrices as
+//! kernels through [`Body`] — the bar's in `crate::bar::body` (tridiagonal), the plane body's
+//! in `crate::plane::body` (sparse) — and its constraints as a [`ContactSet`].
+//!
+//! Imports [`crate::linalg`], [`crate::step`] and [`crate::scene`].
+
+pub mod body;
+pub mod clock;
+pub mod contact;
+pub mod error;
+pub mod load;
+pub mod stepper;
+
+pub use body::{Body, EnergySums};
+pub use contact::{CONTACT_GAP_TOL, ContactSet, ContactState, GroupState, in_contact};
+pub use error::RunError;
+pub use load::Load;
+pub use stepper::{Scheme, Setup, State, StepRecord, Unstarted};
