@@ -419,8 +419,29 @@ fn converge(
         &converge::parse_tolerances("--osqp-eps", osqp_eps)?,
         &converge::parse_tolerances("--penalty-epsilon", penalty_epsilon)?,
     )?;
-    let (scene_name, scene) = scene::load(name, set)?;
+    let (scene_name, any) = scene::load_any(name, set)?;
     let out = out.unwrap_or_else(|| PathBuf::from("out").join(format!("converge-{scene_name}")));
+    let scene = match any {
+        scene::AnyScene::Bar(scene) => scene,
+        scene::AnyScene::Plane(plane) => {
+            let bar_only = if viscosity_sweep {
+                Some("--viscosity-sweep")
+            } else {
+                mass.map(|_| "--mass")
+            };
+            if let Some(flag) = bar_only {
+                return Err(converge::ConvergeError::BadInput(format!(
+                    "{flag} studies a bar scene; `{scene_name}` is a plane scene"
+                )));
+            }
+            let study = converge::study_with(&scene_name, plane.as_ref(), &settings, &options)?;
+            print!("{}", study.markdown());
+            for f in &study.write(&out)? {
+                println!("wrote {}", f.display());
+            }
+            return Ok(());
+        }
+    };
     let files = if viscosity_sweep {
         let sweep = sweep::viscosity_sweep(
             &scene_name,
@@ -452,7 +473,7 @@ fn converge(
         }
         files
     } else {
-        let study = converge::study_with(&scene_name, &scene, &settings, &options)?;
+        let study = converge::study_with(&scene_name, scene.as_ref(), &settings, &options)?;
         print!("{}", study.markdown());
         study.write(&out)?
     };
@@ -499,32 +520,42 @@ fn parse_methods(list: &str) -> Result<Vec<SolverMethod>, SceneError> {
 
 /// `viscobar compare`: each solver after the first run side by side with the first, one row
 /// of the Markdown table per pair, printed as soon as it is measured. A solver that cannot
-/// handle the scene (penalty on an obstacle) gets a row saying why.
+/// handle the scene (the bar's penalty solver on an obstacle) gets a row saying why.
 fn compare(name: &str, solvers: &str, set: &[String]) -> Result<(), viscobar::RunError> {
-    use viscobar::study::compare::{compare, with_solver};
     let methods = parse_methods(solvers)?;
-    let (scene_name, scene) = scene::load(name, set)?;
-    let reference = with_solver(&scene, methods[0]);
+    match scene::load_any(name, set)? {
+        (scene_name, scene::AnyScene::Bar(s)) => compare_on(&scene_name, s.as_ref(), &methods),
+        (scene_name, scene::AnyScene::Plane(s)) => compare_on(&scene_name, s.as_ref(), &methods),
+    }
+}
+
+/// [`compare`] on a scene of either body.
+fn compare_on<S: viscobar::study::refine::StudyScene>(
+    scene_name: &str,
+    scene: &S,
+    methods: &[SolverMethod],
+) -> Result<(), viscobar::RunError> {
+    use viscobar::study::compare::{compare, with_solver};
+    let reference = with_solver(scene, methods[0]);
     // Refused here (exit 2) if the reference itself cannot handle the scene.
-    viscobar::Simulation::new(&reference)?;
-    let ends = !scene.signorini_ends().is_empty();
+    let groups = reference.simulation()?.contact().groups().len();
     let dash = || "–".to_string();
     println!(
         "{scene_name}: {} steps of dt = {}, {} elements; each solver against `{}`\n",
         scene.steps(),
-        scene.time.step,
-        scene.mesh.elements,
+        scene.dt(),
+        scene.elements(),
         methods[0].name()
     );
     println!(
         "| solvers | steps | max \\|Δu\\| | at step | max \\|Δu\\| / max \\|u\\| \
-         | max \\|Δreaction\\| (ends) | max \\|Δreaction\\| / max \\|reaction\\| \
+         | max \\|Δreaction\\| (per group) | max \\|Δreaction\\| / max \\|reaction\\| \
          | max violation | iterations mean / max | wall time (s) |"
     );
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for &method in &methods[1..] {
         let pair = format!("{} vs {}", method.name(), methods[0].name());
-        let other = with_solver(&scene, method);
+        let other = with_solver(scene, method);
         let c = match compare(method.name(), &reference, &other) {
             Ok(c) => c,
             Err(viscobar::RunError::Scene(SceneError::Invalid { field, allowed, .. }))
@@ -543,7 +574,7 @@ fn compare(name: &str, solvers: &str, set: &[String]) -> Result<(), viscobar::Ru
                 dash()
             }
         };
-        let (dr, dr_rel) = if ends {
+        let (dr, dr_rel) = if groups > 0 {
             (
                 format!("{:.3e}", a.max_reaction_difference),
                 ratio(a.max_reaction_difference, a.max_reaction),

@@ -10,7 +10,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 /// The layers, bottom first.
-const LAYERS: [&str; 7] = ["linalg", "step", "scene", "bar", "time", "plane", "study"];
+const LAYERS: [&str; 8] = [
+    "linalg", "step", "scene", "scheme", "bar", "plane", "output", "study",
+];
 
 /// A source file: its layer, its module name inside the layer (`mod` for `mod.rs`) and its text.
 struct Source {

@@ -345,31 +345,6 @@ impl Scheme<BarBody> {
         &self.body().disc
     }
 
-    /// `u^n` on all `J + 2` nodes (clamped nodes are 0).
-    pub fn displacement_into(&self, out: &mut [f64]) {
-        let first = self.body().disc.first;
-        out.fill(0.0);
-        let u = self.displacement();
-        out[first..first + u.len()].copy_from_slice(u);
-    }
-
-    /// `(u^n − u^{n−1})/Δt` on all nodes: the velocity at `t_{n−1/2}`.
-    pub fn velocity_into(&self, out: &mut [f64]) {
-        let first = self.body().disc.first;
-        out.fill(0.0);
-        let s = self.state();
-        for (o, w) in out[first..].iter_mut().zip(s.w) {
-            *o = w * s.scale;
-        }
-    }
-
-    /// `u^n` on all nodes.
-    pub fn displacement_full(&self) -> Vec<f64> {
-        let mut out = vec![0.0; self.body().disc.nodes];
-        self.displacement_into(&mut out);
-        out
-    }
-
     /// Initial displacement and velocity at all nodes (evaluated again: not kept in memory).
     pub fn initial_state(&self) -> (Vec<f64>, Vec<f64>) {
         let nodes = self.body().disc.nodes;

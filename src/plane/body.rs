@@ -12,9 +12,9 @@ use crate::plane::energy::{StrainForms, measure};
 use crate::plane::matrices::{Material, assemble};
 use crate::plane::mesh::Grid;
 use crate::plane::normals::{Normal, normals};
+use crate::scene::SolverMethod;
 use crate::scene::expr::Expression;
 use crate::scene::plane::{EDGE_NAMES, PlaneScene};
-use crate::scene::schema::SolverMethod;
 use crate::scheme::body::{Body, EnergySums, FullMassRows};
 use crate::scheme::contact::{ContactSet, Group, Positions};
 use crate::scheme::{Load, RunError, Scheme, Setup, Unstarted};
@@ -352,23 +352,5 @@ impl Scheme<PlaneBody> {
 
     pub fn discretisation(&self) -> &PlaneDiscretisation {
         &self.body().disc
-    }
-
-    /// `u^n` at every full degree of freedom (`2 node + c`; clamped ones 0).
-    pub fn displacement_into(&self, out: &mut [f64]) {
-        self.body().scatter_into(self.displacement(), 1.0, out);
-    }
-
-    /// `(u^n − u^{n−1})/Δt` at every full degree of freedom: the velocity at `t_{n−1/2}`.
-    pub fn velocity_into(&self, out: &mut [f64]) {
-        let s = self.state();
-        self.body().scatter_into(s.w, s.scale, out);
-    }
-
-    /// `u^n` at every full degree of freedom.
-    pub fn displacement_full(&self) -> Vec<f64> {
-        let mut out = vec![0.0; self.body().disc.grid.dofs()];
-        self.displacement_into(&mut out);
-        out
     }
 }

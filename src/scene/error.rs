@@ -70,3 +70,12 @@ impl From<SettingsError> for SceneError {
         }
     }
 }
+
+/// A field outside its range.
+pub(crate) fn invalid(field: &str, value: f64, allowed: &str) -> SceneError {
+    SceneError::Invalid {
+        field: field.to_string(),
+        value: value.to_string(),
+        allowed: allowed.to_string(),
+    }
+}

@@ -7,12 +7,17 @@
 pub mod error;
 pub mod expr;
 pub mod nodal;
+pub mod output;
+pub mod parser;
 pub mod plane;
 pub mod schema;
 pub mod separation;
+pub mod solver;
 pub mod vecmath;
 
 pub use error::SceneError;
 pub use expr::Expression;
+pub use output::*;
 pub use plane::{AnyScene, PlaneScene, load_any};
 pub use schema::*;
+pub use solver::*;

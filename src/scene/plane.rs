@@ -4,14 +4,16 @@
 //! keys) and the output. A scene file has `[bar]` or `[plane]`, never both ([`load_any`] tells
 //! them apart). Unknown keys are refused, as for the bar.
 
+use crate::scene::error::invalid;
 use crate::scene::expr::Expression;
+use crate::scene::output::{OutputSampling, OutputSpec};
 use crate::scene::schema::{
-    GIB, MAX_STEPS, OutputSampling, OutputSpec, Scene, SolverSpec, Time, available_memory_bytes,
-    check_time_grid, invalid, number_or_expression, number_text, positive, toml_syntax,
-    with_overrides,
+    GIB, MAX_STEPS, Scene, Time, available_memory_bytes, check_time_grid, number_or_expression,
+    number_text, positive, toml_syntax, with_overrides,
 };
 /// The built-in plane scenes (kept beside the bar's list in [`crate::scene::schema`]).
 pub use crate::scene::schema::{PLANE_BUILTIN, plane_builtin_text};
+use crate::scene::solver::SolverSpec;
 use crate::scene::{SceneError, builtin_names, builtin_text};
 use serde::{Deserialize, Serialize};
 use std::path::Path;

@@ -389,6 +389,33 @@ impl<B: Body> Scheme<B> {
         &self.u
     }
 
+    /// The degrees of freedom of the mesh, clamped ones included.
+    pub fn dofs(&self) -> usize {
+        self.body.nodes() * self.body.components()
+    }
+
+    /// `u^n` at every degree of freedom of the mesh (`components · node + c`; clamped ones 0).
+    pub fn displacement_into(&self, out: &mut [f64]) {
+        for (dof, o) in out.iter_mut().enumerate() {
+            *o = self.body.unknown_of(dof).map_or(0.0, |i| self.u[i]);
+        }
+    }
+
+    /// [`Scheme::displacement_into`] as a new vector.
+    pub fn displacement_dofs(&self) -> Vec<f64> {
+        let mut out = vec![0.0; self.dofs()];
+        self.displacement_into(&mut out);
+        out
+    }
+
+    /// The velocity `(u^n − u^{n−1})/Δt` at `t_{n−1/2}` at every degree of freedom of the mesh.
+    pub fn velocity_into(&self, out: &mut [f64]) {
+        let scale = 1.0 / self.body.dt();
+        for (dof, o) in out.iter_mut().enumerate() {
+            *o = self.body.unknown_of(dof).map_or(0.0, |i| self.w[i] * scale);
+        }
+    }
+
     /// `u^n` and the velocity `(u^n − u^{n−1})/Δt` at `t_{n−1/2}` on the unknowns.
     pub fn state(&self) -> State<'_> {
         State {

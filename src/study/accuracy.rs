@@ -6,7 +6,7 @@ use crate::linalg::ldlt::Ldlt;
 use crate::linalg::tridiag::SymTridiag;
 use crate::scene::Scene;
 use crate::scheme::RunError;
-use crate::scheme::StepRecord;
+use crate::scheme::{Body, Scheme, StepRecord};
 
 /// Errors of a run against an exact solution, at the nodes and every time step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -25,16 +25,16 @@ pub fn rigid_drift(u: &[f64], t: f64) -> f64 {
 /// Steps `sims` together from the start-up state to `steps` states, calling `observe` with the
 /// simulations and the records of the step: once after the start-up (no records), then after
 /// every step. They step in slice order, so a failure is the first failing simulation's.
-pub fn lockstep(
-    sims: &mut [Simulation],
+pub fn lockstep<B: Body>(
+    sims: &mut [Scheme<B>],
     steps: usize,
-    mut observe: impl FnMut(&[Simulation], Vec<StepRecord>),
+    mut observe: impl FnMut(&[Scheme<B>], Vec<StepRecord>),
 ) -> Result<(), RunError> {
     observe(sims, Vec::new());
     for _ in 1..steps {
         let records = sims
             .iter_mut()
-            .map(Simulation::step)
+            .map(Scheme::step)
             .collect::<Result<Vec<_>, _>>()?;
         observe(sims, records);
     }
@@ -100,7 +100,7 @@ pub fn rigid_mode_drift(elements: u64, steps: usize) -> Result<(f64, f64), RunEr
     let scene = Scene::from_toml(&text, &[])?;
     let mut sim = Simulation::new(&scene)?;
     lockstep(std::slice::from_mut(&mut sim), steps, |_, _| {})?;
-    let increment = rigid_drift(&sim.displacement(), sim.time());
+    let increment = rigid_drift(&sim.displacement_dofs(), sim.time());
 
     let disc = Discretisation::new(&scene)?;
     let dt = disc.dt;

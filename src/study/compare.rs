@@ -1,5 +1,6 @@
-//! Two runs of the same discretisation side by side, e.g. one scene with two step solvers:
-//! the largest difference of the displacements over all nodes and steps.
+//! Two runs of the same discretisation side by side, e.g. one scene (bar or plane) with two
+//! step solvers: the largest difference of the displacements over all degrees of freedom and
+//! steps, and of the reactions of each group of constraints.
 
 use crate::bar::Simulation;
 use crate::linalg::norms::{max_abs, max_distance};
@@ -10,6 +11,7 @@ use crate::scene::SolverMethod;
 use crate::scheme::RunError;
 use crate::scheme::StepRecord;
 use crate::study::accuracy::lockstep;
+use crate::study::refine::StudyScene;
 
 /// How far run `b` is from run `a`, over every step `u^1 … u^N` and every node (and the
 /// reactions at the Signorini ends).
@@ -53,11 +55,11 @@ pub struct Comparison {
 /// Runs `a` and `b` step by step and compares `u^n` after every step. Both scenes must have
 /// the same mesh and time grid (they differ only in the solver, typically). `name` labels
 /// `b`'s summary.
-pub fn compare(name: &str, a: &Scene, b: &Scene) -> Result<Comparison, RunError> {
-    if a.mesh.elements != b.mesh.elements
-        || a.time.step != b.time.step
+pub fn compare<S: StudyScene>(name: &str, a: &S, b: &S) -> Result<Comparison, RunError> {
+    if a.elements() != b.elements()
+        || a.dt() != b.dt()
         || a.steps() != b.steps()
-        || a.bar.length != b.bar.length
+        || a.spacing() != b.spacing()
     {
         return Err(SceneError::Invalid {
             field: "mesh/time".into(),
@@ -66,12 +68,12 @@ pub fn compare(name: &str, a: &Scene, b: &Scene) -> Result<Comparison, RunError>
         }
         .into());
     }
-    let mut sims = [Simulation::new(a)?, Simulation::new(b)?];
-    let mut tracker = Tracker::new(&sims[1], b.load.density.is_none());
+    let mut sims = [a.simulation()?, b.simulation()?];
+    let mut tracker = Tracker::new(&sims[1], !sims[1].is_forced());
     let mut records = vec![sims[1].first_record()];
     let start = std::time::Instant::now();
-    let nodes = sims[0].discretisation().nodes;
-    let (mut ua, mut ub) = (vec![0.0; nodes], vec![0.0; nodes]);
+    let dofs = sims[0].dofs();
+    let (mut ua, mut ub) = (vec![0.0; dofs], vec![0.0; dofs]);
     let mut out = Agreement::default();
     out.observe_reactions(&sims[0].first_record(), &sims[1].first_record());
     lockstep(&mut sims, a.steps(), |sims, step| {
@@ -104,9 +106,9 @@ pub fn compare(name: &str, a: &Scene, b: &Scene) -> Result<Comparison, RunError>
 /// `scene` with step solver `method`: the `[solver]` settings that belong to `method` are kept,
 /// those of other methods dropped (so one scene with e.g. `epsilon` set serves every solver of a
 /// comparison, the penalty one using it).
-pub fn with_solver(scene: &Scene, method: SolverMethod) -> Scene {
+pub fn with_solver<S: StudyScene>(scene: &S, method: SolverMethod) -> S {
     let mut s = scene.clone();
-    let spec = &mut s.solver;
+    let spec = s.solver_mut();
     spec.method = method;
     if method != SolverMethod::Osqp {
         spec.eps_abs = None;

@@ -2,20 +2,21 @@
 //! scene's closed form, or a finer run of the exact solver) and the data of the work-precision
 //! diagram (drawn by `study::work_precision`). The `α → 0` sweep is `study::viscosity_sweep`.
 //!
-//! The error runs are independent and go to rayon's pool (both cores); each worker builds its
-//! own [`Simulation`] (OSQP's workspace is not `Send`), and results are sorted before anything
+//! Bar and plane scenes alike ([`StudyScene`]). The error runs are independent and go to
+//! rayon's pool (both cores); each worker builds its own simulation (OSQP's workspace is not
+//! `Send`), and results are sorted before anything
 //! is written, so the files do not depend on the scheduling. The wall times come from a second,
 //! serial pass that runs each setting and level alone `repeats` times and keeps the median
 //! ([`study_with`]): no timed run shares the cores with another run of the study. They are the
 //! only non-deterministic columns.
 
-use crate::bar::Simulation;
-use crate::bar::closed_form::{self, ClosedForm};
+use crate::bar::closed_form::ClosedForm;
 use crate::output::files::write_atomically;
 use crate::output::summary::Tracker;
-use crate::scene::{Scene, SolverMethod, SolverSpec};
-use crate::scheme::RunError;
+use crate::scene::{SolverMethod, SolverSpec};
+use crate::scheme::{Body, RunError, Scheme};
 use crate::study::accuracy::observed_order;
+use crate::study::refine::StudyScene;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -97,9 +98,9 @@ impl SolverSetting {
         }
     }
     /// `scene` with its `[solver]` table replaced by this setting.
-    pub fn apply(&self, scene: &Scene) -> Scene {
+    pub fn apply<S: StudyScene>(&self, scene: &S) -> S {
         let mut s = scene.clone();
-        s.solver = match *self {
+        *s.solver_mut() = match *self {
             SolverSetting::Exact => SolverSpec::default(),
             SolverSetting::Osqp(e) => SolverSpec {
                 method: SolverMethod::Osqp,
@@ -172,13 +173,6 @@ pub fn parse_tolerances(flag: &str, list: &str) -> Result<Vec<f64>, ConvergeErro
     Ok(out)
 }
 
-/// `base` with `base.elements · 2^level` elements and `dt = ratio · dx`.
-pub fn refined(base: &Scene, level: u32, ratio: f64) -> Scene {
-    let mut s = base.refined(level);
-    s.time.step = ratio * s.dx();
-    s
-}
-
 /// What the runs are measured against.
 pub enum Reference {
     /// The closed form of the built-in scene `name`.
@@ -210,8 +204,10 @@ pub struct SampledReference {
     /// The time indices of the coarsest level (`t = c · Δt_0`, `c >= 1`) at which `values`
     /// are kept.
     pub coarse_times: Vec<usize>,
-    /// Nodes of the finest level of the study.
-    pub nodes: usize,
+    /// The lattice of nodes of the finest level of the study, and the degrees of freedom per
+    /// node: `values` holds every degree of freedom of that lattice.
+    pub lattice: [usize; 2],
+    pub components: usize,
     pub values: Vec<Vec<f64>>,
     /// `E(t_m)` at the reference's own time steps `t_m = m · dt`, as the mean of its
     /// `E^{m−1/2}` and `E^{m+1/2}` (`NaN` where a neighbour was not measured); index `m`.
@@ -239,33 +235,33 @@ pub struct Row {
     pub wall_time_s: f64,
 }
 
-/// Trapezoidal weights on a uniform mesh.
-pub(crate) fn l2_norm(e: &[f64], dx: f64) -> f64 {
-    let n = e.len();
-    let mut s = 0.0;
-    for (i, v) in e.iter().enumerate() {
-        let w = if i == 0 || i + 1 == n { 0.5 } else { 1.0 };
-        s += w * v * v;
+/// The degrees of freedom of `lattice` (`components` a node) at the nodes of a `2^steps` times
+/// coarser lattice, in its order: the nodes `(i·2^steps, j·2^steps)`.
+fn coarse_dofs(lattice: [usize; 2], components: usize, steps: u32) -> Vec<usize> {
+    let s = 1usize << steps;
+    let axis = |n: usize| (n - 1) / s + 1;
+    let mut out = Vec::new();
+    for j in 0..axis(lattice[1]) {
+        for i in 0..axis(lattice[0]) {
+            let node = i * s + j * s * lattice[0];
+            out.extend((0..components).map(|c| components * node + c));
+        }
     }
-    (s * dx).sqrt()
-}
-
-fn h1_seminorm(e: &[f64], dx: f64) -> f64 {
-    (e.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum::<f64>() / dx).sqrt()
+    out
 }
 
 /// Runs `scene` (already set to its solver and level), measuring against `reference`. Only
 /// the steps are timed. `finest`: the finest level of the study.
-fn measure(
+fn measure<S: StudyScene>(
     scene_name: &str,
-    scene: &Scene,
+    scene: &S,
     setting: SolverSetting,
     level: u32,
     finest: u32,
     reference: &Reference,
 ) -> Result<Row, RunError> {
     let closed: Option<Box<dyn ClosedForm>> = match reference {
-        Reference::ClosedForm { name } => closed_form::for_scene(name, scene),
+        Reference::ClosedForm { name } => scene.closed_form(name),
         Reference::Run(_) => None,
     };
     let run = match reference {
@@ -275,35 +271,38 @@ fn measure(
     // Compared only where the closed form states its energy, or against the reference run.
     let energy = closed.as_deref().filter(|c| c.energy(0.0).is_some());
     let compare_energy = energy.is_some() || run.is_some();
-    let mut sim = Simulation::new(scene)?;
-    let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
-    let nodes = sim.discretisation().nodes;
-    let xs: Vec<f64> = (0..nodes).map(|i| sim.discretisation().x(i)).collect();
-    let (dx, dt) = (scene.dx(), scene.time.step);
-    let mut u = vec![0.0; nodes];
-    let mut e = vec![0.0; nodes];
+    let mut sim = scene.simulation()?;
+    let mut tracker = Tracker::new(&sim, !sim.is_forced());
+    let dofs = sim.dofs();
+    let xs: Vec<f64> = (0..sim.body().nodes())
+        .map(|i| sim.body().point(i).0)
+        .collect();
+    // This level's degrees of freedom in the reference's values (on the finest level).
+    let at = run.map(|r| coarse_dofs(r.lattice, r.components, finest - level));
+    let dt = scene.dt();
+    let mut u = vec![0.0; dofs];
+    let mut e = vec![0.0; dofs];
     let (mut l2, mut h1, mut en) = (0.0f64, 0.0f64, 0.0f64);
     let mut sample = 0usize;
     // `k`: the time index of the state `u^k` the simulation holds (`u^1` after the start-up).
-    let mut observe = |sim: &Simulation, k: usize, u: &mut Vec<f64>, e: &mut Vec<f64>| {
-        let have = match (&closed, run) {
-            (Some(c), _) => {
+    let mut observe = |sim: &Scheme<S::Body>, k: usize, u: &mut Vec<f64>, e: &mut Vec<f64>| {
+        let have = match (&closed, run, &at) {
+            (Some(c), _, _) => {
                 sim.displacement_into(u);
                 let t = sim.time();
-                for i in 0..nodes {
+                for i in 0..dofs {
                     e[i] = u[i] - c.displacement(xs[i], t);
                 }
                 true
             }
-            (None, Some(r)) => {
+            (None, Some(r), Some(at)) => {
                 // The same time t = c·Δt_0 at this level and in the reference; the reference's
                 // values are on the finest level's nodes.
-                let stride = 1usize << (finest - level);
                 if sample < r.coarse_times.len() && k == r.coarse_times[sample] << level {
                     sim.displacement_into(u);
                     let v = &r.values[sample];
-                    for i in 0..nodes {
-                        e[i] = u[i] - v[i * stride];
+                    for i in 0..dofs {
+                        e[i] = u[i] - v[at[i]];
                     }
                     sample += 1;
                     true
@@ -311,11 +310,12 @@ fn measure(
                     false
                 }
             }
-            (None, None) => false,
+            _ => false,
         };
         if have {
-            l2 = l2.max(l2_norm(e, dx));
-            h1 = h1.max(h1_seminorm(e, dx));
+            let (el2, eh1) = scene.norms(e);
+            l2 = l2.max(el2);
+            h1 = h1.max(eh1);
         }
     };
     observe(&sim, 1, &mut u, &mut e);
@@ -351,14 +351,14 @@ fn measure(
                 .map_or(&[][..], |v| &v[..]);
             contact_time_error(&exact, discrete)
         }),
-        // Every side on which the reference touches; the worst.
+        // Every group in which the reference touches; the worst.
         (None, Some(rf)) => rf
             .contact
             .iter()
-            .filter_map(|(side, exact)| {
+            .filter_map(|(group, exact)| {
                 let discrete = summary
                     .contact_intervals
-                    .get(side)
+                    .get(group)
                     .map_or(&[][..], |v| &v[..]);
                 contact_time_error(exact, discrete)
             })
@@ -368,8 +368,8 @@ fn measure(
     Ok(Row {
         setting,
         level,
-        elements: scene.mesh.elements as usize,
-        dx,
+        elements: scene.elements(),
+        dx: scene.spacing(),
         dt,
         steps: scene.steps(),
         l2_error: l2,
@@ -408,22 +408,21 @@ pub fn contact_time_error(exact: &[[f64; 2]], discrete: &[[f64; 2]]) -> Option<f
 /// The exact solver at level `level` (above the study's finest, `finest`), kept at (at most
 /// [`REFERENCE_MAX_SAMPLES`]) times of the coarsest level on the finest level's nodes, with
 /// its energy at every step and its contact intervals.
-fn reference_run(
+fn reference_run<S: StudyScene>(
     scene_name: &str,
-    base: &Scene,
+    base: &S,
     finest: u32,
     level: u32,
     ratio: f64,
 ) -> Result<SampledReference, RunError> {
-    let scene = SolverSetting::Exact.apply(&refined(base, level, ratio));
-    let coarse_steps_total = refined(base, 0, ratio).steps();
+    let scene = SolverSetting::Exact.apply(&base.refined(level, ratio));
+    let coarse_steps_total = base.refined(0, ratio).steps();
     let every = coarse_steps_total.div_ceil(REFERENCE_MAX_SAMPLES).max(1);
     let coarse_times: Vec<usize> = (every..=coarse_steps_total).step_by(every).collect();
-    let stride = 1usize << (level - finest);
-    let mut sim = Simulation::new(&scene)?;
-    let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
-    let all = sim.discretisation().nodes;
-    let mut u = vec![0.0; all];
+    let mut sim = scene.simulation()?;
+    let mut tracker = Tracker::new(&sim, !sim.is_forced());
+    let keep_dofs = coarse_dofs(scene.lattice(), scene.components(), level - finest);
+    let mut u = vec![0.0; sim.dofs()];
     let mut values = Vec::with_capacity(coarse_times.len());
     // E^{k−1/2} by step k (index 0 unused).
     let first = sim.first_record();
@@ -433,10 +432,10 @@ fn reference_run(
     } else {
         f64::NAN
     };
-    let mut keep = |k: usize, sim: &Simulation, values: &mut Vec<Vec<f64>>| {
+    let mut keep = |k: usize, sim: &Scheme<S::Body>, values: &mut Vec<Vec<f64>>| {
         if values.len() < coarse_times.len() && k == coarse_times[values.len()] << level {
             sim.displacement_into(&mut u);
-            values.push(u.iter().step_by(stride).copied().collect::<Vec<f64>>());
+            values.push(keep_dofs.iter().map(|&d| u[d]).collect::<Vec<f64>>());
         }
     };
     keep(1, &sim, &mut values);
@@ -460,11 +459,12 @@ fn reference_run(
         .collect();
     let summary = tracker.finish(scene_name, &sim, 0.0);
     Ok(SampledReference {
-        elements: scene.mesh.elements as usize,
+        elements: scene.elements(),
         level,
-        dt: scene.time.step,
+        dt: scene.dt(),
         coarse_times: coarse_times[..kept].to_vec(),
-        nodes: (all - 1) / stride + 1,
+        lattice: base.refined(finest, ratio).lattice(),
+        components: scene.components(),
         values,
         energy,
         contact: summary
@@ -526,9 +526,9 @@ impl StudyOptions {
 
 /// Runs every setting at every level; one serial timing repeat
 /// ([`study_with`] and [`StudyOptions`] for the other choices).
-pub fn study(
+pub fn study<S: StudyScene>(
     scene_name: &str,
-    base: &Scene,
+    base: &S,
     settings: &[SolverSetting],
     levels: u32,
     ratio: Option<f64>,
@@ -542,8 +542,8 @@ pub fn study(
 }
 
 /// Wall time of the steps of one run of `scene` (set-up excluded), seconds.
-pub fn time_steps(scene: &Scene) -> Result<f64, RunError> {
-    let mut sim = Simulation::new(scene)?;
+pub fn time_steps<S: StudyScene>(scene: &S) -> Result<f64, RunError> {
+    let mut sim = scene.simulation()?;
     let start = Instant::now();
     for _ in 1..scene.steps() {
         sim.step()?;
@@ -566,9 +566,9 @@ pub fn median(mut v: Vec<f64>) -> f64 {
 /// independent and deterministic), then, with `repeats > 0`, a serial pass that times each
 /// run alone `repeats` times and keeps the median, so no run is timed while another shares
 /// the machine's cores.
-pub fn study_with(
+pub fn study_with<S: StudyScene>(
     scene_name: &str,
-    base: &Scene,
+    base: &S,
     settings: &[SolverSetting],
     options: &StudyOptions,
 ) -> Result<Study, ConvergeError> {
@@ -583,7 +583,10 @@ pub fn study_with(
             "--levels {levels}: at most 12 (each level doubles the elements)"
         )));
     }
-    let ratio = options.ratio.unwrap_or(base.time.step / base.dx());
+    if let Some(why) = base.not_nested() {
+        return Err(ConvergeError::BadInput(why));
+    }
+    let ratio = options.ratio.unwrap_or(base.dt() / base.spacing());
     if !(ratio.is_finite() && ratio > 0.0) {
         return Err(ConvergeError::BadInput(format!(
             "--ratio {ratio}: dt/dx must be positive and finite"
@@ -605,7 +608,7 @@ pub fn study_with(
         )));
     }
     let reference = match options.reference_level {
-        None if closed_form::for_scene(scene_name, base).is_some() => Reference::ClosedForm {
+        None if base.closed_form(scene_name).is_some() => Reference::ClosedForm {
             name: scene_name.to_string(),
         },
         level => Reference::Run(Arc::new(reference_run(
@@ -627,7 +630,7 @@ pub fn study_with(
         .par_iter()
         .map(|&i| {
             let (setting, level) = tasks[i];
-            let scene = setting.apply(&refined(base, level, ratio));
+            let scene = setting.apply(&base.refined(level, ratio));
             measure(scene_name, &scene, setting, level, finest, &reference).map(|r| (i, r))
         })
         .collect::<Result<Vec<_>, RunError>>()?;
@@ -635,7 +638,7 @@ pub fn study_with(
     let mut rows: Vec<Row> = rows.into_iter().map(|(_, r)| r).collect();
     if options.repeats > 0 {
         for row in &mut rows {
-            let scene = row.setting.apply(&refined(base, row.level, ratio));
+            let scene = row.setting.apply(&base.refined(row.level, ratio));
             let times = (0..options.repeats)
                 .map(|_| time_steps(&scene))
                 .collect::<Result<Vec<f64>, RunError>>()?;

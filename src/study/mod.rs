@@ -16,6 +16,7 @@ pub mod mass_variants;
 // TEMP pub mod plane_contact;
 pub mod plane_contact_figure;
 pub mod plane_figure;
+pub mod refine;
 pub mod sampled_run;
 // TEMP pub mod stiff;
 // TEMP pub mod stiff_runs;

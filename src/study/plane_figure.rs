@@ -120,7 +120,7 @@ impl PlaneFigure {
         let mut v = vec![0.0; grid.dofs()];
         let mut keep = |sim: &PlaneSimulation, snapshots: &mut Vec<Snapshot>| {
             if wanted[1..].contains(&sim.step_index()) {
-                let u = sim.displacement_full();
+                let u = sim.displacement_dofs();
                 sim.velocity_into(&mut v);
                 snapshots.push(Snapshot {
                     t: sim.time(),
