@@ -8,6 +8,7 @@ pub mod accuracy;
 // TEMP pub mod agreement;
 pub mod compare;
 pub mod converge;
+pub mod convergence_table;
 pub mod figure_writer;
 pub mod figures;
 pub mod mass_figure;
