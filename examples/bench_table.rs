@@ -23,8 +23,8 @@
 use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
-use viscobar::study::timings::{cpu_model, utc_date_time_at};
-use viscobar::study::verify::{Section, update_document};
+use viscobar_certificate::timings::{cpu_model, utc_date_time_at};
+use viscobar_certificate::verify::{Section, update_document};
 
 /// Issue 7's targets.
 const BARE_NS_PER_NODE_TARGET: f64 = 2.0;

@@ -124,25 +124,6 @@ enum Command {
         /// A built-in scene's name (as listed by `viscobar scenes`).
         name: String,
     },
-    /// Recompute the measured figures of VERIFICATION.md and print them as Markdown.
-    Verify {
-        /// Rewrite the generated blocks of this file in place instead of printing.
-        #[arg(long, value_name = "FILE")]
-        update: Option<PathBuf>,
-        /// The stiff and extreme case matrix instead (full size: 1e6 nodes, 1e6-step runs).
-        #[arg(long)]
-        stiff: bool,
-        /// The tolerance registry instead: each tolerance's measured worst / tolerance.
-        #[arg(long, conflicts_with_all = ["stiff", "timings"])]
-        tolerances: bool,
-        /// "Error against run time" instead: its error and timing blocks (machine-dependent:
-        /// the machine and date are written beside the times).
-        #[arg(long, conflicts_with = "stiff")]
-        timings: bool,
-        /// With --timings: also write work-precision-<scene>.png into this folder.
-        #[arg(long, value_name = "DIR", requires = "timings")]
-        figures: Option<PathBuf>,
-    },
 }
 
 fn main() {
@@ -167,13 +148,6 @@ fn main() {
                 }
             }
         }
-        Command::Verify {
-            update,
-            stiff,
-            tolerances,
-            timings,
-            figures,
-        } => verify(update, stiff, tolerances, timings.then_some(figures)),
         Command::Converge {
             scene,
             solvers,
@@ -595,58 +569,6 @@ fn compare(name: &str, solvers: &str, set: &[String]) -> Result<(), viscobar::Ru
         );
     }
     Ok(())
-}
-
-/// `timings`: `Some(figures folder)` for `--timings`.
-fn verify(
-    update: Option<PathBuf>,
-    stiff: bool,
-    tolerances: bool,
-    timings: Option<Option<PathBuf>>,
-) -> i32 {
-    let sections = if let Some(figures) = timings {
-        viscobar::study::timings::sections(figures.as_deref())
-    } else if stiff || tolerances {
-        let results = viscobar::study::stiff_runs::run_all(viscobar::study::stiff::Size::Full);
-        if stiff {
-            Ok(vec![viscobar::study::verify::stiff_section(&results)])
-        } else {
-            viscobar::study::verify::rigid_drift()
-                .and_then(|(drift, _)| viscobar::study::verify::tolerances_section(&results, drift))
-                .map(|s| vec![s])
-                .map_err(Into::into)
-        }
-    } else {
-        viscobar::study::verify::sections()
-    };
-    let sections = match sections {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return e.exit_code();
-        }
-    };
-    let Some(path) = update else {
-        print!("{}", viscobar::study::verify::render(&sections));
-        return 0;
-    };
-    let result = std::fs::read_to_string(&path)
-        .map_err(|e| format!("cannot read {}: {e}", path.display()))
-        .and_then(|doc| {
-            viscobar::study::verify::update_document(&doc, &sections)
-                .map_err(|e| format!("{}: {e}", path.display()))
-        })
-        .and_then(|doc| {
-            viscobar::time::run::write_atomically(&path, doc.as_bytes())
-                .map_err(|e| format!("cannot write {}: {e}", path.display()))
-        });
-    match result {
-        Ok(()) => 0,
-        Err(e) => {
-            eprintln!("error: {e}");
-            1
-        }
-    }
 }
 
 /// The contact episodes of one end (or of the obstacle) in one line: when, impulse and the

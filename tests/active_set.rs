@@ -4,7 +4,7 @@
 
 mod common;
 use common::kkt_ratio;
-use viscobar::study::tolerances::oracle_agreement;
+use viscobar_certificate::tolerances::oracle_agreement;
 
 use proptest::prelude::*;
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
@@ -361,7 +361,7 @@ fn obstacle_runs_meet_kkt_at_the_round_off_floors_at_every_step() {
 /// (`viscobar verify --tolerances` prints its worst ratio).
 #[test]
 fn seeded_sample_meets_the_per_case_kkt_bound() {
-    let (ratio, worst) = viscobar::study::tolerances::random_kkt_worst().unwrap();
+    let (ratio, worst) = viscobar_certificate::tolerances::random_kkt_worst().unwrap();
     println!("seeded sample: worst kkt {worst:e}, worst ratio to the per-case bound {ratio:e}");
     assert!(ratio <= 1.0, "worst ratio {ratio:e}");
 }

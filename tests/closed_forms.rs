@@ -11,7 +11,7 @@ use viscobar::study::accuracy::{error_against, observed_order};
 
 // Error bounds at the scenes' own meshes: 1.25x the measured L2 error, defined beside their
 // measurement in the tolerance registry (`viscobar verify --tolerances`).
-use viscobar::study::tolerances::{
+use viscobar_certificate::tolerances::{
     CLAMPED_IMPACT_L2_BOUND, CONTACT_TIME_TOL, FALLING_BAR_L2_BOUND, FALLING_BAR_ROUNDOFF, FD_STEP,
     IMPACT_L2_BOUND, MEAN_REACTION_TOL, builtin_falling_bar, falling_bar_identities_worst,
     falling_bar_quadrature, falling_bar_reaction_fd_ratio, impact_contact_errors,

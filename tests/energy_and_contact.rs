@@ -6,7 +6,7 @@ use common::{COMPLEMENTARITY_TOL, ENERGY_RISE_TOL, GAP_TOL, IDENTITY_TOL, REACTI
 use viscobar::scene::{self, MassVariant, builtin_names};
 use viscobar::time::run::run_in_memory;
 // Defined beside their measurement in the tolerance registry (`viscobar verify --tolerances`).
-use viscobar::study::tolerances::{
+use viscobar_certificate::tolerances::{
     RESTING_TOL, START_ENERGY_ERROR_PER_DX, resting_bar_worst, start_energy_errors,
 };
 

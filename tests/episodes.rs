@@ -11,7 +11,7 @@ use viscobar::time::summary::{ContactEpisode, TIME_DIGITS, output_time};
 use viscobar::{Summary, run_in_memory};
 
 // Defined beside its measurement in the tolerance registry (`verify --tolerances`).
-use viscobar::study::tolerances::{RELEASE_ELEMENTS, RELEASE_TOL, release_error};
+use viscobar_certificate::tolerances::{RELEASE_ELEMENTS, RELEASE_TOL, release_error};
 
 fn episodes(summary: &Summary, side: &str) -> Vec<ContactEpisode> {
     summary.contact_episodes[side].clone()

@@ -3,7 +3,7 @@
 
 mod common;
 // Defined beside its measurement in the tolerance registry (`viscobar verify --tolerances`).
-use viscobar::study::tolerances::{TIE_TOL, exact_tie, oracle_agreement};
+use viscobar_certificate::tolerances::{TIE_TOL, exact_tie, oracle_agreement};
 
 use proptest::prelude::*;
 use viscobar::linalg::tridiag::SymTridiag;

@@ -145,7 +145,7 @@ const REDISTRIBUTED_L2_RATIO_BAND: (f64, f64) = (0.95, 1.05);
 /// accurate").
 const LUMPED_L2_RATIO_MIN: f64 = 1.1;
 // Defined beside their measurement in the tolerance registry (`verify --tolerances`).
-use viscobar::study::tolerances::{DROP_TOL, START_TOL, drop_worst, start_up_motion};
+use viscobar_certificate::tolerances::{DROP_TOL, START_TOL, drop_worst, start_up_motion};
 
 fn finest<'a>(rows: &'a [MassRow], scene: &str, alpha: f64, mass: MassVariant) -> &'a MassRow {
     groups(rows)

@@ -4,14 +4,14 @@
 //! release (the sparse factorisation is ~150x slower in debug).
 
 use viscobar::plane::run::run_plane_in_memory;
-use viscobar::study::plane_checks::{
+use viscobar_certificate::plane_checks::{
     MANUFACTURED_LEVELS, bar_case, bar_case_scenes, identity_scenes, manufactured_level,
     observed_order,
 };
 
 // The identity, energy-rise and bar-case tolerances: in the registry (study::tolerances), which
 // measures their worst values over these scenes (`verify --tolerances`).
-use viscobar::study::tolerances::{
+use viscobar_certificate::tolerances::{
     PLANE_BAR_CASE_TOL as BAR_CASE_TOL, PLANE_ENERGY_RISE_TOL as ENERGY_RISE_TOL,
     PLANE_IDENTITY_TOL as IDENTITY_TOL,
 };

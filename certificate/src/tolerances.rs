@@ -6,20 +6,20 @@
 //! measurement. The others are found by scanning the sources and listed with the reason they
 //! are not measured.
 
-use crate::bar::closed_form::{ClosedForm, FallingBar};
-use crate::linalg::spectrum::reference::STURM_ERROR_ULPS;
-use crate::linalg::tridiag::SymTridiag;
-use crate::scene::{self, MassVariant, Scene, SolverMethod, builtin_names};
-use crate::step::audit::AUDIT_MARGIN;
-use crate::step::osqp::OSQP_DEFAULT_EPS;
-use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
-use crate::study::accuracy::error_against;
-use crate::study::compare::{Comparison, compare};
-use crate::study::stiff::{CaseResult, checks};
-use crate::study::viscous_contact;
-use crate::time::RunError;
-use crate::time::run::run_in_memory;
+use crate::stiff::{CaseResult, checks};
+use crate::viscous_contact;
 use std::fmt::Write;
+use viscobar::bar::closed_form::{ClosedForm, FallingBar};
+use viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS;
+use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::scene::{self, MassVariant, Scene, SolverMethod, builtin_names};
+use viscobar::step::audit::AUDIT_MARGIN;
+use viscobar::step::osqp::OSQP_DEFAULT_EPS;
+use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::study::accuracy::error_against;
+use viscobar::study::compare::{Comparison, compare};
+use viscobar::time::RunError;
+use viscobar::time::run::run_in_memory;
 
 /// A tolerance more than this many times looser than its measured worst value needs a reason.
 pub const RATIO_FLOOR: f64 = 1e-3;
@@ -114,7 +114,7 @@ pub fn scene_worst() -> Result<[f64; 5], RunError> {
 /// The L2 error of a built-in scene at its own mesh against its closed form.
 pub fn l2_at_scene_mesh(name: &str) -> Result<f64, RunError> {
     let (_, base) = scene::load(name, &[])?;
-    let exact = crate::bar::closed_form::for_scene(name, &base).ok_or_else(|| {
+    let exact = viscobar::bar::closed_form::for_scene(name, &base).ok_or_else(|| {
         invalid(
             "scene",
             name.to_string(),
@@ -337,7 +337,7 @@ pub fn measured() -> Result<Vec<Measured>, RunError> {
     }
     let (mass_sum, _) = mass_sum_worst();
     let (solve, _) = ldlt_family_worst();
-    let too_few = |e: crate::bar::matrices::TooFewElements| {
+    let too_few = |e: viscobar::bar::matrices::TooFewElements| {
         invalid(
             "mesh.elements",
             e.to_string(),
@@ -670,8 +670,8 @@ pub const KAPPA_CASES: [(f64, f64); 4] = [(0.0, 1e-3), (0.0, 1.0), (1e3, 100.0),
 /// f64 bisection in units of `ε‖C‖∞`, and the worst κ error relative to its bound
 /// `STURM_ERROR_ULPS ε ‖C‖∞ (1/λ_min + 1/λ_max)`.
 pub fn kappa_reference_worst() -> (f64, f64) {
-    use crate::bar::matrices::{MatrixVariant, mass, stiffness};
-    use crate::linalg::spectrum::{
+    use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
+    use viscobar::linalg::spectrum::{
         condition_number, extreme_eigenvalues, reference::eigenvalue_dd, smallest_eigenvalue_spd,
     };
     let nodes = 21;
@@ -696,9 +696,15 @@ pub fn kappa_reference_worst() -> (f64, f64) {
     (eig, kappa)
 }
 
+/// The workspace's root folder (the `viscobar` package), which the scanned paths are relative to.
+fn workspace_root() -> &'static std::path::Path {
+    let certificate = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    certificate.parent().unwrap_or(certificate)
+}
+
 /// Files scanned for tolerance constants: every test file and the stiff matrix.
 fn scanned_files() -> Vec<std::path::PathBuf> {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = workspace_root();
     let mut files: Vec<_> = std::fs::read_dir(root.join("tests"))
         .into_iter()
         .flatten()
@@ -707,7 +713,7 @@ fn scanned_files() -> Vec<std::path::PathBuf> {
         .filter(|p| p.extension().is_some_and(|x| x == "rs"))
         .collect();
     files.push(root.join("tests/common/mod.rs"));
-    files.push(root.join("src/study/stiff.rs"));
+    files.push(root.join("certificate/src/stiff.rs"));
     files.sort();
     files
 }
@@ -785,7 +791,7 @@ pub fn uncovered(covered: &[(&str, &str)]) -> Vec<Uncovered> {
             continue;
         };
         let file = path
-            .strip_prefix(env!("CARGO_MANIFEST_DIR"))
+            .strip_prefix(workspace_root())
             .map_or(path.display().to_string(), |p| {
                 p.display().to_string().trim_start_matches('/').to_string()
             });
@@ -842,7 +848,7 @@ pub fn markdown(measured: &[Measured], stiff: &[StiffCheck], uncovered: &[Uncove
         );
     }
     md.push_str(
-        "\nStiff case matrix (`src/study/stiff.rs`, tolerances per case; ratio value / tolerance over the completed runs):\n\n\
+        "\nStiff case matrix (`certificate/src/stiff.rs`, tolerances per case; ratio value / tolerance over the completed runs):\n\n\
          | check | solver | runs | max ratio | min nonzero ratio | runs below 1e-3 | runs at exactly 0 |\n|---|---|---|---|---|---|---|\n",
     );
     for c in stiff {
@@ -896,8 +902,8 @@ pub fn registry_markdown(
     });
     // The stiff matrix's constants enter its per-case tolerances, measured by the checks above.
     let covered = [
-        ("OSQP_AGREEMENT_REL", "src/study/stiff.rs"),
-        ("OSQP_STEP_ABS", "src/study/stiff.rs"),
+        ("OSQP_AGREEMENT_REL", "certificate/src/stiff.rs"),
+        ("OSQP_STEP_ABS", "certificate/src/stiff.rs"),
     ];
     Ok(markdown(
         &measured,
@@ -1109,8 +1115,8 @@ pub const SMALL_TOL: f64 = 64.0 * f64::EPSILON;
 /// (`z = (2, 7/3, 5/3)`, reaction `2/3`): the worst error of `z` and `r` against these closed
 /// forms, and the number of steps the second solver audited.
 pub fn osqp_small_problems() -> Result<(f64, u64), RunError> {
-    use crate::step::StepSolver;
-    use crate::step::osqp::{OsqpSettings, OsqpSolver};
+    use viscobar::step::StepSolver;
+    use viscobar::step::osqp::{OsqpSettings, OsqpSolver};
     let c = SymTridiag::new(vec![2.0, 2.0, 2.0], vec![-1.0, -1.0]);
     let b = [1.0, 1.0, 1.0];
     let mut worst = 0.0f64;
@@ -1260,7 +1266,7 @@ pub fn builtin_falling_bar() -> Result<FallingBar, RunError> {
 
 /// The error of a built-in scene whose data the registry cannot use (not a panic).
 fn invalid(field: &str, value: String, allowed: &str) -> RunError {
-    RunError::Scene(crate::scene::SceneError::Invalid {
+    RunError::Scene(viscobar::scene::SceneError::Invalid {
         field: field.into(),
         value,
         allowed: allowed.into(),
@@ -1312,7 +1318,7 @@ pub fn impact_contact_errors() -> Result<(usize, f64, f64), RunError> {
 pub const DROP_TOL: f64 = 1e-12;
 
 /// The mass study's rows on `impact` at α = 0: the worst `|energy drop − contact term|`.
-pub fn drop_worst(rows: &[crate::study::mass_variants::MassRow]) -> f64 {
+pub fn drop_worst(rows: &[viscobar::study::mass_variants::MassRow]) -> f64 {
     rows.iter()
         .filter(|r| r.scene == "impact" && r.alpha == 0.0)
         .map(|r| (r.energy_drop - r.contact_dissipation).abs())
@@ -1321,7 +1327,7 @@ pub fn drop_worst(rows: &[crate::study::mass_variants::MassRow]) -> f64 {
 
 /// [`drop_worst`] of a fresh mass study (a few seconds).
 pub fn mass_study_drop_worst() -> Result<f64, RunError> {
-    use crate::study::mass_variants::{MassStudyError, mass_study};
+    use viscobar::study::mass_variants::{MassStudyError, mass_study};
     let rows = mass_study().map_err(|e| match e {
         MassStudyError::Run(r) => r,
         other => invalid(
@@ -1344,7 +1350,7 @@ pub fn start_up_motion() -> Result<Vec<(MassVariant, f64, f64)>, RunError> {
     let mut out = Vec::new();
     for mass in MassVariant::ALL {
         let (_, scene) = scene::load("one-end", &[format!("bar.mass={}", mass.name())])?;
-        let sim = crate::time::simulation::Simulation::new(&scene)?;
+        let sim = viscobar::time::simulation::Simulation::new(&scene)?;
         let (u0, _) = sim.initial_state();
         let u1 = sim.displacement();
         let moved = (u1[0] - u0[0]).abs();
@@ -1364,7 +1370,7 @@ pub const RELEASE_TOL: f64 = 0.025;
 pub const RELEASE_ELEMENTS: [u64; 3] = [100, 200, 400];
 
 /// The release time's error of an `impact` contact episode, `|end − 2.1|`.
-pub fn release_error(e: &crate::time::ContactEpisode) -> f64 {
+pub fn release_error(e: &viscobar::time::ContactEpisode) -> f64 {
     (e.end - 2.1).abs()
 }
 
@@ -1402,7 +1408,7 @@ pub fn thinned_energy_error(every: f64, thinned: f64) -> f64 {
 /// [`thinned_energy_error`] over every built-in scene's measured steps, thinned by
 /// [`THINNING`] against every step.
 pub fn thinned_energy_worst() -> Result<f64, RunError> {
-    use crate::time::simulation::Simulation;
+    use viscobar::time::simulation::Simulation;
     let mut worst = 0.0f64;
     for name in builtin_names() {
         let (_, every) = scene::load(name, &[])?;
@@ -1441,8 +1447,8 @@ pub const SEPARABLE_LOADS: [&str; 6] = [
 /// simulation's (separated where it can) and the plain `M l(x, t)`, and the scale
 /// `Σ_k |f_k(t)| M|g_k| + M|l|` of the separation's round-off.
 pub fn load_vectors(text: &str, n: usize) -> Result<[Vec<f64>; 3], RunError> {
-    use crate::bar::matrices::{MatrixVariant, mass};
-    use crate::scene::Expression;
+    use viscobar::bar::matrices::{MatrixVariant, mass};
+    use viscobar::scene::Expression;
     let (_, scene) = scene::load(
         "modal",
         &[
@@ -1451,7 +1457,7 @@ pub fn load_vectors(text: &str, n: usize) -> Result<[Vec<f64>; 3], RunError> {
             format!("time.step={}", 1.0 / LOAD_ELEMENTS as f64),
         ],
     )?;
-    let mut sim = crate::time::simulation::Simulation::new(&scene)?;
+    let mut sim = viscobar::time::simulation::Simulation::new(&scene)?;
     let disc = sim.discretisation().clone();
     let t = n as f64 * disc.dt;
     let fast = sim.load_vector(n)?.to_vec();
@@ -1518,7 +1524,7 @@ pub const MATRIX_SIZES: [usize; 4] = [2, 3, 10, 1001];
 /// nodes): the worst error, and the smallest printed total over `L` (which must exceed 4/3's
 /// neighbourhood, 1.3).
 pub fn mass_sum_worst() -> (f64, f64) {
-    use crate::bar::matrices::{MatrixVariant, mass};
+    use viscobar::bar::matrices::{MatrixVariant, mass};
     let mut worst = 0.0f64;
     for nodes in MATRIX_SIZES {
         let length = 1.7;
@@ -1549,8 +1555,8 @@ pub const SOLVE_ULPS: f64 = 4.0;
 /// signs, not all diagonally dominant), `b = A x`: the worst `|x̂ − x|∞` over its own bound
 /// `SOLVE_ULPS ε ‖A‖∞ ‖x‖₂ / λ_min(A)` (λ_min by bisection), and the worst `|x̂ − x|∞`.
 pub fn ldlt_family_worst() -> (f64, f64) {
-    use crate::linalg::ldlt::Ldlt;
-    use crate::linalg::spectrum::smallest_eigenvalue_spd;
+    use viscobar::linalg::ldlt::Ldlt;
+    use viscobar::linalg::spectrum::smallest_eigenvalue_spd;
     let (mut ratio, mut worst) = (0.0f64, 0.0f64);
     for n in 1..40usize {
         for shift in [0.05, 1.0] {
@@ -1627,8 +1633,8 @@ pub struct VariantWorst {
 }
 
 /// [`VariantWorst`] over [`mass_variant_cases`].
-pub fn mass_variant_worst() -> Result<VariantWorst, crate::bar::matrices::TooFewElements> {
-    use crate::bar::matrices::mass_matrix;
+pub fn mass_variant_worst() -> Result<VariantWorst, viscobar::bar::matrices::TooFewElements> {
+    use viscobar::bar::matrices::mass_matrix;
     let mut w = VariantWorst {
         smallest_other_ulps: f64::INFINITY,
         ..VariantWorst::default()
@@ -1675,8 +1681,8 @@ pub fn mass_variant_worst() -> Result<VariantWorst, crate::bar::matrices::TooFew
 /// redistributed from a Signorini end at the left, row sums `(0, 2Δx, Δx/2, Δx, Δx)` and
 /// `Δx/2` at the free end, diagonals `11Δx/6` and `Δx/6` at nodes 1 and 2: the worst
 /// `|entry − documented|`, and whether the lumped off-diagonals are exactly 0.
-pub fn documented_entries_worst() -> Result<(f64, bool), crate::bar::matrices::TooFewElements> {
-    use crate::bar::matrices::mass_matrix;
+pub fn documented_entries_worst() -> Result<(f64, bool), viscobar::bar::matrices::TooFewElements> {
+    use viscobar::bar::matrices::mass_matrix;
     let elements = 10;
     let dx = 1.0 / elements as f64;
     let l = mass_matrix(MassVariant::Lumped, [true, true], elements + 1, dx)?;
@@ -1768,8 +1774,8 @@ pub const TIE_TOL: f64 = 1e-14;
 /// the worst `|z − 1|` and `r` (`r` must be `>= 0`), whether the bounds held exactly and the
 /// reactions were not negative, and whether every call gave the first call's bits.
 pub fn exact_tie() -> Result<(f64, bool, bool), RunError> {
-    use crate::step::StepSolver;
-    use crate::step::exact::ExactSolver;
+    use viscobar::step::StepSolver;
+    use viscobar::step::exact::ExactSolver;
     let c = SymTridiag::new(vec![2.0, 2.0, 2.0], vec![-1.0, -1.0]);
     let z_free = [1.0, 1.0, 1.0];
     let b = c.mul(&z_free);
@@ -1823,7 +1829,7 @@ pub const PLANE_PENALTY_FACTOR: f64 = 4.0;
 /// the step's active-set system differ by [`AGREEMENT_ULPS_PER_STEP`] ε relative (the bar's
 /// constant; OSQP polished), accumulated linearly over the steps; the worst of the
 /// displacement (relative to max |u|) and the reaction (relative to max r).
-pub fn plane_osqp_agreement_ratio(a: &crate::study::plane_contact::Agreement) -> f64 {
+pub fn plane_osqp_agreement_ratio(a: &crate::plane_contact::Agreement) -> f64 {
     let bound = a.steps as f64 * AGREEMENT_ULPS_PER_STEP * f64::EPSILON;
     let relative = |d: f64, scale: f64| if scale > 0.0 { d / scale } else { d };
     relative(a.max_u_deviation, a.max_u).max(relative(a.max_reaction_deviation, a.max_reaction))
@@ -1832,7 +1838,7 @@ pub fn plane_osqp_agreement_ratio(a: &crate::study::plane_contact::Agreement) ->
 
 /// Plane normal compliance at `epsilon` against exact: `max |u − u_exact|` over
 /// `PLANE_PENALTY_FACTOR ε r_max` (`r_max` of the exact run).
-pub fn plane_penalty_ratio(a: &crate::study::plane_contact::Agreement, epsilon: f64) -> f64 {
+pub fn plane_penalty_ratio(a: &crate::plane_contact::Agreement, epsilon: f64) -> f64 {
     let bound = PLANE_PENALTY_FACTOR * epsilon * a.max_reaction;
     if bound > 0.0 {
         a.max_u_deviation / bound
@@ -1860,12 +1866,12 @@ pub struct PlaneWorst {
     pub penalty_ratio: f64,
 }
 
-fn plane_run_error(e: crate::study::converge::ConvergeError) -> RunError {
+fn plane_run_error(e: viscobar::study::converge::ConvergeError) -> RunError {
     match e {
-        crate::study::converge::ConvergeError::Run(r) => r,
-        crate::study::converge::ConvergeError::Scene(s) => RunError::Scene(s),
+        viscobar::study::converge::ConvergeError::Run(r) => r,
+        viscobar::study::converge::ConvergeError::Scene(s) => RunError::Scene(s),
         other => RunError::SolverSetup {
-            solver: crate::plane::run::SOLVER_NAME.into(),
+            solver: viscobar::plane::run::SOLVER_NAME.into(),
             reason: other.to_string(),
         },
     }
@@ -1873,14 +1879,14 @@ fn plane_run_error(e: crate::study::converge::ConvergeError) -> RunError {
 
 /// [`PlaneWorst`] over the scenes of `tests/plane.rs` and `tests/plane_contact.rs`.
 pub fn plane_worst() -> Result<PlaneWorst, RunError> {
-    use crate::plane::contact::ContactMethod;
-    use crate::plane::run::run_plane_in_memory;
-    use crate::study::plane_checks::{
+    use crate::plane_checks::{
         bar_case, bar_case_scenes, bar_contact_case_scenes, identity_scenes,
     };
-    use crate::study::plane_contact::{
+    use crate::plane_contact::{
         CONTACT_SCENES, PENALTY_EPSILONS, agreement, osqp_method, plane_error, plane_scene,
     };
+    use viscobar::plane::contact::ContactMethod;
+    use viscobar::plane::run::run_plane_in_memory;
     let mut w = PlaneWorst::default();
     for (name, scene) in identity_scenes() {
         let (records, summary, sim) = run_plane_in_memory(&name, &scene)
@@ -2032,7 +2038,7 @@ pub fn stream(seed: u64) -> impl FnMut() -> f64 {
 /// The tests' `common::spd_tridiag(max_n)` distribution drawn from `rnd`: size `2..=max_n`,
 /// off-diagonals in (−1, 1), diagonal-dominance margins in `[MIN_MARGIN, MAX_MARGIN)`.
 pub fn sample_spd_tridiag(max_n: usize, rnd: &mut impl FnMut() -> f64) -> SymTridiag {
-    use crate::study::agreement::{MAX_MARGIN, MIN_MARGIN, diagonally_dominant};
+    use crate::agreement::{MAX_MARGIN, MIN_MARGIN, diagonally_dominant};
     let n = 2 + ((rnd() * (max_n - 1) as f64) as usize).min(max_n - 2);
     let off: Vec<f64> = (0..n - 1).map(|_| 2.0 * rnd() - 1.0).collect();
     let margin: Vec<f64> = (0..n)
@@ -2045,7 +2051,7 @@ pub fn sample_spd_tridiag(max_n: usize, rnd: &mut impl FnMut() -> f64) -> SymTri
 /// relative to the data: stationarity `‖Cz − b − Σ r_j e_j‖∞`, feasibility, sign and
 /// complementarity, over `1 + max(‖b‖∞, ‖lo‖∞, ‖z‖∞)`.
 pub fn kkt(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64], z: &[f64], r: &[f64]) -> f64 {
-    use crate::linalg::norms::max_abs;
+    use viscobar::linalg::norms::max_abs;
     let scale = 1.0 + max_abs(b).max(max_abs(lo)).max(max_abs(z));
     let mut rho = c.mul(z);
     for (ri, bi) in rho.iter_mut().zip(b) {
@@ -2069,7 +2075,7 @@ pub fn kkt(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64], z: &[f64], r:
 /// `|ΔC| ≤ 4u|C|` (`|L||D||Lᵀ| = |C|` on SPD tridiagonal matrices, Higham Thm 9.14) after `γ₂`
 /// in its right side; the reactions are rounded rows of `Cz − b` (`γ₃`) and recomputing
 /// `Cz − b − r` here adds `γ₄`: `TIE_ULPS + 6.5` ulps, rounded up.
-pub const KKT_ULPS: f64 = crate::step::block_pivot::TIE_ULPS + 8.0;
+pub const KKT_ULPS: f64 = viscobar::step::block_pivot::TIE_ULPS + 8.0;
 
 /// [`kkt`] over its per-case bound: `KKT_ULPS ε` times `‖C‖∞‖z‖∞ + ‖b‖∞ + ‖r‖∞` (stationarity,
 /// clamped reactions) and times `max(‖z‖∞, ‖lo‖∞)` (a free gap), over `kkt`'s scale. The
@@ -2082,7 +2088,7 @@ pub fn kkt_ratio(
     z: &[f64],
     r: &[f64],
 ) -> f64 {
-    use crate::linalg::norms::max_abs;
+    use viscobar::linalg::norms::max_abs;
     let scale = 1.0 + max_abs(b).max(max_abs(lo)).max(max_abs(z));
     let data =
         (c.inf_norm() * max_abs(z) + max_abs(b) + max_abs(r)).max(max_abs(z).max(max_abs(lo)));
@@ -2092,7 +2098,7 @@ pub fn kkt_ratio(
 }
 
 /// The error of the exact solver failing on case (or call) `case` of a registry sample.
-fn exact_sample_error(case: usize) -> impl FnOnce(crate::step::StepFailure) -> RunError {
+fn exact_sample_error(case: usize) -> impl FnOnce(viscobar::step::StepFailure) -> RunError {
     move |failure| RunError::Step {
         step: case,
         time: 0.0,
@@ -2109,8 +2115,8 @@ pub const KKT_SAMPLE_CASES: usize = 200;
 /// 3000, every node bounded) and `tests/osqp_many_bounds.rs` (n up to 400, every node or a
 /// random half, two problems in a row: the second warm-started).
 pub fn random_kkt_worst() -> Result<(f64, f64), RunError> {
-    use crate::step::StepSolver;
-    use crate::step::block_pivot::BlockPivotSolver;
+    use viscobar::step::StepSolver;
+    use viscobar::step::block_pivot::BlockPivotSolver;
     let mut rnd = stream(2026);
     let (mut ratio, mut worst) = (0.0f64, 0.0f64);
     for case in 0..KKT_SAMPLE_CASES {
@@ -2145,8 +2151,8 @@ pub const EQUAL_ERROR_RTOL: f64 = 1e-6;
 /// The study of `tests/converge.rs`'s `exact_solver_beats_tight_osqp_at_equal_error_on_a_talk_scene`:
 /// one-end at 100 elements and Δt = 0.02, exact and OSQP (eps 1e-10), two levels; rows
 /// `0..2` exact, `2..4` OSQP.
-pub fn equal_error_study() -> Result<crate::study::converge::Study, RunError> {
-    use crate::study::converge::{self, ConvergeError, SolverSetting};
+pub fn equal_error_study() -> Result<viscobar::study::converge::Study, RunError> {
+    use viscobar::study::converge::{self, ConvergeError, SolverSetting};
     let overrides = [
         "mesh.elements=100".to_string(),
         "time.step=0.02".to_string(),
@@ -2165,7 +2171,7 @@ pub fn equal_error_study() -> Result<crate::study::converge::Study, RunError> {
 
 /// What [`EQUAL_ERROR_RTOL`] guards on [`equal_error_study`]: the largest
 /// `l2_exact / l2_osqp − 1` over its levels (negative: exact is strictly better).
-pub fn equal_error_excess(study: &crate::study::converge::Study) -> f64 {
+pub fn equal_error_excess(study: &viscobar::study::converge::Study) -> f64 {
     let levels = study.rows.len() / 2;
     (0..levels)
         .map(|l| study.rows[l].l2_error / study.rows[levels + l].l2_error - 1.0)
@@ -2198,7 +2204,7 @@ pub const RESIDUAL_ENTRY_ROUNDINGS: f64 = 8.0;
 /// `|r_j − r*_j| <= |ρ_{n_j}| + ‖C‖₂ ‖d‖₂`. `ρ` is the computed residual plus its rounding
 /// (`RESIDUAL_ENTRY_ROUNDINGS · u · (|C||z| + |b| + |r|)` entrywise); `‖C‖₂ <= ‖C‖∞`; `λ` is
 /// the bisection's smallest eigenvalue less its error bound
-/// ([`crate::linalg::spectrum::reference::STURM_ERROR_ULPS`] `ε ‖C‖∞`). For an exactly
+/// ([`viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS`] `ε ‖C‖∞`). For an exactly
 /// feasible, complementary answer (`g, r >= 0`, `r·g = 0`) it is the classic `‖ρ‖₂ / λ_min`.
 /// Returns the bound on `‖d‖₂` and the bounds on `|r_j − r*_j|`; infinite when `λ <= 0`.
 pub fn oracle_distance_bound(
@@ -2238,8 +2244,8 @@ pub fn oracle_distance_bound(
         .map(|(x, s)| x.abs() + RESIDUAL_ENTRY_ROUNDINGS * u * s)
         .collect();
     let c_norm = c.inf_norm();
-    let lambda = crate::linalg::spectrum::smallest_eigenvalue_spd(c)
-        - crate::linalg::spectrum::reference::STURM_ERROR_ULPS * f64::EPSILON * c_norm;
+    let lambda = viscobar::linalg::spectrum::smallest_eigenvalue_spd(c)
+        - viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS * f64::EPSILON * c_norm;
     if lambda <= 0.0 || !lambda.is_finite() {
         return (f64::INFINITY, vec![f64::INFINITY; nodes.len()]);
     }
@@ -2281,8 +2287,8 @@ pub fn oracle_agreement(
     z: &[f64],
     r: &[f64],
 ) -> f64 {
-    let zscale = 1.0 + crate::linalg::norms::max_abs(z);
-    let Ok(Some(oracle)) = crate::step::oracle::brute_force(
+    let zscale = 1.0 + viscobar::linalg::norms::max_abs(z);
+    let Ok(Some(oracle)) = viscobar::step::oracle::brute_force(
         &c.to_dense(),
         b,
         nodes,
@@ -2308,8 +2314,8 @@ pub fn oracle_agreement(
 /// `tests/exact_solver.rs`'s distribution: n up to 23, no bound, either end or both, two
 /// problems in a row (the second `s b` with bounds moved by `t`: warm-started).
 pub fn oracle_agreement_worst() -> Result<f64, RunError> {
-    use crate::step::StepSolver;
-    use crate::step::exact::ExactSolver;
+    use viscobar::step::StepSolver;
+    use viscobar::step::exact::ExactSolver;
     let mut rnd = stream(22);
     let mut worst = 0.0f64;
     for case in 0..KKT_SAMPLE_CASES * 5 {

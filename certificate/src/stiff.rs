@@ -9,9 +9,9 @@
 //!
 //! Per run (solver): the largest relative energy-identity residual, the largest penetration,
 //! the distance to the exact solver (max over nodes and steps), the cumulative drift of the
-//! energy balance, and, for the exact solver, the KKT audit of [`crate::step::audit`] at its
+//! energy balance, and, for the exact solver, the KKT audit of [`viscobar::step::audit`] at its
 //! round-off floors (`eps = 0`), an independent check of the reference itself. `κ(C)` comes
-//! from [`crate::linalg::spectrum`].
+//! from [`viscobar::linalg::spectrum`].
 //!
 //! Tolerances, a posteriori (issue #22): each step's tolerance is computed from what that step
 //! formed ([`StepTerms`]), not from `κ(C)` and a worst-case size. On the computed vectors the
@@ -38,12 +38,12 @@
 //! This file holds what is checked: the cases, the tolerances, the verdict and the table of
 //! VERIFICATION.md. Running the cases is `study::stiff_runs`.
 
-use crate::scene::Scene;
-use crate::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
-use crate::step::osqp::OSQP_DEFAULT_EPS;
-use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
-use crate::time::RunError;
 use std::fmt::Write;
+use viscobar::scene::Scene;
+use viscobar::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
+use viscobar::step::osqp::OSQP_DEFAULT_EPS;
+use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::time::RunError;
 
 /// Full size (`viscobar verify --stiff`) or the reduced size of `tests/stiff.rs`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

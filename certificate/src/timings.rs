@@ -5,14 +5,14 @@
 //! `viscobar verify --timings`). Runs through `study::converge` (errors in parallel, then a
 //! serial timing pass, median of [`REPEATS`]).
 
-use crate::scene::{self, Scene};
-use crate::study::converge::{
-    ConvergeError, OSQP_EPS, PENALTY_EPSILON, Row, SolverSetting, Study, StudyOptions, study_with,
-};
-use crate::study::verify::Section;
-use crate::time::simulation::Simulation;
+use crate::verify::Section;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use viscobar::scene::{self, Scene};
+use viscobar::study::converge::{
+    ConvergeError, OSQP_EPS, PENALTY_EPSILON, Row, SolverSetting, Study, StudyOptions, study_with,
+};
+use viscobar::time::simulation::Simulation;
 
 /// Timing repeats per run; the median is kept.
 pub const REPEATS: usize = 3;
@@ -352,27 +352,22 @@ pub fn sections(figures: Option<&Path>) -> Result<Vec<Section>, ConvergeError> {
     ])
 }
 
-/// `work-precision-<scene>.png` per study into `dir` (with the `plots` feature; without it,
-/// nothing).
+/// `work-precision-<scene>.png` per study into `dir`.
 pub fn write_figures(studies: &[Study], dir: &Path) -> Result<Vec<PathBuf>, ConvergeError> {
-    #[cfg_attr(not(feature = "plots"), expect(unused_mut))]
     let mut files = Vec::new();
-    #[cfg(feature = "plots")]
     for st in studies {
         std::fs::create_dir_all(dir).map_err(|source| ConvergeError::Write {
             path: dir.to_path_buf(),
             source,
         })?;
         let path = dir.join(format!("work-precision-{}.png", st.scene));
-        crate::study::work_precision::write_work_precision(&path, &st.title(), &st.lines())
+        viscobar::study::work_precision::write_work_precision(&path, &st.title(), &st.lines())
             .map_err(|e| ConvergeError::Draw {
                 path: path.clone(),
                 message: e.to_string(),
             })?;
         files.push(path);
     }
-    #[cfg(not(feature = "plots"))]
-    let _ = (studies, dir);
     Ok(files)
 }
 

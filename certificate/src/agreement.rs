@@ -9,21 +9,21 @@
 //!
 //! Everything is deterministic (no timings): the same build prints the same numbers.
 
-use crate::linalg::ldlt::Ldlt;
-use crate::linalg::norms::{max_abs, max_distance};
-use crate::linalg::tridiag::SymTridiag;
-use crate::scene::{self, Scene};
-use crate::step::StepSolver;
-use crate::step::audit::dual_tolerance;
-use crate::step::exact::ExactSolver;
-use crate::step::osqp::{OsqpSettings, OsqpSolver, raw_problem};
-use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
-use crate::study::accuracy::observed_order;
-use crate::study::compare::{StepProblem, compare, start_up_problem};
-use crate::time::RunError;
-use crate::time::run::run_in_memory;
 use osqp::Status;
 use std::fmt::Write;
+use viscobar::linalg::ldlt::Ldlt;
+use viscobar::linalg::norms::{max_abs, max_distance};
+use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::scene::{self, Scene};
+use viscobar::step::StepSolver;
+use viscobar::step::audit::dual_tolerance;
+use viscobar::step::exact::ExactSolver;
+use viscobar::step::osqp::{OsqpSettings, OsqpSolver, raw_problem};
+use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::study::accuracy::observed_order;
+use viscobar::study::compare::{StepProblem, compare, start_up_problem};
+use viscobar::time::RunError;
+use viscobar::time::run::run_in_memory;
 
 /// The four parts above, as Markdown.
 pub fn markdown() -> Result<String, RunError> {
@@ -48,8 +48,8 @@ fn with_method(m: &str, extra: &[String]) -> Vec<String> {
 /// The audit report of an OSQP or penalty run (both always audit).
 fn audit_of<'a>(
     name: &str,
-    s: &'a crate::time::summary::Summary,
-) -> Result<&'a crate::step::AuditReport, RunError> {
+    s: &'a viscobar::time::summary::Summary,
+) -> Result<&'a viscobar::step::AuditReport, RunError> {
     s.audit.as_ref().ok_or_else(|| RunError::SolverSetup {
         solver: s.solver.clone(),
         reason: format!("{name}: the run kept no audit report"),
