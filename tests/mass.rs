@@ -9,7 +9,8 @@ use common::viscobar;
 
 use viscobar::bar::Discretisation;
 use viscobar::scene::MassVariant;
-use viscobar::study::mass_variants::{MassRow, group_order, groups, mass_study, run_with_mass};
+use viscobar::study::mass_variants::run_with_mass;
+use viscobar_certificate::mass_study::{MassRow, group_order, groups, mass_study};
 
 /// The refused combinations exit 2 with a message naming both keys, and write nothing.
 #[test]

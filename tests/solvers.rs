@@ -18,9 +18,10 @@ use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
 use viscobar::step::penalty::PenaltySettings;
 use viscobar::step::{StepFailure, StepSolver};
 use viscobar::study::accuracy::observed_order;
-use viscobar::study::compare::{compare, start_up_problem};
+use viscobar::study::compare::compare;
 use viscobar::time::run::run_in_memory;
 use viscobar::time::simulation::Simulation;
+use viscobar_certificate::agreement::start_up_problem;
 use viscobar_certificate::agreement::stiff_impact_overrides;
 
 // ---- tolerances -------------------------------------------------------------------------

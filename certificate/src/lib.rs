@@ -3,18 +3,23 @@
 //! The certificate of [`viscobar`]: the studies that recompute the generated tables of
 //! VERIFICATION.md ([`verify`]), the tolerance registry that measures every tolerance of the
 //! tests against the worst value it guards ([`tolerances`]), the stiff and extreme case matrix
-//! ([`stiff`], [`stiff_runs`]), the step solvers' agreement ([`agreement`]), the plane body's
-//! checks ([`plane_checks`], [`plane_contact`]), the manufactured viscous contact solution
-//! ([`viscous_contact`]) and the error-against-run-time study ([`timings`]).
+//! ([`stiff`], [`stiff_runs`]), the step solvers' agreement ([`agreement`]) with the dense
+//! brute-force [`oracle`], the round-off of the rigid mode ([`roundoff`]), the mass variants
+//! side by side ([`mass_study`]), the plane body's checks ([`plane_checks`],
+//! [`plane_contact`]), the manufactured viscous contact solution ([`viscous_contact`]) and the
+//! error-against-run-time study ([`timings`]).
 //!
 //! A member crate of the viscobar workspace, beside the library and not part of its API: it
-//! imports `viscobar`, and the integration tests of `viscobar` import it (a dev-dependency)
-//! so that a test and the registry share one constant. Its commands: `cargo run --release -p
-//! viscobar-certificate -- --help`.
+//! imports `viscobar`, and the integration tests of `viscobar` import it (a dev-dependency),
+//! so that a test and the registry share one constant. Its commands:
+//! `cargo run --release -p viscobar-certificate -- --help`.
 
 pub mod agreement;
+pub mod mass_study;
+pub mod oracle;
 pub mod plane_checks;
 pub mod plane_contact;
+pub mod roundoff;
 pub mod stiff;
 pub mod stiff_runs;
 pub mod timings;

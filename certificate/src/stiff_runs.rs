@@ -7,6 +7,7 @@
 //! Apart from the case list, the tolerances and the table (`study::stiff`), which say what is
 //! checked and why; this file only produces the numbers they are checked on.
 
+use crate::roundoff::rigid_drift;
 use crate::stiff::{
     COMBINATION_ROUNDINGS, Case, CaseResult, Family, GAP_ROUNDINGS, RESIDUAL_ROUNDINGS, Size,
     SolverRun, StepTerms, UNIT_ROUNDOFF, Worst, cases, sum_rounding, violation_law,
@@ -21,7 +22,6 @@ use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::audit::{KktAudit, Law};
 use viscobar::step::block_pivot::TIE_ULPS;
 use viscobar::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
-use viscobar::study::accuracy::rigid_drift;
 use viscobar::time::RunError;
 use viscobar::time::simulation::StepRecord;
 use viscobar::time::simulation::{Discretisation, Simulation, make_solver};

@@ -3,12 +3,13 @@
 //! document is regenerated (`viscobar verify --update VERIFICATION.md`), never hand-edited.
 //! Every figure here is deterministic (no timings), so a test checks the document is current.
 
+use crate::roundoff::rigid_mode_drift;
 use std::fmt::Write;
 use viscobar::bar::closed_form;
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
 use viscobar::linalg::norms::max_abs;
 use viscobar::scene;
-use viscobar::study::accuracy::{error_against, observed_order, rigid_mode_drift};
+use viscobar::study::accuracy::{error_against, observed_order};
 use viscobar::time::RunError;
 use viscobar::time::run::run_in_memory;
 
@@ -383,15 +384,15 @@ pub fn stiff_section(results: &[crate::stiff::CaseResult]) -> Section {
 
 /// The mass variants on `impact` and `falling-bar` (`study::mass_variants`; a few seconds).
 fn mass_variants_section() -> Result<Section, viscobar::study::converge::ConvergeError> {
+    use crate::mass_study::{MassStudyError, mass_study};
     use viscobar::study::converge::ConvergeError;
-    use viscobar::study::mass_variants::{MassStudyError, mass_study};
     let rows = mass_study().map_err(|e| match e {
         MassStudyError::Run(r) => ConvergeError::Run(r),
         other => ConvergeError::BadInput(other.to_string()),
     })?;
-    let mut markdown = viscobar::study::mass_variants::certificate_markdown()?;
+    let mut markdown = crate::mass_study::certificate_markdown()?;
     markdown.push('\n');
-    markdown.push_str(&viscobar::study::mass_variants::markdown(&rows));
+    markdown.push_str(&crate::mass_study::markdown(&rows));
     Ok(Section {
         id: "mass-variants",
         markdown,

@@ -1,6 +1,6 @@
 //! One time step's bound-constrained quadratic programme and the solvers behind the
 //! [`StepSolver`] seam: exact enumeration, block pivoting, penalty and OSQP, with the
-//! independent KKT audit of their answers and a dense brute-force oracle for tests.
+//! independent KKT audit of their answers.
 //!
 //! Imports only [`crate::linalg`].
 
@@ -8,7 +8,6 @@ pub mod audit;
 pub mod block_pivot;
 pub mod exact;
 pub mod lcp;
-pub mod oracle;
 pub mod osqp;
 pub mod penalty;
 pub mod report;
