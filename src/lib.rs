@@ -17,7 +17,8 @@
 //! [`linalg`] (tridiagonal kernels) → [`step`] (the step solvers and their audit) →
 //! [`scene`] (input) → [`bar`] (matrices, closed forms) → [`time`] (the time loop, energy
 //! balance and outputs) → [`plane`] (the plane Kelvin–Voigt body, Q1, sparse Cholesky) →
-//! [`study`] (the verification studies).
+//! [`study`] (refinement, comparison, mass variants and figures). The certificate (the tables of
+//! VERIFICATION.md, the tolerance registry) is the workspace member `viscobar-certificate`.
 
 //! # Use as a library
 //!

@@ -358,7 +358,7 @@ fn obstacle_runs_meet_kkt_at_the_round_off_floors_at_every_step() {
 }
 
 /// The registry's seeded sample of the proptests' distributions meets the per-case KKT bound
-/// (`viscobar verify --tolerances` prints its worst ratio).
+/// (`viscobar-certificate verify --tolerances` prints its worst ratio).
 #[test]
 fn seeded_sample_meets_the_per_case_kkt_bound() {
     let (ratio, worst) = viscobar_certificate::tolerances::random_kkt_worst().unwrap();

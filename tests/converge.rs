@@ -9,7 +9,8 @@
 mod common;
 use common::{KINK_ORDER_BAND, MODAL_ORDER, MODAL_ORDER_TOL};
 use viscobar::study::converge::{self, SolverSetting};
-// Defined beside its measurement in the tolerance registry (`viscobar verify --tolerances`).
+// Defined beside its measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`).
 use viscobar::study::viscosity_sweep::viscosity_sweep;
 use viscobar_certificate::tolerances::{EQUAL_ERROR_RTOL, equal_error_excess, equal_error_study};
 

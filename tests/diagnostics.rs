@@ -8,7 +8,8 @@ use common::{ENERGY_RISE_TOL, IDENTITY_TOL};
 use viscobar::Simulation;
 use viscobar::scene::builtin_names;
 
-// Defined beside its measurement in the tolerance registry (`verify --tolerances`).
+// Defined beside its measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`).
 use viscobar_certificate::tolerances::{ENERGY_ROUNDOFF_TOL, THINNING, thinned_energy_error};
 
 #[test]

@@ -10,7 +10,8 @@ use viscobar::study::accuracy::observed_order;
 use viscobar::time::summary::{ContactEpisode, TIME_DIGITS, output_time};
 use viscobar::{Summary, run_in_memory};
 
-// Defined beside its measurement in the tolerance registry (`verify --tolerances`).
+// Defined beside its measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`).
 use viscobar_certificate::tolerances::{RELEASE_ELEMENTS, RELEASE_TOL, release_error};
 
 fn episodes(summary: &Summary, side: &str) -> Vec<ContactEpisode> {

@@ -8,8 +8,8 @@ use proptest::prelude::*;
 use viscobar::Simulation;
 use viscobar::scene::Expression;
 
-// Defined beside its measurement in the tolerance registry (`verify --tolerances`), which
-// measures the separation on fixed loads; the properties below draw more.
+// Defined beside its measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`), which measures the separation on fixed loads; the properties below draw more.
 use viscobar_certificate::tolerances::{SEPARATION_TOL, load_vectors, separation_error};
 
 /// A load's text and the text of its magnitude: the same tree with every factor's absolute

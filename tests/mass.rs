@@ -145,7 +145,8 @@ const REDISTRIBUTED_L2_RATIO_BAND: (f64, f64) = (0.95, 1.05);
 /// Lumped over consistent L2 error, every scene and α: measured 1.14 … 1.52 ("less
 /// accurate").
 const LUMPED_L2_RATIO_MIN: f64 = 1.1;
-// Defined beside their measurement in the tolerance registry (`verify --tolerances`).
+// Defined beside their measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`).
 use viscobar_certificate::tolerances::{DROP_TOL, START_TOL, drop_worst, start_up_motion};
 
 fn finest<'a>(rows: &'a [MassRow], scene: &str, alpha: f64, mass: MassVariant) -> &'a MassRow {

@@ -3,7 +3,8 @@
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
 use viscobar_certificate::verify::SolveCase;
 
-// Defined beside their measurement in the tolerance registry (`viscobar verify --tolerances`).
+// Defined beside their measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`).
 use viscobar_certificate::tolerances::{
     BACKWARD_ULPS, MASS_SUM_TOL, MATRIX_SIZES as SIZES, ldlt_family_worst, mass_sum_worst,
 };
@@ -140,7 +141,8 @@ mod mass_variants {
         REDISTRIBUTED_MIN_ELEMENTS_ONE_END, REDISTRIBUTED_MIN_ELEMENTS_TWO_ENDS,
     };
 
-    // Defined beside their measurement in the tolerance registry (`verify --tolerances`).
+    // Defined beside their measurement in the tolerance registry (`viscobar-certificate verify
+    // --tolerances`).
     use viscobar_certificate::tolerances::{
         EIGEN_TOL_ULPS, ENTRY_TOL, VARIANT_LENGTH as LENGTH, VARIANT_SUM_TOL,
         documented_entries_worst, mass_variant_cases as cases, mass_variant_worst,

@@ -6,7 +6,8 @@ use common::viscobar;
 
 use std::path::PathBuf;
 
-// The plane identity's tolerance: in the registry (study::tolerances), measured there.
+// The plane identity's tolerance: in the registry (viscobar_certificate::tolerances), measured
+// there.
 use viscobar_certificate::tolerances::PLANE_IDENTITY_TOL as IDENTITY_TOL;
 /// A drawn figure is more than its headers: the smallest plausible PNG or SVG of a mesh.
 const MIN_FIGURE_BYTES: u64 = 1000;

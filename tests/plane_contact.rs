@@ -5,8 +5,8 @@
 use viscobar::plane::run::run_plane_in_memory;
 use viscobar_certificate::plane_checks::{bar_case, bar_contact_case_scenes, identity_scenes};
 
-// The tolerances of this file: in the registry (study::tolerances), which measures their worst
-// values over these scenes (`verify --tolerances`).
+// The tolerances of this file: in the registry (viscobar_certificate::tolerances), which measures
+// their worst values over these scenes (`viscobar-certificate verify --tolerances`).
 use viscobar_certificate::tolerances::{
     PLANE_BAR_CASE_TOL as BAR_CASE_TOL, PLANE_GAP_TOL as GAP_TOL,
     PLANE_IDENTITY_TOL as IDENTITY_TOL, PLANE_OSQP_AGREEMENT_TOL as OSQP_AGREEMENT_TOL,

@@ -7,7 +7,8 @@ use common::viscobar;
 
 use std::path::{Path, PathBuf};
 
-// The plane identity's and gap's tolerances: in the registry (study::tolerances), measured there.
+// The plane identity's and gap's tolerances: in the registry (viscobar_certificate::tolerances),
+// measured there.
 use viscobar_certificate::tolerances::{
     PLANE_GAP_TOL as GAP_TOL, PLANE_IDENTITY_TOL as IDENTITY_TOL,
 };

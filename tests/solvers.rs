@@ -27,7 +27,7 @@ use viscobar_certificate::agreement::stiff_impact_overrides;
 // ---- tolerances -------------------------------------------------------------------------
 
 // The solver tolerances, defined beside their measurement in the tolerance registry
-// (`viscobar verify --tolerances`, `study::tolerances::solver_worst`).
+// (`viscobar-certificate verify --tolerances`, `tolerances::solver_worst`).
 use viscobar_certificate::tolerances::{
     OSQP_AGREEMENT_TOL, OSQP_GAP_TOL, OSQP_REACTION_TOL, PENALTY_LAW_TOL, SMALL_TOL,
     osqp_small_problems, solver_cases, solver_worst,

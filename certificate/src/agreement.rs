@@ -1,5 +1,5 @@
 //! The measured figures of VERIFICATION.md, section "Step solvers" (generated block
-//! `solver-agreement`, `viscobar verify --update VERIFICATION.md`):
+//! `solver-agreement`, `verify --update VERIFICATION.md`; alone: `solver-agreement`):
 //!
 //! 1. OSQP and penalty against the exact solver on every built-in scene (whole runs, every
 //!    node and step), with their audits;
@@ -7,7 +7,8 @@
 //! 3. OSQP's failures on a stiff scene, with OSQP's own verdict next to viscobar's;
 //! 4. a seeded sample of random step problems, OSQP against exact.
 //!
-//! Everything is deterministic (no timings): the same build prints the same numbers.
+//! Everything is deterministic (no timings): the same build prints the same numbers. The
+//! start-up step problem of a scene ([`start_up_problem`]) lets a solver be probed alone.
 
 use osqp::Status;
 use std::fmt::Write;

@@ -1,8 +1,13 @@
-//! The certificate's commands: `verify` regenerates the measured tables of VERIFICATION.md.
+//! The certificate's commands: `verify` regenerates the measured tables of VERIFICATION.md,
+//! `solver-agreement` prints one of them, `bench-table` writes the criterion timings into
+//! README.md and benches/README.md, `peak-memory` measures a long run's resident memory.
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
-use viscobar_certificate::{stiff, stiff_runs, timings, verify};
+use viscobar_certificate::peak_memory::Ends;
+use viscobar_certificate::{
+    agreement, bench_table, peak_memory, stiff, stiff_runs, timings, verify,
+};
 
 #[derive(Parser)]
 #[command(
@@ -36,6 +41,29 @@ enum Command {
         #[arg(long, value_name = "DIR", requires = "timings")]
         figures: Option<PathBuf>,
     },
+    /// Print the measured figures of VERIFICATION.md's section "Step solvers" (the generated
+    /// block `solver-agreement`, which `verify --update VERIFICATION.md` writes) as Markdown.
+    SolverAgreement,
+    /// Print criterion's last measurements of the step and scene benches as Markdown tables,
+    /// with the performance targets (run `cargo bench --bench step` and `--bench scenes` first).
+    BenchTable {
+        /// Rewrite the generated timing blocks of these files instead of printing.
+        #[arg(long, value_name = "FILE", num_args = 1..)]
+        update: Option<Vec<PathBuf>>,
+    },
+    /// Run a long viscoelastic bar to files and print its timings and the peak resident memory
+    /// of this process (target: 1e6 elements, 1e4 steps under 200 MB).
+    PeakMemory {
+        /// Elements of the bar (Δt = Δx = 1/ELEMENTS).
+        #[arg(default_value_t = 1_000_000)]
+        elements: u64,
+        /// Time steps.
+        #[arg(default_value_t = 10_000)]
+        steps: u64,
+        /// The ends: free-free, or Signorini obstacles under one or both ends.
+        #[arg(value_enum, default_value_t = Ends::Free)]
+        ends: Ends,
+    },
 }
 
 fn main() {
@@ -47,6 +75,28 @@ fn main() {
             timings,
             figures,
         } => run_verify(update, stiff, tolerances, timings.then_some(figures)),
+        Command::SolverAgreement => match agreement::markdown() {
+            Ok(md) => {
+                print!("{md}");
+                0
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                e.exit_code()
+            }
+        },
+        Command::BenchTable { update } => bench_table::run(update.as_deref()),
+        Command::PeakMemory {
+            elements,
+            steps,
+            ends,
+        } => match peak_memory::run(elements, steps, ends) {
+            Ok(()) => 0,
+            Err(e) => {
+                eprintln!("error: {e}");
+                e.exit_code()
+            }
+        },
     };
     std::process::exit(code);
 }

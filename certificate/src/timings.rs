@@ -1,8 +1,8 @@
-//! VERIFICATION.md, "Error against run time" (issue #18): every solver setting at 4–5 levels
+//! VERIFICATION.md, "Error against run time": every solver setting at 4–5 levels
 //! on five scenes, errors against a closed form or a 4x finer exact run, and the wall time of
 //! the steps. Two generated blocks: the errors (deterministic; `tests/error_time_doc.rs` checks
 //! part of them) and the timings with the machine they were taken on (regenerated only by
-//! `viscobar verify --timings`). Runs through `study::converge` (errors in parallel, then a
+//! `verify --timings`). Runs through `viscobar::study::converge` (errors in parallel, then a
 //! serial timing pass, median of [`REPEATS`]).
 
 use crate::verify::Section;
@@ -320,7 +320,7 @@ pub fn utc_date_time_at(secs: u64) -> String {
 pub const ERRORS_ID: &str = "error-time-errors";
 pub const TIMINGS_ID: &str = "error-time-timings";
 
-/// The whole study (`viscobar verify --timings`): both blocks, and with `figures` the diagrams
+/// The whole study (`verify --timings`): both blocks, and with `figures` the diagrams
 /// `work-precision-<scene>.png` written there. Cases run one after the other; in each, errors
 /// in parallel, then the serial timing pass.
 pub fn sections(figures: Option<&Path>) -> Result<Vec<Section>, ConvergeError> {

@@ -1,6 +1,7 @@
-//! `viscobar verify`: recomputes the measured figures of VERIFICATION.md and prints them as
-//! Markdown tables, each between `<!-- generated:ID -->` and `<!-- end:ID -->` markers, so the
-//! document is regenerated (`viscobar verify --update VERIFICATION.md`), never hand-edited.
+//! `verify` (`cargo run --release -p viscobar-certificate -- verify`): recomputes the measured
+//! figures of VERIFICATION.md and prints them as Markdown tables, each between
+//! `<!-- generated:ID -->` and `<!-- end:ID -->` markers, so the document is regenerated
+//! (`verify --update VERIFICATION.md`), never hand-edited.
 //! Every figure here is deterministic (no timings), so a test checks the document is current.
 
 use crate::roundoff::rigid_mode_drift;
@@ -323,7 +324,7 @@ fn roundoff_section((ours, talk): (f64, f64)) -> Section {
     }
 }
 
-/// The whole output of `viscobar verify`.
+/// The whole output of `verify`.
 pub fn render(sections: &[Section]) -> String {
     let mut out = String::new();
     for s in sections {
@@ -374,7 +375,7 @@ fn viscosity_section() -> Result<Section, viscobar::study::converge::ConvergeErr
 }
 
 /// The stiff and extreme case matrix from its runs (full size: about 40 s on 2 cores; alone:
-/// `viscobar verify --stiff`); `tests/stiff.rs` runs the reduced size.
+/// `verify --stiff`); `tests/stiff.rs` runs the reduced size.
 pub fn stiff_section(results: &[crate::stiff::CaseResult]) -> Section {
     Section {
         id: "stiff",
@@ -399,7 +400,7 @@ fn mass_variants_section() -> Result<Section, viscobar::study::converge::Converg
     })
 }
 
-/// The tolerance registry (`viscobar verify --tolerances`, `study::tolerances`), with the stiff
+/// The tolerance registry (`verify --tolerances`, [`crate::tolerances`]), with the stiff
 /// matrix's checks read from `results` and the rigid-mode drift `increment_drift` of
 /// [`rigid_drift`].
 pub fn tolerances_section(

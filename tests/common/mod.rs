@@ -10,7 +10,7 @@ use viscobar_certificate::agreement::{MAX_MARGIN, diagonally_dominant};
 // ---- tolerances shared by several test files -----------------------------------------------
 
 /// Scene-wide round-off tolerances, defined beside their measurement in the tolerance registry
-/// (`viscobar verify --tolerances`).
+/// (`viscobar-certificate verify --tolerances`).
 #[allow(unused_imports)] // each test file uses some of them
 pub use viscobar_certificate::tolerances::{
     COMPLEMENTARITY_TOL, ENERGY_RISE_TOL, GAP_TOL, IDENTITY_TOL, REACTION_TOL,
@@ -48,7 +48,7 @@ pub fn spd_tridiag(max_n: usize) -> impl Strategy<Value = SymTridiag> {
 }
 
 /// The KKT residual, its per-case round-off bound and the tests' seeded data stream, defined
-/// beside their measurement in the tolerance registry (`viscobar verify --tolerances`).
+/// beside their measurement in the tolerance registry (`viscobar-certificate verify --tolerances`).
 #[allow(unused_imports)] // each test file uses some of them
 pub use viscobar_certificate::tolerances::{kkt, kkt_ratio, stream};
 

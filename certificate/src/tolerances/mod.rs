@@ -574,7 +574,7 @@ pub fn markdown(measured: &[Measured], stiff: &[StiffCheck], uncovered: &[Uncove
 
 /// The whole registry as Markdown: measured tolerances, the stiff matrix's checks from
 /// `results`, and the rest (the generated block `tolerances` of VERIFICATION.md).
-/// `increment_drift` and `backward_ulps` are measured by `study::verify` (the rigid-mode run
+/// `increment_drift` and `backward_ulps` are measured by [`crate::verify`] (the rigid-mode run
 /// of its round-off table; its solve study on `tests/matrices.rs`'s node counts).
 pub fn registry_markdown(
     results: &[CaseResult],

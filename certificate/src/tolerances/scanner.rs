@@ -3,12 +3,7 @@
 //! reason it is not measured.
 
 use super::Uncovered;
-
-/// The workspace's root folder (the `viscobar` package), which the scanned paths are relative to.
-fn workspace_root() -> &'static std::path::Path {
-    let certificate = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    certificate.parent().unwrap_or(certificate)
-}
+use crate::workspace_root;
 
 /// Files scanned for tolerance constants: every test file and the stiff matrix.
 fn scanned_files() -> Vec<std::path::PathBuf> {
