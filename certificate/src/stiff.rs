@@ -526,8 +526,8 @@ pub fn markdown(results: &[CaseResult]) -> String {
     md
 }
 
-/// Ratios below this are listed under the table with their reason (issue #22: a tolerance at
-/// most 1000 times what it guards, unless the table says why).
+/// Ratios below this are listed under the table with their reason (the registry's rule: a
+/// tolerance at most 1000 times what it guards, unless the table says why).
 pub const NOTE_RATIO_FLOOR: f64 = 1e-3;
 
 /// Why a completed run's check has a nonzero ratio below [`NOTE_RATIO_FLOOR`], from what the
