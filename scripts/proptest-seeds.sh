@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Runs every test target that holds a property test (proptest) once per seed FIRST..=LAST.
+# Runs every test target that holds a property test (proptest) once per seed FIRST..=LAST: the
+# unit tests of both workspace members (viscobar and the certificate) and the tests/ files.
 # `cargo test` draws from the fixed seed of .cargo/config.toml; this explores the others.
 # A failing case is reported with its seed and saved by proptest under proptest-regressions/
 # (commit that file: its cases are replayed before the seeded ones).
@@ -10,7 +11,7 @@ if [ $# -ne 2 ] || ! [[ "$1" =~ ^[0-9]+$ && "$2" =~ ^[0-9]+$ ]]; then
   echo "usage: bash scripts/proptest-seeds.sh FIRST LAST (two seeds, u64)" >&2
   exit 2
 fi
-targets=(--lib)
+targets=(--workspace --lib)
 for f in tests/*.rs; do
   if grep -q 'proptest!\|proptest::test_runner' "$f"; then
     targets+=(--test "$(basename "$f" .rs)")

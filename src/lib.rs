@@ -18,7 +18,8 @@
 //! problem's solvers and their audit) → [`scene`] (input) → [`scheme`] (the talk's scheme for
 //! any body) → [`bar`] (P1 matrices, the bar's kernels, closed forms) → [`plane`] (the plane
 //! Kelvin–Voigt body, Q1, sparse Cholesky) → [`output`] (runs and their files, both bodies) →
-//! [`study`] (refinement, comparison, figures).
+//! [`study`] (refinement, comparison, mass variants and figures). The certificate (the tables
+//! of VERIFICATION.md, the tolerance registry) is the workspace member `viscobar-certificate`.
 
 //! # Use as a library
 //!

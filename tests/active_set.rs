@@ -4,14 +4,14 @@
 
 mod common;
 use common::kkt_ratio;
-use viscobar::study::tolerances::oracle_agreement;
+use viscobar_certificate::tolerances::oracle_agreement;
 
 use proptest::prelude::*;
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::block_pivot::BlockPivotSolver;
-use viscobar::step::oracle::brute_force;
+use viscobar_certificate::oracle::brute_force;
 
 fn solve(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64]) -> (Vec<f64>, Vec<f64>, u32) {
     let mut s = BlockPivotSolver::new(c, nodes).unwrap();
@@ -358,10 +358,10 @@ fn obstacle_runs_meet_kkt_at_the_round_off_floors_at_every_step() {
 }
 
 /// The registry's seeded sample of the proptests' distributions meets the per-case KKT bound
-/// (`viscobar verify --tolerances` prints its worst ratio).
+/// (`viscobar-certificate verify --tolerances` prints its worst ratio).
 #[test]
 fn seeded_sample_meets_the_per_case_kkt_bound() {
-    let (ratio, worst) = viscobar::study::tolerances::random_kkt_worst().unwrap();
+    let (ratio, worst) = viscobar_certificate::tolerances::random_kkt_worst().unwrap();
     println!("seeded sample: worst kkt {worst:e}, worst ratio to the per-case bound {ratio:e}");
     assert!(ratio <= 1.0, "worst ratio {ratio:e}");
 }

@@ -5,7 +5,7 @@ mod common;
 use common::viscobar;
 
 use std::process::Command;
-use viscobar::study::tolerances::osqp_agreement_bound;
+use viscobar_certificate::tolerances::osqp_agreement_bound;
 
 fn tmpdir(name: &str) -> std::path::PathBuf {
     common::fresh_dir("cli", name)

@@ -1,8 +1,8 @@
 //! Convergence to the closed-form solutions shipped with the built-in scenes.
 //!
-//! The refinement study behind the bounds is `cargo run --release -- verify` (five
-//! levels, dx and dt halved together): modal order 1.995; impact 0.686; clamped-impact 0.680,
-//! with L2 errors 2.10e-2 and 1.09e-2 at the scenes' own meshes.
+//! The refinement study behind the bounds is `cargo run --release -p viscobar-certificate --
+//! verify` (five levels, dx and dt halved together): modal order 1.995; impact 0.686;
+//! clamped-impact 0.680, with L2 errors 2.10e-2 and 1.09e-2 at the scenes' own meshes.
 
 mod common;
 use common::{KINK_ORDER_BAND, MODAL_ORDER, MODAL_ORDER_TOL};
@@ -10,8 +10,8 @@ use viscobar::bar::closed_form::{self, ClosedForm, FallingBar, ForcedMode};
 use viscobar::study::accuracy::{error_against, observed_order};
 
 // Error bounds at the scenes' own meshes: 1.25x the measured L2 error, defined beside their
-// measurement in the tolerance registry (`viscobar verify --tolerances`).
-use viscobar::study::tolerances::{
+// measurement in the tolerance registry (`viscobar-certificate verify --tolerances`).
+use viscobar_certificate::tolerances::{
     CLAMPED_IMPACT_L2_BOUND, CONTACT_TIME_TOL, FALLING_BAR_L2_BOUND, FALLING_BAR_ROUNDOFF, FD_STEP,
     IMPACT_L2_BOUND, MEAN_REACTION_TOL, builtin_falling_bar, falling_bar_identities_worst,
     falling_bar_quadrature, falling_bar_reaction_fd_ratio, impact_contact_errors,

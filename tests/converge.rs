@@ -9,9 +9,10 @@
 mod common;
 use common::{KINK_ORDER_BAND, MODAL_ORDER, MODAL_ORDER_TOL};
 use viscobar::study::converge::{self, SolverSetting};
-// Defined beside its measurement in the tolerance registry (`viscobar verify --tolerances`).
-use viscobar::study::tolerances::{EQUAL_ERROR_RTOL, equal_error_excess, equal_error_study};
+// Defined beside its measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`).
 use viscobar::study::viscosity_sweep::viscosity_sweep;
+use viscobar_certificate::tolerances::{EQUAL_ERROR_RTOL, equal_error_excess, equal_error_study};
 
 /// OSQP does ~50 ADMM iterations per step where the exact solver does one factorised solve
 /// and an enumeration; measured ~40x, required 3x so that a loaded test machine still passes.

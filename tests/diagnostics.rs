@@ -8,8 +8,9 @@ use common::{ENERGY_RISE_TOL, IDENTITY_TOL};
 use viscobar::Simulation;
 use viscobar::scene::builtin_names;
 
-// Defined beside its measurement in the tolerance registry (`verify --tolerances`).
-use viscobar::study::tolerances::{ENERGY_ROUNDOFF_TOL, THINNING, thinned_energy_error};
+// Defined beside its measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`).
+use viscobar_certificate::tolerances::{ENERGY_ROUNDOFF_TOL, THINNING, thinned_energy_error};
 
 #[test]
 fn thinning_leaves_the_trajectory_unchanged_and_measured_steps_close_the_identity() {

@@ -5,8 +5,9 @@ mod common;
 use common::{COMPLEMENTARITY_TOL, ENERGY_RISE_TOL, GAP_TOL, IDENTITY_TOL, REACTION_TOL};
 use viscobar::scene::{self, MassVariant, builtin_names};
 use viscobar::time::run::run_in_memory;
-// Defined beside their measurement in the tolerance registry (`viscobar verify --tolerances`).
-use viscobar::study::tolerances::{
+// Defined beside their measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`).
+use viscobar_certificate::tolerances::{
     RESTING_TOL, START_ENERGY_ERROR_PER_DX, resting_bar_worst, start_energy_errors,
 };
 

@@ -10,8 +10,9 @@ use viscobar::study::accuracy::observed_order;
 use viscobar::time::summary::{ContactEpisode, TIME_DIGITS, output_time};
 use viscobar::{Summary, run_in_memory};
 
-// Defined beside its measurement in the tolerance registry (`verify --tolerances`).
-use viscobar::study::tolerances::{RELEASE_ELEMENTS, RELEASE_TOL, release_error};
+// Defined beside its measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`).
+use viscobar_certificate::tolerances::{RELEASE_ELEMENTS, RELEASE_TOL, release_error};
 
 fn episodes(summary: &Summary, side: &str) -> Vec<ContactEpisode> {
     summary.contact_episodes[side].clone()

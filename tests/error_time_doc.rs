@@ -1,12 +1,12 @@
 //! VERIFICATION.md, "Error against run time": its error block must be what the code computes
 //! now. The whole study (OSQP at 800–1024 elements, three timing repeats) takes minutes and runs
-//! behind `viscobar verify --timings`; this test recomputes the cheap part, the exact solver and
-//! the penalty settings on every scene, with the reference run and its estimated error, and
-//! finds each of their lines in the block (the OSQP rows are checked only by rerunning the
-//! command). The timing block is machine-dependent and not checked.
+//! behind `viscobar-certificate verify --timings`; this test recomputes the cheap part, the
+//! exact solver and the penalty settings on every scene, with the reference run and its
+//! estimated error, and finds each of their lines in the block (the OSQP rows are checked only
+//! by rerunning the command). The timing block is machine-dependent and not checked.
 
 use viscobar::study::converge::{SolverSetting, StudyOptions, study_with};
-use viscobar::study::timings::{CASES, ERRORS_ID, errors_markdown, settings_for};
+use viscobar_certificate::timings::{CASES, ERRORS_ID, errors_markdown, settings_for};
 
 #[test]
 fn error_against_run_time_error_rows_of_exact_and_penalty_are_current() {
@@ -32,8 +32,8 @@ fn error_against_run_time_error_rows_of_exact_and_penalty_are_current() {
             assert!(
                 block.contains(&line),
                 "VERIFICATION.md's error block lacks (or has another value for)\n{line}\n\
-                 run `cargo run --release -- verify --timings --update VERIFICATION.md --figures \
-                 docs/figures` and review the change"
+                 run `cargo run --release -p viscobar-certificate -- verify --timings --update \
+                 VERIFICATION.md --figures docs/figures` and review the change"
             );
             checked += 1;
         }

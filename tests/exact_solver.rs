@@ -2,18 +2,19 @@
 //! symmetric positive definite tridiagonal problems with zero, one or two bounds.
 
 mod common;
-// Defined beside its measurement in the tolerance registry (`viscobar verify --tolerances`).
-use viscobar::study::tolerances::{TIE_TOL, exact_tie, oracle_agreement};
+// Defined beside its measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`).
+use viscobar_certificate::tolerances::{TIE_TOL, exact_tie, oracle_agreement};
 
 use proptest::prelude::*;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::exact::ExactSolver;
 
-/// KKT residuals of `(z, r)` against their per-case round-off bound (`kkt_ratio`) and its
-/// distance to the dense brute-force oracle against the a-posteriori bound of both answers
-/// (`oracle_agreement`, measured by `viscobar verify --tolerances` on a seeded sample of this
-/// distribution).
+/// KKT residuals of `(z, r)` against their per-case round-off bound (`kkt_ratio`) and its distance
+/// to the dense brute-force oracle against the a-posteriori bound of both answers
+/// (`oracle_agreement`, measured by `viscobar-certificate verify --tolerances` on a seeded sample
+/// of this distribution).
 fn check_against_oracle(
     c: &SymTridiag,
     b: &[f64],

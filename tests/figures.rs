@@ -248,7 +248,7 @@ fn docs_figures_are_the_pngs_the_command_writes() {
         .map(|(n, _)| n)
         .filter(|n| n.ends_with(".png"))
         .collect();
-    let diagrams: Vec<String> = viscobar::study::timings::CASES
+    let diagrams: Vec<String> = viscobar_certificate::timings::CASES
         .iter()
         .map(|c| format!("work-precision-{}.png", c.scene))
         .collect();
@@ -263,7 +263,8 @@ fn docs_figures_are_the_pngs_the_command_writes() {
         assert!(readme.contains(&link), "README does not show {scene}");
     }
     assert!(readme.contains(
-        "cargo run --release -- verify --timings --update VERIFICATION.md --figures docs/figures"
+        "cargo run --release -p viscobar-certificate -- verify --timings --update VERIFICATION.md \
+         --figures docs/figures"
     ));
     for name in &diagrams {
         let link = format!("(docs/figures/{name})");

@@ -8,9 +8,9 @@ use proptest::prelude::*;
 use viscobar::Simulation;
 use viscobar::scene::Expression;
 
-// Defined beside its measurement in the tolerance registry (`verify --tolerances`), which
-// measures the separation on fixed loads; the properties below draw more.
-use viscobar::study::tolerances::{SEPARATION_TOL, load_vectors, separation_error};
+// Defined beside its measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`), which measures the separation on fixed loads; the properties below draw more.
+use viscobar_certificate::tolerances::{SEPARATION_TOL, load_vectors, separation_error};
 
 /// A load's text and the text of its magnitude: the same tree with every factor's absolute
 /// value and every difference a sum, the scale of its round-off.

@@ -9,7 +9,8 @@ use common::viscobar;
 
 use viscobar::bar::Discretisation;
 use viscobar::scene::MassVariant;
-use viscobar::study::mass_variants::{MassRow, group_order, groups, mass_study, run_with_mass};
+use viscobar::study::mass_variants::run_with_mass;
+use viscobar_certificate::mass_study::{MassRow, group_order, groups, mass_study};
 
 /// The refused combinations exit 2 with a message naming both keys, and write nothing.
 #[test]
@@ -144,8 +145,9 @@ const REDISTRIBUTED_L2_RATIO_BAND: (f64, f64) = (0.95, 1.05);
 /// Lumped over consistent L2 error, every scene and α: measured 1.14 … 1.52 ("less
 /// accurate").
 const LUMPED_L2_RATIO_MIN: f64 = 1.1;
-// Defined beside their measurement in the tolerance registry (`verify --tolerances`).
-use viscobar::study::tolerances::{DROP_TOL, START_TOL, drop_worst, start_up_motion};
+// Defined beside their measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`).
+use viscobar_certificate::tolerances::{DROP_TOL, START_TOL, drop_worst, start_up_motion};
 
 fn finest<'a>(rows: &'a [MassRow], scene: &str, alpha: f64, mass: MassVariant) -> &'a MassRow {
     groups(rows)

@@ -1,10 +1,11 @@
 //! Properties of the P1 matrices M and R, and the diagnosis of the talk's printed entries.
 
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
-use viscobar::study::verify::SolveCase;
+use viscobar_certificate::verify::SolveCase;
 
-// Defined beside their measurement in the tolerance registry (`viscobar verify --tolerances`).
-use viscobar::study::tolerances::{
+// Defined beside their measurement in the tolerance registry (`viscobar-certificate verify
+// --tolerances`).
+use viscobar_certificate::tolerances::{
     BACKWARD_ULPS, MASS_SUM_TOL, MATRIX_SIZES as SIZES, ldlt_family_worst, mass_sum_worst,
 };
 
@@ -103,7 +104,7 @@ fn factorisation_solves_spd_tridiagonal_systems() {
 /// for speed in a one-off probe (not in the tree), measured 31 ε on these matrices.
 #[test]
 fn factorisation_is_backward_stable_on_the_step_matrices() {
-    use viscobar::study::verify::{SOLVE_STUDY_CASES, backward_error_nodes, solve_study};
+    use viscobar_certificate::verify::{SOLVE_STUDY_CASES, backward_error_nodes, solve_study};
     let nodes = backward_error_nodes();
     let cases = solve_study(&nodes);
     assert_eq!(
@@ -140,8 +141,9 @@ mod mass_variants {
         REDISTRIBUTED_MIN_ELEMENTS_ONE_END, REDISTRIBUTED_MIN_ELEMENTS_TWO_ENDS,
     };
 
-    // Defined beside their measurement in the tolerance registry (`verify --tolerances`).
-    use viscobar::study::tolerances::{
+    // Defined beside their measurement in the tolerance registry (`viscobar-certificate verify
+    // --tolerances`).
+    use viscobar_certificate::tolerances::{
         EIGEN_TOL_ULPS, ENTRY_TOL, VARIANT_LENGTH as LENGTH, VARIANT_SUM_TOL,
         documented_entries_worst, mass_variant_cases as cases, mass_variant_worst,
     };

@@ -3,7 +3,7 @@
 //! estimate `scene::BYTES_PER_NODE` per node and within a tighter per-scene budget, and must
 //! not grow with the number of steps.
 //! (Peak resident memory of the full J = 1e6, 1e4-step run is measured by
-//! `cargo run --release --example peak_memory`, see benches/README.md.)
+//! `cargo run --release -p viscobar-certificate -- peak-memory`, see benches/README.md.)
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;

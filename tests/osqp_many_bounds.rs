@@ -137,7 +137,8 @@ proptest! {
             let (mut ze, mut re) = (vec![0.0; n], vec![0.0; k]);
             exact.solve(&b, &lo, &mut ze, &mut re).unwrap();
             // The exact answer's KKT residual within its per-case round-off bound (the registry's
-            // `kkt_ratio`, measured by `viscobar verify --tolerances` on a seeded sample).
+            // `kkt_ratio`, measured by `viscobar-certificate verify --tolerances` on a seeded
+            // sample).
             prop_assert!(common::kkt_ratio(&c, &b, &nodes, &lo, &ze, &re) <= 1.0);
             let (mut zo, mut ro) = (vec![0.0; n], vec![0.0; k]);
             osqp.solve(&b, &lo, &mut zo, &mut ro)

@@ -1,17 +1,18 @@
-//! The plane body (issue 20): the energy identity at every step, the bar as an exact special
-//! case, and the observed order of the manufactured solution, on the computations of
-//! `study::plane_checks` (which also writes VERIFICATION.md's "Plane body" tables). Run in
-//! release (the sparse factorisation is ~150x slower in debug).
+//! The plane body: the energy identity at every step, the bar as an exact special case, and the
+//! observed order of the manufactured solution, on the computations of
+//! `viscobar_certificate::plane_checks` (which also writes VERIFICATION.md's "Plane body" tables).
+//! Run in release (the sparse factorisation is ~150x slower in debug).
 
 use viscobar::plane::run::run_plane_in_memory;
-use viscobar::study::plane_checks::{
+use viscobar_certificate::plane_checks::{
     MANUFACTURED_LEVELS, bar_case, bar_case_scenes, identity_scenes, manufactured_level,
     observed_order,
 };
 
-// The identity, energy-rise and bar-case tolerances: in the registry (study::tolerances), which
-// measures their worst values over these scenes (`verify --tolerances`).
-use viscobar::study::tolerances::{
+// The identity, energy-rise and bar-case tolerances: in the registry
+// (viscobar_certificate::tolerances), which measures their worst values over these scenes
+// (`viscobar-certificate verify --tolerances`).
+use viscobar_certificate::tolerances::{
     PLANE_BAR_CASE_TOL as BAR_CASE_TOL, PLANE_ENERGY_RISE_TOL as ENERGY_RISE_TOL,
     PLANE_IDENTITY_TOL as IDENTITY_TOL,
 };

@@ -6,7 +6,7 @@
 
 use viscobar::plane::run::run_plane_in_memory;
 use viscobar::scene::{AnyScene, load_any};
-use viscobar::study::tolerances::IDENTITY_TOL;
+use viscobar_certificate::tolerances::IDENTITY_TOL;
 
 /// The talk's α (the bar's talk scenes).
 const TALK_ALPHA: &str = "0.1";

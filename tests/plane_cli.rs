@@ -6,8 +6,9 @@ use common::viscobar;
 
 use std::path::PathBuf;
 
-// The plane identity's tolerance: in the registry (study::tolerances), measured there.
-use viscobar::study::tolerances::PLANE_IDENTITY_TOL as IDENTITY_TOL;
+// The plane identity's tolerance: in the registry (viscobar_certificate::tolerances), measured
+// there.
+use viscobar_certificate::tolerances::PLANE_IDENTITY_TOL as IDENTITY_TOL;
 /// A drawn figure is more than its headers: the smallest plausible PNG or SVG of a mesh.
 const MIN_FIGURE_BYTES: u64 = 1000;
 /// Three quotients of one total add up to 1 up to their four roundings (each at most ε/2 of

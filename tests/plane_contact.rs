@@ -3,11 +3,11 @@
 //! every built-in plane scene. Run in release.
 
 use viscobar::plane::run::run_plane_in_memory;
-use viscobar::study::plane_checks::{bar_case, bar_contact_case_scenes, identity_scenes};
+use viscobar_certificate::plane_checks::{bar_case, bar_contact_case_scenes, identity_scenes};
 
-// The tolerances of this file: in the registry (study::tolerances), which measures their worst
-// values over these scenes (`verify --tolerances`).
-use viscobar::study::tolerances::{
+// The tolerances of this file: in the registry (viscobar_certificate::tolerances), which measures
+// their worst values over these scenes (`viscobar-certificate verify --tolerances`).
+use viscobar_certificate::tolerances::{
     PLANE_BAR_CASE_TOL as BAR_CASE_TOL, PLANE_GAP_TOL as GAP_TOL,
     PLANE_IDENTITY_TOL as IDENTITY_TOL, PLANE_OSQP_AGREEMENT_TOL as OSQP_AGREEMENT_TOL,
     plane_osqp_agreement_ratio, plane_penalty_ratio,
@@ -100,7 +100,9 @@ fn contact_conditions_and_energy_identity_hold_at_every_node_and_step_of_every_p
 
 #[test]
 fn exact_and_osqp_agree_on_the_two_dimensional_contact_scenes() {
-    use viscobar::study::plane_contact::{CONTACT_SCENES, agreement, osqp_method, plane_scene};
+    use viscobar_certificate::plane_contact::{
+        CONTACT_SCENES, agreement, osqp_method, plane_scene,
+    };
     for name in CONTACT_SCENES {
         let scene = plane_scene(name, &[]).unwrap();
         let a = agreement(&scene, osqp_method()).unwrap();
@@ -131,7 +133,7 @@ const ORDER_BAND: (f64, f64) = (1.55, 2.1);
 
 #[test]
 fn the_tilted_drop_converges_against_a_finer_exact_run() {
-    use viscobar::study::plane_contact::*;
+    use viscobar_certificate::plane_contact::*;
     let scene = plane_scene(
         "plane-tilted-drop",
         &[format!("time.end={CONVERGENCE_END}")],
@@ -155,7 +157,7 @@ const PENALTY_MIN_RATIO: f64 = 10.0;
 #[test]
 fn the_penalty_tends_to_the_exact_solution_as_epsilon_decreases() {
     use viscobar::plane::contact::ContactMethod;
-    use viscobar::study::plane_contact::*;
+    use viscobar_certificate::plane_contact::*;
     let scene = plane_scene("plane-tilted-drop", &[]).unwrap();
     let [a, b] = PENALTY_EPSILONS
         .map(|epsilon| agreement(&scene, ContactMethod::Penalty { epsilon }).unwrap());

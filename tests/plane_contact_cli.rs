@@ -7,8 +7,11 @@ use common::viscobar;
 
 use std::path::{Path, PathBuf};
 
-// The plane identity's and gap's tolerances: in the registry (study::tolerances), measured there.
-use viscobar::study::tolerances::{PLANE_GAP_TOL as GAP_TOL, PLANE_IDENTITY_TOL as IDENTITY_TOL};
+// The plane identity's and gap's tolerances: in the registry (viscobar_certificate::tolerances),
+// measured there.
+use viscobar_certificate::tolerances::{
+    PLANE_GAP_TOL as GAP_TOL, PLANE_IDENTITY_TOL as IDENTITY_TOL,
+};
 
 fn fresh_dir(name: &str) -> PathBuf {
     common::fresh_dir("contact", name)

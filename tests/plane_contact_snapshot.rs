@@ -10,7 +10,7 @@
 use insta::with_settings;
 use serde::Serialize;
 use viscobar::plane::PlaneSimulation;
-use viscobar::study::plane_contact::plane_scene;
+use viscobar_certificate::plane_contact::plane_scene;
 
 /// Significant digits kept, relative to the largest magnitude of each quantity.
 const SIGNIFICANT_DIGITS: i32 = 7;

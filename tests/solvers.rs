@@ -18,16 +18,17 @@ use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
 use viscobar::step::penalty::PenaltySettings;
 use viscobar::step::{StepFailure, StepSolver};
 use viscobar::study::accuracy::observed_order;
-use viscobar::study::agreement::stiff_impact_overrides;
-use viscobar::study::compare::{compare, start_up_problem};
+use viscobar::study::compare::compare;
 use viscobar::time::run::run_in_memory;
 use viscobar::time::simulation::Simulation;
+use viscobar_certificate::agreement::start_up_problem;
+use viscobar_certificate::agreement::stiff_impact_overrides;
 
 // ---- tolerances -------------------------------------------------------------------------
 
 // The solver tolerances, defined beside their measurement in the tolerance registry
-// (`viscobar verify --tolerances`, `study::tolerances::solver_worst`).
-use viscobar::study::tolerances::{
+// (`viscobar-certificate verify --tolerances`, `tolerances::solver_worst`).
+use viscobar_certificate::tolerances::{
     OSQP_AGREEMENT_TOL, OSQP_GAP_TOL, OSQP_REACTION_TOL, PENALTY_LAW_TOL, SMALL_TOL,
     osqp_small_problems, solver_cases, solver_worst,
 };

@@ -1,10 +1,11 @@
-//! The stiff and extreme case matrix in reduced size (meshes up to 1e5 elements, drift runs of
-//! 1e5 steps; the full matrix is `cargo run --release -- verify --stiff`): every case finite,
-//! within its round-off tolerances, or stopped with an error naming its step. The exact
-//! solver must complete every case but the overflowing ones, which every solver must refuse.
+//! The stiff and extreme case matrix in reduced size (meshes up to 1e5 elements, drift runs of 1e5
+//! steps; the full matrix is `cargo run --release -p viscobar-certificate -- verify --stiff`):
+//! every case finite, within its round-off tolerances, or stopped with an error naming its step.
+//! The exact solver must complete every case but the overflowing ones, which every solver must
+//! refuse.
 
-use viscobar::study::stiff::{Family, Size, cases, verdict};
-use viscobar::study::stiff_runs::run_case;
+use viscobar_certificate::stiff::{Family, Size, cases, verdict};
+use viscobar_certificate::stiff_runs::run_case;
 
 #[test]
 fn every_stiff_case_is_correct_or_reported() {

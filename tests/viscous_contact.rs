@@ -6,7 +6,7 @@
 mod common;
 use common::{MODAL_ORDER, MODAL_ORDER_TOL};
 use viscobar::bar::closed_form::{self, ClosedForm, ViscousContact};
-use viscobar::study::viscous_contact::{self, L2_BOUND, REACTION_INTERIOR_BOUND, Row};
+use viscobar_certificate::viscous_contact::{self, L2_BOUND, REACTION_INTERIOR_BOUND, Row};
 
 fn exact() -> ViscousContact {
     viscous_contact::closed_form(&common::builtin("viscous-contact", &[]))
@@ -73,10 +73,10 @@ fn the_scene_is_refused_when_overrides_leave_the_manufactured_data() {
     }
 }
 
-/// Three levels from the scene's mesh (64 elements, dt = dx). Orders measured by `cargo run
-/// --release -- verify` over five levels: L2 1.991, reaction (all steps) 0.818, reaction on the
-/// window's interior 2.039, contact times 0.650; over these three levels 1.988, 0.901, 2.002,
-/// 0.596.
+/// Three levels from the scene's mesh (64 elements, dt = dx). Orders measured by the
+/// certificate's `verify` over five levels: L2 1.991, reaction (all steps) 0.818, reaction on
+/// the window's interior 2.039, contact times 0.650; over these three levels 1.988, 0.901,
+/// 2.002, 0.596.
 const LEVELS: u32 = 3;
 /// Largest reaction error (all steps) at the landing, where the discrete end touches a few
 /// steps early (the gap closes as `(t1 − t)³`) with a reaction of a few percent: order 0.90

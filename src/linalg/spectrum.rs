@@ -390,7 +390,8 @@ mod tests {
     /// double-double reference, and κ within the relative error that implies,
     /// `STURM_ERROR_ULPS ε ‖C‖∞ (1/λ_min + 1/λ_max)` (about 3.7e-4 at κ = 4e11, where the dense
     /// comparison allowed 64 ε κ ≈ 6, i.e. 600 %). Measured worst: 0.69 units on an eigenvalue,
-    /// κ off by 7.7e-6 relative at 4e11 (`viscobar verify --tolerances` prints both ratios).
+    /// κ off by 7.7e-6 relative at 4e11 (`viscobar-certificate verify --tolerances` prints
+    /// both ratios).
     #[test]
     fn condition_numbers_match_the_double_double_reference() {
         for (alpha, ratio, c) in step_matrices() {

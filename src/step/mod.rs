@@ -1,8 +1,7 @@
 //! One time step's constrained quadratic programme and the solvers behind the [`StepSolver`]
 //! seam, for every body: condensation onto the constraints with an exact LCP solve (any body),
 //! enumeration over the bar's two ends and block pivoting for its obstacle (tridiagonal
-//! kernels), penalty and OSQP; with the independent KKT audit of their answers and a dense
-//! brute-force oracle for tests.
+//! kernels), penalty and OSQP; with the independent KKT audit of their answers.
 //!
 //! Imports only [`crate::linalg`].
 
@@ -11,7 +10,6 @@ pub mod block_pivot;
 pub mod condensed;
 pub mod exact;
 pub mod lcp;
-pub mod oracle;
 pub mod osqp;
 pub mod penalty;
 pub mod report;

@@ -2,10 +2,8 @@
 //! step solvers: the largest difference of the displacements over all degrees of freedom and
 //! steps, and of the reactions of each group of constraints.
 
-use crate::bar::Simulation;
 use crate::linalg::norms::{max_abs, max_distance};
 use crate::output::summary::{Summary, Tracker};
-use crate::scene::Scene;
 use crate::scene::SceneError;
 use crate::scene::SolverMethod;
 use crate::scheme::RunError;
@@ -122,73 +120,4 @@ pub fn with_solver<S: StudyScene>(scene: &S, method: SolverMethod) -> S {
         spec.epsilon = None;
     }
     s
-}
-
-/// One step problem `min ½zᵀCz − bᵀz, z_j >= lo_j` with the exact solver's answer `(z, r)`.
-#[derive(Clone, Debug)]
-pub struct StepProblem {
-    pub c: crate::linalg::tridiag::SymTridiag,
-    /// Local indices of the constrained nodes.
-    pub nodes: Vec<usize>,
-    pub b: Vec<f64>,
-    pub lo: Vec<f64>,
-    pub z: Vec<f64>,
-    pub r: Vec<f64>,
-}
-
-/// The start-up step problem of `scene` (the step `u^0 → u^1`) as the exact solver of the scene's
-/// constraints sees it, and its answer: the data on which other solvers are probed in isolation.
-pub fn start_up_problem(scene: &Scene) -> Result<StepProblem, RunError> {
-    use crate::step::{SolveInfo, StepFailure, StepSolver};
-    use std::cell::RefCell;
-    use std::rc::Rc;
-
-    /// Wraps the exact solver and keeps the first problem it is given, with its answer.
-    struct Recorder {
-        inner: Box<dyn StepSolver>,
-        first: Rc<RefCell<Option<[Vec<f64>; 4]>>>,
-    }
-    impl StepSolver for Recorder {
-        fn name(&self) -> &'static str {
-            "recorder"
-        }
-        fn solve(
-            &mut self,
-            b: &[f64],
-            lo: &[f64],
-            z: &mut [f64],
-            r: &mut [f64],
-        ) -> Result<SolveInfo, StepFailure> {
-            let info = self.inner.solve(b, lo, z, r)?;
-            self.first
-                .borrow_mut()
-                .get_or_insert_with(|| [b.to_vec(), lo.to_vec(), z.to_vec(), r.to_vec()]);
-            Ok(info)
-        }
-    }
-
-    let mut exact = scene.clone();
-    exact.solver.method = crate::scene::SolverMethod::Exact;
-    let disc = crate::bar::Discretisation::new(&exact)?;
-    let c = disc.step_matrix.clone();
-    let nodes = disc.constrained_locals();
-    let first = Rc::default();
-    let recorder = Recorder {
-        inner: crate::bar::body::make_solver(&exact, &disc)?,
-        first: Rc::clone(&first),
-    };
-    // Setting the simulation up solves the start-up step.
-    Simulation::with_solver(&exact, disc, Box::new(recorder))?;
-    let [b, lo, z, r] = first.take().ok_or_else(|| RunError::SolverSetup {
-        solver: "exact".into(),
-        reason: "the start-up step was not solved".into(),
-    })?;
-    Ok(StepProblem {
-        c,
-        nodes,
-        b,
-        lo,
-        z,
-        r,
-    })
 }

@@ -5,14 +5,14 @@ use proptest::prelude::*;
 use viscobar::Scene;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::scene;
-use viscobar::study::agreement::{MAX_MARGIN, diagonally_dominant};
+use viscobar_certificate::agreement::{MAX_MARGIN, diagonally_dominant};
 
 // ---- tolerances shared by several test files -----------------------------------------------
 
 /// Scene-wide round-off tolerances, defined beside their measurement in the tolerance registry
-/// (`viscobar verify --tolerances`).
+/// (`viscobar-certificate verify --tolerances`).
 #[allow(unused_imports)] // each test file uses some of them
-pub use viscobar::study::tolerances::{
+pub use viscobar_certificate::tolerances::{
     COMPLEMENTARITY_TOL, ENERGY_RISE_TOL, GAP_TOL, IDENTITY_TOL, REACTION_TOL,
 };
 /// The scheme is second order in (dx, dt) for smooth solutions (the card asks for 2 ± 0.15).
@@ -32,7 +32,7 @@ pub fn builtin(name: &str, overrides: &[&str]) -> Scene {
 
 /// Smallest diagonal-dominance margin of [`spd_tridiag`] (shared with the agreement study's
 /// random problems).
-pub use viscobar::study::agreement::MIN_MARGIN;
+pub use viscobar_certificate::agreement::MIN_MARGIN;
 
 /// Random SPD tridiagonal matrices of size `2..=max_n`: diagonally dominant by a random margin
 /// of at least [`MIN_MARGIN`], off-diagonals of either sign (the step matrix C is not an
@@ -48,9 +48,9 @@ pub fn spd_tridiag(max_n: usize) -> impl Strategy<Value = SymTridiag> {
 }
 
 /// The KKT residual, its per-case round-off bound and the tests' seeded data stream, defined
-/// beside their measurement in the tolerance registry (`viscobar verify --tolerances`).
+/// beside their measurement in the tolerance registry (`viscobar-certificate verify --tolerances`).
 #[allow(unused_imports)] // each test file uses some of them
-pub use viscobar::study::tolerances::{kkt, kkt_ratio, stream};
+pub use viscobar_certificate::tolerances::{kkt, kkt_ratio, stream};
 
 // ---- the `viscobar` binary ------------------------------------------------------------------
 

@@ -1,45 +1,39 @@
-//! Prints the last criterion measurements of `benches/step.rs` and `benches/scenes.rs` as
-//! Markdown (median time per step or per run, ns per node-step, and for steps the ratio to the
-//! unconstrained step at equal J), read from `target/criterion/{step,scenes,load,setup}/*/…/new/
-//! estimates.json`, followed by the targets of issues 7 and 17, each marked met or not met, and
-//! a short headline of issue 17's targets. Run after `cargo bench --bench step` and
-//! `cargo bench --bench scenes`:
-//!
-//!     cargo run --release --example bench_table
-//!     cargo run --release --features npy --example bench_table -- --update README.md benches/README.md
-//!
-//! With `--update`, the headline and the tables replace the blocks between
-//! `<!-- generated:bench-headline -->` / `<!-- generated:bench-table -->` and their
+//! `bench-table`: the last criterion measurements of `benches/step.rs` and `benches/scenes.rs`
+//! as Markdown (median time per step or per run, ns per node-step, and for steps the ratio to
+//! the unconstrained step at equal J), read from `target/criterion/{step,scenes,load,setup}/
+//! */…/new/estimates.json`, followed by the performance targets, each marked met or not met,
+//! and a short headline. With `--update FILE…`, the headline and the tables replace the blocks
+//! between `<!-- generated:bench-headline -->` / `<!-- generated:bench-table -->` and their
 //! `<!-- end:… -->` markers in each file named (a file must hold at least one of them), so the
-//! timings quoted in the READMEs are never typed by hand. Each block names the dates of the
-//! measurements and the machine.
+//! timings quoted in the READMEs are never typed by hand; each block names the dates of the
+//! measurements, the machine and [`UPDATE_COMMAND`].
 //!
-//! A measurement more than [`STALE_AFTER_S`] older than the newest one of its group is
-//! marked `(stale)` and left out of the targets (and out of the written blocks): criterion
-//! keeps the last result of every bench ever run, so a partial run would otherwise mix in rows
-//! measured on older code. `--update` also refuses a group measured more than
-//! [`STALE_AFTER_S`] before the newest group.
+//! A measurement more than `STALE_AFTER_S` older than the newest one of its group is marked
+//! `(stale)` and left out of the targets (and out of the written blocks): criterion keeps the
+//! last result of every bench ever run, so a partial run would otherwise mix in rows measured
+//! on older code. `--update` also refuses a group measured more than `STALE_AFTER_S` before
+//! the newest group.
 
+use crate::timings::{cpu_model, utc_date_time_at};
+use crate::verify::{Section, update_document};
 use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
-use viscobar::study::timings::{cpu_model, utc_date_time_at};
-use viscobar::study::verify::{Section, update_document};
 
-/// Issue 7's targets.
+/// Targets of the unconstrained step, of its diagnostics and of the exact step at the ends.
 const BARE_NS_PER_NODE_TARGET: f64 = 2.0;
 const DIAGNOSTICS_OVERHEAD_TARGET: f64 = 0.5;
 const EXACT_RATIO_TARGET: f64 = 1.15;
-/// Issue 17's targets: a forced talk scene against its unforced twin, per step; a load that
+/// Targets of the loads: a forced talk scene against its unforced twin, per step; a load that
 /// does not separate (two transcendental calls), per node-step.
 const FORCED_RATIO_TARGET: f64 = 1.3;
 const MIXED_LOAD_NS_TARGET: f64 = 30.0;
-/// Issue 17's distributed-obstacle targets: the step against the unconstrained one at J = 1e4
-/// and 1e5, and at J = 1e5 with Δt = 10Δx.
+/// Targets of the distributed obstacle: the step against the unconstrained one at J = 1e4 and
+/// 1e5, and at J = 1e5 with Δt = 10Δx.
 const DISTRIBUTED_RATIO_TARGET: f64 = 4.0;
 const DISTRIBUTED_DT10DX_RATIO_TARGET: f64 = 15.0;
 
-/// Issue 17's set-up and output targets: a one-step run of the 16384-element two-end bar (ms),
+/// Targets of the set-up and the output: a one-step run of the 16384-element two-end bar (ms),
 /// the 400-step run against its steps alone, that run's ns per node-step, and the refined
 /// 1e5-element run end to end (ns per node-step).
 const ONE_STEP_MS_TARGET: f64 = 5.0;
@@ -51,7 +45,10 @@ const REFINED_NS_TARGET: f64 = 3.0;
 const STALE_AFTER_S: u64 = 3600;
 
 /// The command that writes the blocks, as the blocks quote it.
-const UPDATE_COMMAND: &str = "cargo run --release --features npy --example bench_table -- --update README.md benches/README.md";
+pub const UPDATE_COMMAND: &str = concat!(
+    "cargo run --release -p viscobar-certificate -- bench-table ",
+    "--update README.md benches/README.md"
+);
 
 /// Median and modification time (s since the epoch) of an `estimates.json`.
 fn median_ns(path: &Path) -> Option<(f64, u64)> {
@@ -172,7 +169,7 @@ impl Measurements {
         Some((first, kept.map(|s| s.1).max()?))
     }
 
-    /// Refuses a group measured more than [`STALE_AFTER_S`] before the newest one.
+    /// Refuses a group measured more than `STALE_AFTER_S` before the newest one.
     fn check_one_run(&self) -> Result<(), String> {
         let Some((_, newest)) = self.span() else {
             return Err("no measurements in target/criterion: run the benches first".into());
@@ -208,7 +205,7 @@ impl Measurements {
         self.scene_table(&mut out, list_stale);
         self.load_table(&mut out, list_stale);
         self.setup_table(&mut out, list_stale);
-        self.issue7_targets(&mut out);
+        self.step_targets(&mut out);
         out
     }
 
@@ -401,7 +398,7 @@ impl Measurements {
         }
     }
 
-    fn issue7_targets(&self, out: &mut String) {
+    fn step_targets(&self, out: &mut String) {
         if self.steps.rows.is_empty() {
             return;
         }
@@ -443,8 +440,8 @@ impl Measurements {
         }
     }
 
-    /// Issue 17's targets in four lines (and the step's cost at J = 1e5 for scale); a figure
-    /// this run did not measure is said to be missing.
+    /// The targets of the loads, the distributed obstacle and the set-up in four lines (and the
+    /// step's cost at J = 1e5 for scale); a figure this run did not measure is said to be missing.
     fn headline(&self) -> String {
         const MISSING: &str = "not measured in this run";
         let mut out = String::new();
@@ -576,7 +573,7 @@ impl Measurements {
 
 /// Replaces, in each file, the generated blocks it holds; every file is checked before any
 /// is written, and each is written whole or not at all.
-fn update(files: &[PathBuf], m: &Measurements) -> Result<(), String> {
+fn update_files(files: &[PathBuf], m: &Measurements) -> Result<(), String> {
     m.check_one_run()?;
     let head = m.provenance();
     let sections = [
@@ -616,31 +613,30 @@ fn update(files: &[PathBuf], m: &Measurements) -> Result<(), String> {
     Ok(())
 }
 
-fn main() {
-    let target = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/criterion");
+/// `bench-table`: prints the tables, the targets and the headline, or with `update` rewrites
+/// the blocks of those files. The exit code: 0; 1 without measurements or when a file cannot be
+/// updated.
+pub fn run(update: Option<&[PathBuf]>) -> i32 {
+    let target = crate::workspace_root().join("target/criterion");
     let m = Measurements::read(&target);
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    match args.split_first() {
+    match update {
         None => {
             if m.span().is_none() {
                 eprintln!(
                     "no measurements in target/criterion: run `cargo bench --bench step` first"
                 );
-                std::process::exit(1);
+                return 1;
             }
             print!("{}", m.tables(true));
             println!("\nHeadline:\n{}", m.headline());
+            0
         }
-        Some((flag, files)) if flag == "--update" && !files.is_empty() => {
-            let files: Vec<PathBuf> = files.iter().map(PathBuf::from).collect();
-            if let Err(e) = update(&files, &m) {
+        Some(files) => match update_files(files, &m) {
+            Ok(()) => 0,
+            Err(e) => {
                 eprintln!("error: {e}");
-                std::process::exit(1);
+                1
             }
-        }
-        _ => {
-            eprintln!("usage: bench_table [--update FILE...]");
-            std::process::exit(2);
-        }
+        },
     }
 }

@@ -1,5 +1,5 @@
 //! The measured figures of VERIFICATION.md, section "Step solvers" (generated block
-//! `solver-agreement`, `viscobar verify --update VERIFICATION.md`):
+//! `solver-agreement`, `verify --update VERIFICATION.md`; alone: `solver-agreement`):
 //!
 //! 1. OSQP and penalty against the exact solver on every built-in scene (whole runs, every
 //!    node and step), with their audits;
@@ -7,23 +7,24 @@
 //! 3. OSQP's failures on a stiff scene, with OSQP's own verdict next to viscobar's;
 //! 4. a seeded sample of random step problems, OSQP against exact.
 //!
-//! Everything is deterministic (no timings): the same build prints the same numbers.
+//! Everything is deterministic (no timings): the same build prints the same numbers. The
+//! start-up step problem of a scene ([`start_up_problem`]) lets a solver be probed alone.
 
-use crate::linalg::ldlt::Ldlt;
-use crate::linalg::norms::{max_abs, max_distance};
-use crate::linalg::tridiag::SymTridiag;
-use crate::scene::{self, Scene};
-use crate::step::StepSolver;
-use crate::step::audit::dual_tolerance;
-use crate::step::exact::ExactSolver;
-use crate::step::osqp::{OsqpSettings, OsqpSolver, raw_problem};
-use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
-use crate::study::accuracy::observed_order;
-use crate::study::compare::{StepProblem, compare, start_up_problem};
-use crate::scheme::RunError;
-use crate::output::run_in_memory;
 use osqp::Status;
 use std::fmt::Write;
+use viscobar::linalg::ldlt::Ldlt;
+use viscobar::linalg::norms::{max_abs, max_distance};
+use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::scene::{self, Scene};
+use viscobar::step::StepSolver;
+use viscobar::step::audit::dual_tolerance;
+use viscobar::step::exact::ExactSolver;
+use viscobar::step::osqp::{OsqpSettings, OsqpSolver, raw_problem};
+use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::study::accuracy::observed_order;
+use viscobar::study::compare::compare;
+use viscobar::time::RunError;
+use viscobar::time::run::run_in_memory;
 
 /// The four parts above, as Markdown.
 pub fn markdown() -> Result<String, RunError> {
@@ -48,8 +49,8 @@ fn with_method(m: &str, extra: &[String]) -> Vec<String> {
 /// The audit report of an OSQP or penalty run (both always audit).
 fn audit_of<'a>(
     name: &str,
-    s: &'a crate::output::summary::Summary,
-) -> Result<&'a crate::step::AuditReport, RunError> {
+    s: &'a viscobar::time::summary::Summary,
+) -> Result<&'a viscobar::step::AuditReport, RunError> {
     s.audit.as_ref().ok_or_else(|| RunError::SolverSetup {
         solver: s.solver.clone(),
         reason: format!("{name}: the run kept no audit report"),
@@ -372,4 +373,74 @@ fn random_problems(md: &mut String) -> Result<(), RunError> {
          max \\|r_osqp − r_exact\\| / (1 + \\|b\\|∞) = {worst_r:.1e}"
     );
     Ok(())
+}
+
+/// One step problem `min ½zᵀCz − bᵀz, z_j >= lo_j` with the exact solver's answer `(z, r)`.
+#[derive(Clone, Debug)]
+pub struct StepProblem {
+    pub c: viscobar::linalg::tridiag::SymTridiag,
+    /// Local indices of the constrained nodes.
+    pub nodes: Vec<usize>,
+    pub b: Vec<f64>,
+    pub lo: Vec<f64>,
+    pub z: Vec<f64>,
+    pub r: Vec<f64>,
+}
+
+/// The start-up step problem of `scene` (the step `u^0 → u^1`) as the exact solver of the scene's
+/// constraints sees it, and its answer: the data on which other solvers are probed in isolation.
+pub fn start_up_problem(scene: &Scene) -> Result<StepProblem, RunError> {
+    use std::cell::RefCell;
+    use std::rc::Rc;
+    use viscobar::step::{SolveInfo, StepFailure};
+    use viscobar::time::simulation::{Discretisation, Simulation, make_solver};
+
+    /// Wraps the exact solver and keeps the first problem it is given, with its answer.
+    struct Recorder {
+        inner: Box<dyn StepSolver>,
+        first: Rc<RefCell<Option<[Vec<f64>; 4]>>>,
+    }
+    impl StepSolver for Recorder {
+        fn name(&self) -> &'static str {
+            "recorder"
+        }
+        fn solve(
+            &mut self,
+            b: &[f64],
+            lo: &[f64],
+            z: &mut [f64],
+            r: &mut [f64],
+        ) -> Result<SolveInfo, StepFailure> {
+            let info = self.inner.solve(b, lo, z, r)?;
+            self.first
+                .borrow_mut()
+                .get_or_insert_with(|| [b.to_vec(), lo.to_vec(), z.to_vec(), r.to_vec()]);
+            Ok(info)
+        }
+    }
+
+    let mut exact = scene.clone();
+    exact.solver.method = viscobar::scene::SolverMethod::Exact;
+    let disc = Discretisation::new(&exact)?;
+    let c = disc.step_matrix.clone();
+    let nodes = disc.constrained_locals();
+    let first = Rc::default();
+    let recorder = Recorder {
+        inner: make_solver(&exact, &disc)?,
+        first: Rc::clone(&first),
+    };
+    // Setting the simulation up solves the start-up step.
+    Simulation::with_solver(&exact, disc, Box::new(recorder))?;
+    let [b, lo, z, r] = first.take().ok_or_else(|| RunError::SolverSetup {
+        solver: "exact".into(),
+        reason: "the start-up step was not solved".into(),
+    })?;
+    Ok(StepProblem {
+        c,
+        nodes,
+        b,
+        lo,
+        z,
+        r,
+    })
 }

@@ -1,16 +1,18 @@
-//! `viscobar verify`: recomputes the measured figures of VERIFICATION.md and prints them as
-//! Markdown tables, each between `<!-- generated:ID -->` and `<!-- end:ID -->` markers, so the
-//! document is regenerated (`viscobar verify --update VERIFICATION.md`), never hand-edited.
+//! `verify` (`cargo run --release -p viscobar-certificate -- verify`): recomputes the measured
+//! figures of VERIFICATION.md and prints them as Markdown tables, each between
+//! `<!-- generated:ID -->` and `<!-- end:ID -->` markers, so the document is regenerated
+//! (`verify --update VERIFICATION.md`), never hand-edited.
 //! Every figure here is deterministic (no timings), so a test checks the document is current.
 
-use crate::bar::closed_form;
-use crate::bar::matrices::{MatrixVariant, mass, stiffness};
-use crate::linalg::norms::max_abs;
-use crate::scene;
-use crate::study::accuracy::{error_against, observed_order, rigid_mode_drift};
-use crate::scheme::RunError;
-use crate::output::run_in_memory;
+use crate::roundoff::rigid_mode_drift;
 use std::fmt::Write;
+use viscobar::bar::closed_form;
+use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
+use viscobar::linalg::norms::max_abs;
+use viscobar::scene;
+use viscobar::study::accuracy::{error_against, observed_order};
+use viscobar::time::RunError;
+use viscobar::time::run::run_in_memory;
 
 /// One generated block of VERIFICATION.md.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,8 +29,8 @@ pub const RIGID_STEPS: usize = 26_000;
 
 /// All sections, in document order.
 /// Errors are those of the runs and of the α-sweep (both carry their exit code).
-pub fn sections() -> Result<Vec<Section>, crate::study::converge::ConvergeError> {
-    let stiff = crate::study::stiff_runs::run_all(crate::study::stiff::Size::Full);
+pub fn sections() -> Result<Vec<Section>, viscobar::study::converge::ConvergeError> {
+    let stiff = crate::stiff_runs::run_all(crate::stiff::Size::Full);
     // One rigid-mode run for the round-off table and the registry's INCREMENT_DRIFT_TOL.
     let drift = rigid_drift()?;
     Ok(vec![
@@ -37,15 +39,15 @@ pub fn sections() -> Result<Vec<Section>, crate::study::converge::ConvergeError>
         scenes_section()?,
         Section {
             id: "solver-agreement",
-            markdown: crate::study::agreement::markdown()?,
+            markdown: crate::agreement::markdown()?,
         },
         convergence_section()?,
         falling_bar_section()?,
         Section {
             id: "viscous-contact",
-            markdown: crate::study::viscous_contact::markdown(
-                &crate::study::viscous_contact::study(CONVERGENCE_LEVELS)?,
-            ),
+            markdown: crate::viscous_contact::markdown(&crate::viscous_contact::study(
+                CONVERGENCE_LEVELS,
+            )?),
         },
         roundoff_section(drift),
         viscosity_section()?,
@@ -54,11 +56,11 @@ pub fn sections() -> Result<Vec<Section>, crate::study::converge::ConvergeError>
         mass_variants_section()?,
         Section {
             id: "plane",
-            markdown: crate::study::plane_checks::markdown()?,
+            markdown: crate::plane_checks::markdown()?,
         },
         Section {
             id: "plane-contact",
-            markdown: crate::study::plane_contact::markdown()?,
+            markdown: crate::plane_contact::markdown()?,
         },
     ])
 }
@@ -74,7 +76,7 @@ fn matrices_section() -> Section {
             let r = stiffness(variant, nodes, dx);
             let total: f64 = m.mul(&vec![1.0; nodes]).iter().sum();
             let r1 = max_abs(&r.mul(&vec![1.0; nodes]));
-            let sym = |a: &crate::linalg::tridiag::SymTridiag| {
+            let sym = |a: &viscobar::linalg::tridiag::SymTridiag| {
                 let d = a.to_dense();
                 d == d.transpose()
             };
@@ -130,14 +132,14 @@ pub fn solve_study(nodes: &[usize]) -> Vec<SolveCase> {
                 mass(MatrixVariant::Consistent, n, dx),
                 stiffness(MatrixVariant::Consistent, n, dx),
             );
-            let c = crate::linalg::tridiag::SymTridiag::combine(
+            let c = viscobar::linalg::tridiag::SymTridiag::combine(
                 1.0 / (dt * dt),
                 &m,
                 0.5 + alpha / (2.0 * dt),
                 &r,
             );
             let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() + 0.1).collect();
-            let Ok(factor) = crate::linalg::ldlt::Ldlt::factor(&c) else {
+            let Ok(factor) = viscobar::linalg::ldlt::Ldlt::factor(&c) else {
                 continue;
             };
             let mut x = b.clone();
@@ -148,7 +150,7 @@ pub fn solve_study(nodes: &[usize]) -> Vec<SolveCase> {
                 alpha,
                 dt_over_dx: ratio,
                 nodes: n,
-                backward_error: crate::linalg::tridiag::backward_error(&c, &x, &b),
+                backward_error: viscobar::linalg::tridiag::backward_error(&c, &x, &b),
                 into_same_bits: x.iter().zip(&y).all(|(p, q)| p.to_bits() == q.to_bits()),
             });
         }
@@ -265,8 +267,8 @@ fn convergence_section() -> Result<Section, RunError> {
 
 /// The falling bar through `viscobar converge` (exact solver; the wall times are left out):
 /// the errors in displacement, energy and contact times, and their observed orders.
-fn falling_bar_section() -> Result<Section, crate::study::converge::ConvergeError> {
-    use crate::study::converge::{SolverSetting, study};
+fn falling_bar_section() -> Result<Section, viscobar::study::converge::ConvergeError> {
+    use viscobar::study::converge::{SolverSetting, study};
     let (_, base) = scene::load("falling-bar", &[])?;
     let st = study(
         "falling-bar",
@@ -284,7 +286,7 @@ fn falling_bar_section() -> Result<Section, crate::study::converge::ConvergeErro
         &[],
     ));
     let h: Vec<f64> = st.rows.iter().map(|r| r.dx).collect();
-    let order = |f: fn(&crate::study::converge::Row) -> Option<f64>| {
+    let order = |f: fn(&viscobar::study::converge::Row) -> Option<f64>| {
         let e: Option<Vec<f64>> = st.rows.iter().map(f).collect();
         e.map_or("-".to_string(), |e| {
             format!("{:.3}", observed_order(&h, &e))
@@ -322,7 +324,7 @@ fn roundoff_section((ours, talk): (f64, f64)) -> Section {
     }
 }
 
-/// The whole output of `viscobar verify`.
+/// The whole output of `verify`.
 pub fn render(sections: &[Section]) -> String {
     let mut out = String::new();
     for s in sections {
@@ -358,9 +360,9 @@ pub fn update_document(doc: &str, sections: &[Section]) -> Result<String, String
 pub const SWEEP_ALPHAS: [f64; 4] = [1e-1, 1e-2, 1e-3, 1e-4];
 pub const SWEEP_ELEMENTS: [u64; 2] = [800, 1600];
 
-fn viscosity_section() -> Result<Section, crate::study::converge::ConvergeError> {
+fn viscosity_section() -> Result<Section, viscobar::study::converge::ConvergeError> {
     let (_, base) = scene::load("impact", &[])?;
-    let sweep = crate::study::viscosity_sweep::viscosity_sweep(
+    let sweep = viscobar::study::viscosity_sweep::viscosity_sweep(
         "impact",
         &base,
         &SWEEP_ALPHAS,
@@ -373,36 +375,36 @@ fn viscosity_section() -> Result<Section, crate::study::converge::ConvergeError>
 }
 
 /// The stiff and extreme case matrix from its runs (full size: about 40 s on 2 cores; alone:
-/// `viscobar verify --stiff`); `tests/stiff.rs` runs the reduced size.
-pub fn stiff_section(results: &[crate::study::stiff::CaseResult]) -> Section {
+/// `verify --stiff`); `tests/stiff.rs` runs the reduced size.
+pub fn stiff_section(results: &[crate::stiff::CaseResult]) -> Section {
     Section {
         id: "stiff",
-        markdown: crate::study::stiff::markdown(results),
+        markdown: crate::stiff::markdown(results),
     }
 }
 
 /// The mass variants on `impact` and `falling-bar` (`study::mass_variants`; a few seconds).
-fn mass_variants_section() -> Result<Section, crate::study::converge::ConvergeError> {
-    use crate::study::converge::ConvergeError;
-    use crate::study::mass_variants::{MassStudyError, mass_study};
+fn mass_variants_section() -> Result<Section, viscobar::study::converge::ConvergeError> {
+    use crate::mass_study::{MassStudyError, mass_study};
+    use viscobar::study::converge::ConvergeError;
     let rows = mass_study().map_err(|e| match e {
         MassStudyError::Run(r) => ConvergeError::Run(r),
         other => ConvergeError::BadInput(other.to_string()),
     })?;
-    let mut markdown = crate::study::mass_variants::certificate_markdown()?;
+    let mut markdown = crate::mass_study::certificate_markdown()?;
     markdown.push('\n');
-    markdown.push_str(&crate::study::mass_variants::markdown(&rows));
+    markdown.push_str(&crate::mass_study::markdown(&rows));
     Ok(Section {
         id: "mass-variants",
         markdown,
     })
 }
 
-/// The tolerance registry (`viscobar verify --tolerances`, `study::tolerances`), with the stiff
+/// The tolerance registry (`verify --tolerances`, [`crate::tolerances`]), with the stiff
 /// matrix's checks read from `results` and the rigid-mode drift `increment_drift` of
 /// [`rigid_drift`].
 pub fn tolerances_section(
-    results: &[crate::study::stiff::CaseResult],
+    results: &[crate::stiff::CaseResult],
     increment_drift: f64,
 ) -> Result<Section, RunError> {
     let backward_ulps = solve_study(&backward_error_nodes())
@@ -411,11 +413,7 @@ pub fn tolerances_section(
         .fold(0.0, f64::max);
     Ok(Section {
         id: "tolerances",
-        markdown: crate::study::tolerances::registry_markdown(
-            results,
-            increment_drift,
-            backward_ulps,
-        )?,
+        markdown: crate::tolerances::registry_markdown(results, increment_drift, backward_ulps)?,
     })
 }
 

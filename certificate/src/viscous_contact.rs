@@ -1,17 +1,17 @@
 //! Refinement study of the manufactured viscous-contact scene (`viscous-contact`,
-//! [`ViscousContact`](crate::bar::closed_form::ViscousContact)): errors of the displacement,
+//! [`ViscousContact`](viscobar::bar::closed_form::ViscousContact)): errors of the displacement,
 //! the reaction and the contact times against the closed form, `dx` and `dt` halved together;
 //! and the closed form's self-checks by finite differences. Shared by
 //! `tests/viscous_contact.rs`, the tolerance registry and the generated table of
 //! VERIFICATION.md; derivation in [docs/viscous-contact.md](../../docs/viscous-contact.md).
 
-use crate::bar::closed_form::{self, ClosedForm};
-use crate::scene::{self, Scene};
-use crate::study::accuracy::{error_against, observed_order};
-use crate::study::converge::contact_time_error;
-use crate::scheme::RunError;
-use crate::output::run_in_memory;
 use std::fmt::Write;
+use viscobar::bar::closed_form::{self, ClosedForm};
+use viscobar::scene::{self, Scene};
+use viscobar::study::accuracy::{error_against, observed_order};
+use viscobar::study::converge::contact_time_error;
+use viscobar::time::RunError;
+use viscobar::time::run::run_in_memory;
 
 /// The built-in scene's name.
 pub const SCENE: &str = "viscous-contact";
@@ -147,7 +147,7 @@ pub fn energy_quadrature_worst(vc: &closed_form::ViscousContact) -> f64 {
     worst
 }
 
-/// Errors at the scene's own mesh (`tests/viscous_contact.rs`, [`crate::study::tolerances`]):
+/// Errors at the scene's own mesh (`tests/viscous_contact.rs`, [`crate::tolerances`]):
 /// 1.25x those measured (VERIFICATION.md's viscous-contact table, first row), so that
 /// round-off changes pass and a wrong reaction or load fails.
 pub const L2_BOUND: f64 = 1.25 * 1.196e-3;
@@ -175,26 +175,29 @@ pub struct Row {
 pub fn closed_form(scene: &Scene) -> closed_form::ViscousContact {
     let exact = closed_form::for_scene(SCENE, scene).expect("viscous-contact has its closed form");
     let [t1, t2] = closed_form::VISCOUS_CONTACT_WINDOW;
-    closed_form::ViscousContact {
-        length: scene.bar.length,
-        alpha: scene.bar.viscosity,
-        gap: scene.left.gap.expect("Signorini left end"),
-        t1,
-        t2,
-        pulse: closed_form::VISCOUS_CONTACT_PULSE,
-        initial_amplitude: closed_form::VISCOUS_CONTACT_INITIAL_AMPLITUDE,
-    }
-    .checked_against(exact.as_ref())
+    checked_against(
+        closed_form::ViscousContact {
+            length: scene.bar.length,
+            alpha: scene.bar.viscosity,
+            gap: scene.left.gap.expect("Signorini left end"),
+            t1,
+            t2,
+            pulse: closed_form::VISCOUS_CONTACT_PULSE,
+            initial_amplitude: closed_form::VISCOUS_CONTACT_INITIAL_AMPLITUDE,
+        },
+        exact.as_ref(),
+    )
 }
 
-impl closed_form::ViscousContact {
-    /// `self`, after checking it is the closed form `other` (same displacement at a few points).
-    fn checked_against(self, other: &dyn ClosedForm) -> Self {
-        for (x, t) in [(0.3, 0.2), (0.7, 1.1), (1.0, 2.0)] {
-            assert_eq!(self.displacement(x, t), other.displacement(x, t));
-        }
-        self
+/// `form`, after checking it is the closed form `other` (same displacement at a few points).
+fn checked_against(
+    form: closed_form::ViscousContact,
+    other: &dyn ClosedForm,
+) -> closed_form::ViscousContact {
+    for (x, t) in [(0.3, 0.2), (0.7, 1.1), (1.0, 2.0)] {
+        assert_eq!(form.displacement(x, t), other.displacement(x, t));
     }
+    form
 }
 
 /// One level: the scene refined `level` times (dx and dt halved together).

@@ -3,23 +3,22 @@
 //! special case, and the observed order of the manufactured solution. The tests
 //! (`tests/plane.rs`, `src/plane/*`) assert on the same computations.
 
-use crate::scheme::RunError;
-use crate::plane::closed_form::Manufactured;
-use crate::linalg::cholesky::SparseCholesky;
-use crate::plane::matrices::{Material, assemble};
-use crate::plane::mesh::Grid;
-use crate::output::run_plane_in_memory;
-use crate::plane::PlaneSimulation;
-use crate::scene::plane::{
-    Body, EdgeCondition, EdgeSpec, Edges, PLANE_BUILTIN, PlaneInitial, PlaneLoad, PlaneMesh,
-    PlaneScene, Vector, plane_builtin_text,
-};
-use crate::scene::schema::number_text;
-use crate::scene::{Condition, Scene};
-use crate::study::converge::ConvergeError;
-use crate::bar::Simulation;
-use crate::scheme::RunError;
 use std::fmt::Write;
+use viscobar::plane::PlaneError;
+use viscobar::plane::closed_form::Manufactured;
+use viscobar::plane::factor::SparseCholesky;
+use viscobar::plane::matrices::{Material, assemble};
+use viscobar::plane::mesh::Grid;
+use viscobar::plane::run::run_plane_in_memory;
+use viscobar::plane::simulation::PlaneSimulation;
+use viscobar::scene::plane::{
+    Body, EdgeCondition, EdgeSpec, Edges, PLANE_BUILTIN, PlaneInitial, PlaneLoad, PlaneMesh,
+    PlaneOutput, PlaneScene, Vector, plane_builtin_text,
+};
+use viscobar::scene::schema::number_text;
+use viscobar::scene::{Condition, Scene};
+use viscobar::study::converge::ConvergeError;
+use viscobar::time::{RunError, Simulation};
 
 /// The grids of the matrix table: `(nx, ny, y_grading)`.
 pub const MATRIX_GRIDS: [(usize, usize, f64); 3] = [(4, 2, 1.0), (16, 8, 3.0), (64, 16, 0.2)];
@@ -169,7 +168,7 @@ pub fn plane_of_bar(bar: &Scene, height: f64, ny: u64, y_grading: f64) -> Option
         },
         time: bar.time.clone(),
         solver: Default::default(),
-        output: Default::default(),
+        output: PlaneOutput::default(),
     })
 }
 
@@ -260,7 +259,7 @@ pub fn bar_case(bar: &Scene) -> Result<BarCase, ConvergeError> {
 
 /// The two bars of the special case: `modal` and [`CLAMPED_BAR`].
 pub fn bar_case_scenes() -> Vec<(&'static str, Scene)> {
-    let (_, modal) = crate::scene::load("modal", &[]).expect("built-in");
+    let (_, modal) = viscobar::scene::load("modal", &[]).expect("built-in");
     let clamped = Scene::from_toml(CLAMPED_BAR, &[]).expect("valid");
     vec![("modal", modal), ("clamped", clamped)]
 }
@@ -292,7 +291,7 @@ end = 4.0
 
 /// The bars with contact of the special case: `impact` and [`CONTACT_BAR`].
 pub fn bar_contact_case_scenes() -> Vec<(&'static str, Scene)> {
-    let (_, impact) = crate::scene::load("impact", &[]).expect("built-in");
+    let (_, impact) = viscobar::scene::load("impact", &[]).expect("built-in");
     let loaded = Scene::from_toml(CONTACT_BAR, &[]).expect("valid");
     vec![("impact", impact), ("loaded-contact", loaded)]
 }
@@ -360,7 +359,7 @@ fn plane_error(e: PlaneError) -> ConvergeError {
     match e {
         PlaneError::Scene(s) => ConvergeError::Scene(s),
         other => ConvergeError::Run(RunError::SolverSetup {
-            solver: crate::plane::run::SOLVER_NAME.into(),
+            solver: viscobar::plane::run::SOLVER_NAME.into(),
             reason: other.to_string(),
         }),
     }

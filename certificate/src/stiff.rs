@@ -1,51 +1,27 @@
-//! The stiff and extreme case matrix (`viscobar verify --stiff`, `tests/stiff.rs`): the scheme
-//! at the corners of its parameter space, every step solver that applies, and for each run
-//! either a result checked against round-off tolerances derived from `κ(C)` or an error that
-//! names the step. Never a silent wrong answer.
+//! The stiff and extreme case matrix (`verify --stiff`, `tests/stiff.rs`): the scheme at the
+//! corners of its parameter space, every step solver that applies, and for each run either a
+//! result checked against round-off tolerances or an error that names the step. Never a
+//! silent wrong answer.
 //!
 //! Axes: `α ∈ {0, 1e-8, 1e3, 1e6}`, `Δt/Δx ∈ {1e-3, 1, 100, 1e4}`, meshes from 1 element to
 //! 999 999 (1e6 nodes), two Signorini ends at gap 0 with initial contact, a bar lying on a
 //! distributed obstacle, forcing 1e6, overflowing forcing, and 1e6-step runs for drift.
 //!
-//! Per run (solver): the largest relative energy-identity residual, the largest penetration,
-//! the distance to the exact solver (max over nodes and steps), the cumulative drift of the
-//! energy balance, and, for the exact solver, the KKT audit of [`crate::step::audit`] at its
-//! round-off floors (`eps = 0`), an independent check of the reference itself. `κ(C)` comes
-//! from [`crate::linalg::spectrum`].
-//!
-//! Tolerances, a posteriori (issue #22): each step's tolerance is computed from what that step
-//! formed ([`StepTerms`]), not from `κ(C)` and a worst-case size. On the computed vectors the
-//! energy identity is the scheme multiplied by `δ/2`, so exact arithmetic leaves exactly
-//! `½ δ·ρ` with `ρ = C z − b − r` the solve's residual. The tolerance is the measured
-//! `|½ δ·ρ̂|` plus worst-case (first-order, `γ_k`) bounds on every rounding the run made:
-//! of `ρ̂` and `b̂` entry by entry, of the energy sums (`γ_m Σ|terms|`), of the stored
-//! displacements, of the final combination ([`StepTerms::identity_tolerance`]). The
-//! penetration tolerance is taken node by node from what the solver tests on the `z` it
-//! returns: the exact solvers put a node with a reaction on its bound bit for bit and test
-//! (block pivoting, the end enumeration without an active end) or do not test (the end
-//! enumeration with one) the others, so the computed gap can be negative only by the rounding
-//! of the bound and of `û + z` (`γ_2`), plus the block pivoting's tie threshold, or the
-//! forward error on the chosen active set (a solve with `C` pinned there) where the returned
-//! `z` is untested; OSQP and penalty add their law ([`StepTerms::violation_tolerance`]). The
-//! energy drift is the sum of the steps' residuals on the recorded numbers (telescoping); it
-//! is checked against the sum of the steps' absolute identity tolerances plus the rounding of
-//! the two sums ([`SolverRun::drift_tolerance`]), so that its ratio says how much of the
-//! per-step allowance accumulates (the former bound, the signed residuals' sum, was the drift
-//! itself by the same telescoping and could not fail).
-//! A run's figure is its worst step by ratio ([`Worst`]). The distance between solvers keeps
-//! its a-priori `κ(C)` forward-error bound ([`roundoff_distance`]).
-//!
-//! This file holds what is checked: the cases, the tolerances, the verdict and the table of
-//! VERIFICATION.md. Running the cases is `study::stiff_runs`.
+//! Per run (solver): the energy-identity residual, the penetration, the distance to the exact
+//! solver, the energy balance's drift and (exact solver) the KKT audit at round-off floors,
+//! each against a tolerance computed a posteriori from what the step formed ([`StepTerms`],
+//! [`Worst`]), derived in `docs/stiff-tolerances.md`. This file holds what is checked: the
+//! cases, the tolerances, the verdict and the table of VERIFICATION.md; running the cases is
+//! [`crate::stiff_runs`].
 
-use crate::scene::Scene;
-use crate::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
-use crate::step::osqp::OSQP_DEFAULT_EPS;
-use crate::step::penalty::PENALTY_DEFAULT_EPSILON;
-use crate::scheme::RunError;
 use std::fmt::Write;
+use viscobar::scene::Scene;
+use viscobar::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
+use viscobar::step::osqp::OSQP_DEFAULT_EPS;
+use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::time::RunError;
 
-/// Full size (`viscobar verify --stiff`) or the reduced size of `tests/stiff.rs`.
+/// Full size (`verify --stiff`) or the reduced size of `tests/stiff.rs`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Size {
     Full,
@@ -550,8 +526,8 @@ pub fn markdown(results: &[CaseResult]) -> String {
     md
 }
 
-/// Ratios below this are listed under the table with their reason (issue #22: a tolerance at
-/// most 1000 times what it guards, unless the table says why).
+/// Ratios below this are listed under the table with their reason (the registry's rule: a
+/// tolerance at most 1000 times what it guards, unless the table says why).
 pub const NOTE_RATIO_FLOOR: f64 = 1e-3;
 
 /// Why a completed run's check has a nonzero ratio below [`NOTE_RATIO_FLOOR`], from what the
@@ -659,7 +635,7 @@ pub fn sum_rounding(k: f64, abs_sum: f64) -> f64 {
 }
 
 /// The a-posteriori quantities of one step of one run, all computed by
-/// `study::stiff_runs` from the vectors the step formed (the solver's `b̂`, `z`, `r`, the
+/// [`crate::stiff_runs`] from the vectors the step formed (the solver's `b̂`, `z`, `r`, the
 /// previous increment `w`, the stored `û^{n−1}, û^n, û^{n+1}`), with `δ = z + w`, `ρ̂` the
 /// computed `C z − b̂ − Σ r_j e_j` and `f_i` the entrywise bound on its rounding and on the
 /// rounding of `b̂` (see [`StepTerms::identity_tolerance`]).

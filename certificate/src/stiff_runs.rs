@@ -1,32 +1,31 @@
-//! Running the stiff and extreme case matrix of `study::stiff`: each case's solvers step in
+//! Running the stiff and extreme case matrix of [`crate::stiff`]: each case's solvers step in
 //! lockstep with the exact one and are compared with it after every step, while each run's
 //! identity residual, penetration, energy drift and (exact solver) KKT audit at round-off
 //! floors are recorded into a [`CaseResult`]. A failing solver is stopped and its error kept;
 //! the others go on.
 //!
-//! Apart from the case list, the tolerances and the table (`study::stiff`), which say what is
+//! Apart from the case list, the tolerances and the table ([`crate::stiff`]), which say what is
 //! checked and why; this file only produces the numbers they are checked on.
 
-use crate::linalg::ldlt::Ldlt;
-use crate::linalg::norms::{max_abs, max_distance};
-use crate::linalg::spectrum::reference::STURM_ERROR_ULPS;
-use crate::linalg::tridiag::SymTridiag;
-use crate::step::audit::{KktAudit, Law};
-use crate::step::block_pivot::TIE_ULPS;
-use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
-use crate::study::accuracy::rigid_drift;
-use crate::study::stiff::{
+use crate::roundoff::rigid_drift;
+use crate::stiff::{
     COMBINATION_ROUNDINGS, Case, CaseResult, Family, GAP_ROUNDINGS, RESIDUAL_ROUNDINGS, Size,
     SolverRun, StepTerms, UNIT_ROUNDOFF, Worst, cases, sum_rounding, violation_law,
 };
-use crate::scheme::RunError;
-use crate::scheme::StepRecord;
-use crate::bar::body::make_solver;
-use crate::bar::{Discretisation, Simulation};
-use crate::output::summary::Tracker;
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::rc::Rc;
+use viscobar::linalg::ldlt::Ldlt;
+use viscobar::linalg::norms::{max_abs, max_distance};
+use viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS;
+use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::step::audit::{KktAudit, Law};
+use viscobar::step::block_pivot::TIE_ULPS;
+use viscobar::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
+use viscobar::time::RunError;
+use viscobar::time::simulation::StepRecord;
+use viscobar::time::simulation::{Discretisation, Simulation, make_solver};
+use viscobar::time::summary::Tracker;
 
 /// What the last solve formed, shared between a run's [`Traced`] solver and its [`Live`]
 /// state: the right-hand side `b̂`, the answer `z`, the reactions `r` and the previous answer
@@ -108,7 +107,7 @@ impl StepSolver for Traced {
 /// end enumeration puts an active node on its bound exactly, moving `z_j` by its forward error
 /// (up to `κ ε |z|`), which leaves a force residual `C_jj` times that by design. Its image in
 /// displacement, `‖C⁻¹(Cz − b − r)‖`, is checked: that is the error of the answer.
-fn worst_ratio(r: &crate::step::AuditReport) -> (f64, &'static str) {
+fn worst_ratio(r: &viscobar::step::AuditReport) -> (f64, &'static str) {
     [
         (
             r.primal_violation.map_or(0.0, |w| w.max_over_tolerance),
@@ -694,10 +693,10 @@ pub fn run_case(case: &Case) -> CaseResult {
                     if kappa.is_none() {
                         let d = sim.discretisation();
                         let c = &d.step_matrix;
-                        kappa = crate::linalg::spectrum::condition_number(c);
+                        kappa = viscobar::linalg::spectrum::condition_number(c);
                         // The bisection's error bound, tested against the double-double
                         // reference in `linalg::spectrum`.
-                        lambda_min = (crate::linalg::spectrum::smallest_eigenvalue_spd(c)
+                        lambda_min = (viscobar::linalg::spectrum::smallest_eigenvalue_spd(c)
                             - STURM_ERROR_ULPS * f64::EPSILON * c.inf_norm())
                         .max(0.0);
                         max_gap = d.constraints.iter().fold(0.0, |m, c| m.max(c.gap));

@@ -1,16 +1,16 @@
 //! The plane contact certificate (VERIFICATION.md, "Plane contact"): the bar with contact as
-//! an exact special case ([`crate::study::plane_checks::bar_case`]), the contact conditions and
+//! an exact special case ([`crate::plane_checks::bar_case`]), the contact conditions and
 //! the energy identity on the built-in contact scenes, the exact solver against OSQP and the
 //! penalty, and the observed convergence of the tilted drop. The tests
 //! (`tests/plane_contact.rs`) assert on the same computations.
 
-use crate::scheme::RunError;
-use crate::plane::contact::ContactMethod;
-use crate::plane::PlaneSimulation;
-use crate::scene::plane::{AnyScene, PlaneScene, load_any};
-use crate::step::osqp::OsqpSettings;
-use crate::study::converge::ConvergeError;
-use crate::scheme::RunError;
+use viscobar::plane::PlaneError;
+use viscobar::plane::contact::ContactMethod;
+use viscobar::plane::simulation::PlaneSimulation;
+use viscobar::scene::plane::{AnyScene, PlaneScene, load_any};
+use viscobar::step::osqp::OsqpSettings;
+use viscobar::study::converge::ConvergeError;
+use viscobar::time::RunError;
 
 /// The built-in scenes of the solver comparison.
 pub const CONTACT_SCENES: [&str; 2] = ["plane-tilted-drop", "plane-curved-obstacle"];
@@ -28,7 +28,7 @@ pub fn plane_error(e: PlaneError) -> ConvergeError {
     match e {
         PlaneError::Scene(s) => ConvergeError::Scene(s),
         other => ConvergeError::Run(RunError::SolverSetup {
-            solver: crate::plane::run::SOLVER_NAME.into(),
+            solver: viscobar::plane::run::SOLVER_NAME.into(),
             reason: other.to_string(),
         }),
     }
@@ -210,7 +210,7 @@ pub const PENALTY_EPSILONS: [f64; 2] = [1e-4, 1e-6];
 #[derive(Clone, Debug)]
 pub struct SceneCheck {
     pub name: String,
-    pub summary: crate::plane::run::PlaneSummary,
+    pub summary: viscobar::plane::run::PlaneSummary,
 }
 
 /// The exact runs of the built-in contact scenes.
@@ -220,7 +220,7 @@ pub fn scene_checks() -> Result<Vec<SceneCheck>, ConvergeError> {
         .map(|name| {
             let scene = plane_scene(name, &[])?;
             let (_, summary, _) =
-                crate::output::run_plane_in_memory(name, &scene).map_err(plane_error)?;
+                viscobar::plane::run::run_plane_in_memory(name, &scene).map_err(plane_error)?;
             Ok(SceneCheck {
                 name: name.to_string(),
                 summary,
@@ -231,7 +231,7 @@ pub fn scene_checks() -> Result<Vec<SceneCheck>, ConvergeError> {
 
 /// The generated block of VERIFICATION.md's "Plane contact" section (id `plane-contact`).
 pub fn markdown() -> Result<String, ConvergeError> {
-    use crate::study::plane_checks::{BAR_CASE_BODY, bar_case, bar_contact_case_scenes};
+    use crate::plane_checks::{BAR_CASE_BODY, bar_case, bar_contact_case_scenes};
     use std::fmt::Write;
     let mut md = String::from(
         "| bar scene | steps | steps in contact | plane rows (y_grading) | max abs(ux − u) / max abs(u) | max abs(uy) / max abs(u) | max abs(r_k − ω_k r) / max r |\n|---|---|---|---|---|---|---|\n",

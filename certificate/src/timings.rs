@@ -1,18 +1,18 @@
-//! VERIFICATION.md, "Error against run time" (issue #18): every solver setting at 4–5 levels
+//! VERIFICATION.md, "Error against run time": every solver setting at 4–5 levels
 //! on five scenes, errors against a closed form or a 4x finer exact run, and the wall time of
 //! the steps. Two generated blocks: the errors (deterministic; `tests/error_time_doc.rs` checks
 //! part of them) and the timings with the machine they were taken on (regenerated only by
-//! `viscobar verify --timings`). Runs through `study::converge` (errors in parallel, then a
+//! `verify --timings`). Runs through `viscobar::study::converge` (errors in parallel, then a
 //! serial timing pass, median of [`REPEATS`]).
 
-use crate::scene::{self, Scene};
-use crate::study::converge::{
-    ConvergeError, OSQP_EPS, PENALTY_EPSILON, Row, SolverSetting, Study, StudyOptions, study_with,
-};
-use crate::study::verify::Section;
-use crate::bar::Simulation;
+use crate::verify::Section;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use viscobar::scene::{self, Scene};
+use viscobar::study::converge::{
+    ConvergeError, OSQP_EPS, PENALTY_EPSILON, Row, SolverSetting, Study, StudyOptions, study_with,
+};
+use viscobar::time::simulation::Simulation;
 
 /// Timing repeats per run; the median is kept.
 pub const REPEATS: usize = 3;
@@ -320,7 +320,7 @@ pub fn utc_date_time_at(secs: u64) -> String {
 pub const ERRORS_ID: &str = "error-time-errors";
 pub const TIMINGS_ID: &str = "error-time-timings";
 
-/// The whole study (`viscobar verify --timings`): both blocks, and with `figures` the diagrams
+/// The whole study (`verify --timings`): both blocks, and with `figures` the diagrams
 /// `work-precision-<scene>.png` written there. Cases run one after the other; in each, errors
 /// in parallel, then the serial timing pass.
 pub fn sections(figures: Option<&Path>) -> Result<Vec<Section>, ConvergeError> {
@@ -352,27 +352,22 @@ pub fn sections(figures: Option<&Path>) -> Result<Vec<Section>, ConvergeError> {
     ])
 }
 
-/// `work-precision-<scene>.png` per study into `dir` (with the `plots` feature; without it,
-/// nothing).
+/// `work-precision-<scene>.png` per study into `dir`.
 pub fn write_figures(studies: &[Study], dir: &Path) -> Result<Vec<PathBuf>, ConvergeError> {
-    #[cfg_attr(not(feature = "plots"), expect(unused_mut))]
     let mut files = Vec::new();
-    #[cfg(feature = "plots")]
     for st in studies {
         std::fs::create_dir_all(dir).map_err(|source| ConvergeError::Write {
             path: dir.to_path_buf(),
             source,
         })?;
         let path = dir.join(format!("work-precision-{}.png", st.scene));
-        crate::study::work_precision::write_work_precision(&path, &st.title(), &st.lines())
+        viscobar::study::work_precision::write_work_precision(&path, &st.title(), &st.lines())
             .map_err(|e| ConvergeError::Draw {
                 path: path.clone(),
                 message: e.to_string(),
             })?;
         files.push(path);
     }
-    #[cfg(not(feature = "plots"))]
-    let _ = (studies, dir);
     Ok(files)
 }
 

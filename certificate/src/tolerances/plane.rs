@@ -1,0 +1,224 @@
+//! The plane body's tolerances (`tests/plane.rs`, `plane_contact.rs`, `plane_cli.rs`,
+//! `plane_contact_cli.rs`), each beside the measurement of what it guards.
+
+use super::{AGREEMENT_ULPS_PER_STEP, Measured};
+use viscobar::time::RunError;
+
+// ---- tests/plane.rs, tests/plane_contact.rs, tests/plane_cli.rs, tests/plane_contact_cli.rs ----
+
+/// The plane's energy identity (with the contact term): exact algebra, round-off only,
+/// relative to the largest of its terms (rows of 18 entries; the `K`-forms from strains).
+pub const PLANE_IDENTITY_TOL: f64 = 1e-12;
+/// Without load the plane's energy never rises (viscous term ≥ 0), up to round-off.
+pub const PLANE_ENERGY_RISE_TOL: f64 = 1e-13;
+/// The bar (with and without contact) as a special case of the plane body: the same equations
+/// and LCP, different factorisations: round-off only, relative to max |u| and max r.
+pub const PLANE_BAR_CASE_TOL: f64 = 1e-12;
+/// Penetration and `|r·gap|` of the plane's exact contact solver, relative to the gaps' scale
+/// (and `−dissipation` relative to the energy): the gap `g − u_n` is one subtraction of terms
+/// of that scale after a backward-stable solve that puts `u_n` on `g`: a few ulps, 8 ε.
+pub const PLANE_GAP_TOL: f64 = 8.0 * f64::EPSILON;
+/// Plane exact against OSQP (`eps = 1e-10`, polished), relative to max |u| and max r: the
+/// issue's requirement, kept as the outer contract; the check that can fail is
+/// [`plane_osqp_agreement_ratio`].
+pub const PLANE_OSQP_AGREEMENT_TOL: f64 = 1e-7;
+/// Normal compliance against the exact run: the penetration `ε r` perturbs the motion by up to
+/// twice itself where the wave reflects, and the release delayed by O(ε) can double that again
+/// (the bar's `PENALTY_AGREEMENT_FACTOR`, one contact episode): `|u − u_exact| ≤ 4 ε r_max`.
+pub const PLANE_PENALTY_FACTOR: f64 = 4.0;
+
+/// Plane OSQP against exact over its a-posteriori bound: per step, two backward-stable solves of
+/// the step's active-set system differ by [`AGREEMENT_ULPS_PER_STEP`] ε relative (the bar's
+/// constant; OSQP polished), accumulated linearly over the steps; the worst of the
+/// displacement (relative to max |u|) and the reaction (relative to max r).
+pub fn plane_osqp_agreement_ratio(a: &crate::plane_contact::Agreement) -> f64 {
+    let bound = a.steps as f64 * AGREEMENT_ULPS_PER_STEP * f64::EPSILON;
+    let relative = |d: f64, scale: f64| if scale > 0.0 { d / scale } else { d };
+    relative(a.max_u_deviation, a.max_u).max(relative(a.max_reaction_deviation, a.max_reaction))
+        / bound
+}
+
+/// Plane normal compliance at `epsilon` against exact: `max |u − u_exact|` over
+/// `PLANE_PENALTY_FACTOR ε r_max` (`r_max` of the exact run).
+pub fn plane_penalty_ratio(a: &crate::plane_contact::Agreement, epsilon: f64) -> f64 {
+    let bound = PLANE_PENALTY_FACTOR * epsilon * a.max_reaction;
+    if bound > 0.0 {
+        a.max_u_deviation / bound
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Worst values of what the plane tolerances guard, over every plane scene the tests run.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PlaneWorst {
+    /// Identity residual (every identity scene, steps after the first).
+    pub identity: f64,
+    /// Energy rise of the unforced scenes (`max_energy_rise`).
+    pub energy_rise: f64,
+    /// Bar case: max of `|ux − u|/max|u|`, `|uy|/max|u|`, `|r − ω r|/max r` over both sets.
+    pub bar_case: f64,
+    /// Contact scenes: max of penetration / scale and `|r·gap|` / (scale · total reaction).
+    pub gap: f64,
+    /// OSQP against exact, relative (displacement and reaction).
+    pub osqp_agreement: f64,
+    /// That over its bound ([`plane_osqp_agreement_ratio`]).
+    pub osqp_agreement_ratio: f64,
+    /// Penalty at the smaller ε against exact, over its bound ([`plane_penalty_ratio`]).
+    pub penalty_ratio: f64,
+}
+
+fn plane_run_error(e: viscobar::study::converge::ConvergeError) -> RunError {
+    match e {
+        viscobar::study::converge::ConvergeError::Run(r) => r,
+        viscobar::study::converge::ConvergeError::Scene(s) => RunError::Scene(s),
+        other => RunError::SolverSetup {
+            solver: viscobar::plane::run::SOLVER_NAME.into(),
+            reason: other.to_string(),
+        },
+    }
+}
+
+/// [`PlaneWorst`] over the scenes of `tests/plane.rs` and `tests/plane_contact.rs`.
+pub fn plane_worst() -> Result<PlaneWorst, RunError> {
+    use crate::plane_checks::{
+        bar_case, bar_case_scenes, bar_contact_case_scenes, identity_scenes,
+    };
+    use crate::plane_contact::{
+        CONTACT_SCENES, PENALTY_EPSILONS, agreement, osqp_method, plane_error, plane_scene,
+    };
+    use viscobar::plane::contact::ContactMethod;
+    use viscobar::plane::run::run_plane_in_memory;
+    let mut w = PlaneWorst::default();
+    for (name, scene) in identity_scenes() {
+        let (records, summary, sim) = run_plane_in_memory(&name, &scene)
+            .map_err(plane_error)
+            .map_err(plane_run_error)?;
+        let sim_has_contact = sim.contact().is_some();
+        for r in records.iter().skip(1) {
+            w.identity = w.identity.max(r.identity_residual);
+        }
+        if let Some(rise) = summary.max_energy_rise {
+            w.energy_rise = w.energy_rise.max(rise);
+        }
+        for r in &records {
+            let c = &r.contact;
+            if sim_has_contact && r.energy > 0.0 {
+                w.gap = w.gap.max(-c.dissipation / r.energy);
+            }
+            if c.gap_scale > 0.0 {
+                w.gap = w.gap.max(c.penetration / c.gap_scale);
+                if c.total_reaction > 0.0 {
+                    w.gap = w
+                        .gap
+                        .max(c.complementarity / (c.gap_scale * c.total_reaction));
+                }
+            }
+        }
+    }
+    for (_, bar) in bar_case_scenes()
+        .into_iter()
+        .chain(bar_contact_case_scenes())
+    {
+        let c = bar_case(&bar).map_err(plane_run_error)?;
+        w.bar_case = w
+            .bar_case
+            .max(c.max_ux_deviation / c.max_u)
+            .max(c.max_uy / c.max_u);
+        if c.max_reaction > 0.0 {
+            w.bar_case = w.bar_case.max(c.max_reaction_deviation / c.max_reaction);
+        }
+    }
+    let smallest_epsilon = PENALTY_EPSILONS
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    for name in CONTACT_SCENES {
+        let scene = plane_scene(name, &[]).map_err(plane_run_error)?;
+        let a = agreement(&scene, osqp_method()).map_err(plane_run_error)?;
+        w.osqp_agreement = w
+            .osqp_agreement
+            .max(a.max_u_deviation / a.max_u)
+            .max(a.max_reaction_deviation / a.max_reaction);
+        w.osqp_agreement_ratio = w.osqp_agreement_ratio.max(plane_osqp_agreement_ratio(&a));
+        if name == "plane-tilted-drop" {
+            let p = agreement(
+                &scene,
+                ContactMethod::Penalty {
+                    epsilon: smallest_epsilon,
+                },
+            )
+            .map_err(plane_run_error)?;
+            w.penalty_ratio = plane_penalty_ratio(&p, smallest_epsilon);
+        }
+    }
+    Ok(w)
+}
+
+/// The registry's rows of the plane tolerances.
+pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
+    let w = plane_worst()?;
+    let rows = [
+        (
+            "PLANE_IDENTITY_TOL",
+            "tests/plane.rs, plane_contact.rs, plane_cli.rs, plane_contact_cli.rs",
+            PLANE_IDENTITY_TOL,
+            w.identity,
+            "round-off of the identity's sums (built-in plane scenes and the manufactured one)",
+        ),
+        (
+            "PLANE_ENERGY_RISE_TOL",
+            "tests/plane.rs",
+            PLANE_ENERGY_RISE_TOL,
+            w.energy_rise,
+            "a rise is round-off only; the worst starts at 0, so a scene whose energy never rises shows 0",
+        ),
+        (
+            "PLANE_BAR_CASE_TOL",
+            "tests/plane.rs, plane_contact.rs",
+            PLANE_BAR_CASE_TOL,
+            w.bar_case,
+            "the bar's and the plane's factorisations of the same equations",
+        ),
+        (
+            "PLANE_GAP_TOL",
+            "tests/plane_contact.rs, plane_contact_cli.rs",
+            PLANE_GAP_TOL,
+            w.gap,
+            "8 ε: the gap's subtraction after a backward-stable solve (also −dissipation / E)",
+        ),
+        (
+            "PLANE_OSQP_AGREEMENT_TOL",
+            "tests/plane_contact.rs",
+            PLANE_OSQP_AGREEMENT_TOL,
+            w.osqp_agreement,
+            "the issue's stated requirement (1e-7), kept as the outer contract; the check that \
+             can fail is the per-run bound of the next row",
+        ),
+        (
+            "plane OSQP relative |Δu|, |Δr| / (steps · AGREEMENT_ULPS_PER_STEP ε)",
+            "tests/plane_contact.rs",
+            1.0,
+            w.osqp_agreement_ratio,
+            "two backward-stable solves per step (OSQP polished), accumulated linearly",
+        ),
+        (
+            "plane penalty |u − u_exact| / (PLANE_PENALTY_FACTOR ε r_max), ε = 1e-6",
+            "tests/plane_contact.rs",
+            1.0,
+            w.penalty_ratio,
+            "the penetration ε r, doubled at a reflection and again by the delayed release \
+             (plane-tilted-drop, one episode)",
+        ),
+    ];
+    Ok(rows
+        .into_iter()
+        .map(|(name, used_in, tolerance, worst, note)| Measured {
+            name: name.into(),
+            used_in,
+            tolerance,
+            worst,
+            note,
+        })
+        .collect())
+}
