@@ -2,22 +2,24 @@
 //! 1e6 with `VISCOBAR_BENCH_PLANE_1E6=1`: about 5 s of set-up and 1 GB for the factor).
 //!
 //! A cantilever-like body on `nx × nx/2` cells of `(0, 2) × (0, 1)`, left edge clamped,
-//! `λ = 1`, `μ = ½`, `α = 0.02`, `Δt = h`, under a constant load (as the sparse-Cholesky probe
-//! in `../shared/notes/faer-sparse-cholesky.md`). `plane-step/N` is a whole step (right-hand
-//! side, solve, energy balance), `plane-solve/N` one solve; after criterion's groups the bench
-//! prints the ratio step / solve from medians of its own timings.
+//! `λ = 1`, `μ = ½`, `α = 0.02`, `Δt = h`, under a constant load (as the probe of
+//! `docs/sparse-cholesky.md`). `plane-step/N` is a whole step (right-hand side, solve, energy
+//! balance), `plane-solve/N` one solve with a factor of the same `C`; after criterion's groups
+//! the bench prints the ratio step / solve from medians of its own timings.
 //!
 //! `plane-contact`: a block resting on a Signorini floor (every bottom node in contact), the
 //! exact step against the unconstrained step of the same body with a free bottom, at 1e4 …
 //! 2e5 unknowns with up to 200 contact normals and at 1e5 with 500; it prints the ratio, the
 //! set-up cost of `S` (the contact run's set-up minus the free one's) and OSQP's step over the
-//! exact one (up to 5e4 unknowns). `plane-contact/kratos-block-30x15-200-steps` is the issue's
-//! Kratos point: the built-in `plane-block-drop` end to end in memory (`bench_kratos`).
+//! exact one (up to 5e4 unknowns). `plane-contact/kratos-block-30x15-200-steps` is the built-in
+//! `plane-block-drop` end to end in memory, the size of a Kratos comparison run (`bench_kratos`).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use std::time::Instant;
+use viscobar::linalg::cholesky::SparseCholesky;
 use viscobar::plane::PlaneSimulation;
 use viscobar::scene::plane::PlaneScene;
+use viscobar::scene::{SolverMethod, SolverSpec};
 
 fn scene(nx: u64) -> PlaneScene {
     let dt = 2.0 / nx as f64;
@@ -59,20 +61,22 @@ fn bench(c: &mut Criterion) {
     let mut ratios = Vec::new();
     for nx in sizes() {
         let mut sim = PlaneSimulation::new(&scene(nx)).unwrap();
-        let n = sim.discretisation().unknowns();
+        let d = sim.discretisation();
+        let n = d.unknowns();
+        let mut chol = SparseCholesky::new(&d.pattern, &d.step_matrix(), "C").unwrap();
         group.throughput(Throughput::Elements(n as u64));
         group.bench_function(BenchmarkId::new("plane-step", n), |b| {
             b.iter(|| sim.step().unwrap())
         });
         let mut x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
         group.bench_function(BenchmarkId::new("plane-solve", n), |b| {
-            b.iter(|| sim.solve_in_place(&mut x))
+            b.iter(|| chol.solve_in_place(&mut x))
         });
         let runs = if n > 200_000 { 5 } else { 21 };
         let step = median(runs, || {
             sim.step().unwrap();
         });
-        let solve = median(runs, || sim.solve_in_place(&mut x));
+        let solve = median(runs, || chol.solve_in_place(&mut x));
         ratios.push((n, step, solve));
     }
     group.finish();
@@ -115,8 +119,6 @@ const CONTACT_SIZES: [(u64, u64); 5] = [(99, 50), (199, 24), (199, 100), (199, 5
 /// The exact step with contact against the unconstrained step of the same body, the set-up of
 /// `S` (m solves, blocked), and OSQP's step where it is affordable (at most 5e4 unknowns).
 fn bench_contact(c: &mut Criterion) {
-    use viscobar::plane::contact::ContactMethod;
-    use viscobar::step::osqp::OsqpSettings;
     let mut group = c.benchmark_group("plane-contact");
     group.sample_size(10);
     let mut rows = Vec::new();
@@ -128,7 +130,7 @@ fn bench_contact(c: &mut Criterion) {
         let mut sim = PlaneSimulation::new(&resting(nx, ny, true)).unwrap();
         let setup_contact = t.elapsed().as_secs_f64();
         let n = sim.discretisation().unknowns();
-        let m = sim.contact().map_or(0, |c| c.len());
+        let m = sim.contact().len();
         // Settle into contact before timing.
         for _ in 0..20 {
             sim.step().unwrap();
@@ -147,13 +149,14 @@ fn bench_contact(c: &mut Criterion) {
         let unconstrained = median(runs, || {
             free.step().unwrap();
         });
-        let active = sim.step().unwrap().contact.active;
+        let active = sim.step().unwrap().contact.contact_nodes;
         let osqp = (n <= 50_000).then(|| {
-            let mut o = PlaneSimulation::with_method(
-                &resting(nx, ny, true),
-                ContactMethod::Osqp(OsqpSettings::default()),
-            )
-            .unwrap();
+            let mut scene = resting(nx, ny, true);
+            scene.solver = SolverSpec {
+                method: SolverMethod::Osqp,
+                ..SolverSpec::default()
+            };
+            let mut o = PlaneSimulation::new(&scene).unwrap();
             for _ in 0..20 {
                 o.step().unwrap();
             }
@@ -187,12 +190,13 @@ fn bench_contact(c: &mut Criterion) {
     }
 }
 
-/// The Kratos point (Kratos 10.4.4: 12–28 s on this machine): the built-in
-/// `plane-block-drop`, a 30 × 15 block falling onto a floor for 200 steps, undamped (α = 0, as
-/// Kratos' Newmark run) and with the talk's α = 0.1; set-up and the 200 exact steps end to end
-/// in memory (`run_plane_in_memory`: the scene validated, the factor, `S`, every record).
+/// The built-in `plane-block-drop` at the size of a Kratos comparison run (Kratos 10.4.4 takes
+/// 12–28 s for it on this machine): a 30 × 15 block falling onto a floor for 200 steps,
+/// undamped (α = 0, as a Newmark run) and with the talk's α = 0.1; set-up and the 200 exact
+/// steps end to end in memory (`run_plane_in_memory`: the scene validated, the factor, `S`,
+/// every record).
 fn bench_kratos(c: &mut Criterion) {
-    use viscobar::plane::run::run_plane_in_memory;
+    use viscobar::output::run_plane_in_memory;
     use viscobar::scene::{AnyScene, load_any};
     let mut group = c.benchmark_group("plane-contact");
     group.sample_size(20);

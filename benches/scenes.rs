@@ -13,8 +13,8 @@
 use criterion::{BatchSize, BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use std::path::Path;
 use std::time::{Duration, Instant};
+use viscobar::output::{run_in_memory, run_to_dir};
 use viscobar::study::figures::talk_scenes;
-use viscobar::time::run::{run_in_memory, run_to_dir};
 
 fn bench_scenes(c: &mut Criterion) {
     let mut group = c.benchmark_group("scenes");

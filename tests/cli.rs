@@ -32,7 +32,7 @@ fn run_writes_summary_history_and_displacement() {
         "dt",
         "steps",
         "wall_time_s",
-        "ns_per_node_step",
+        "ns_per_unknown_step",
         "energy_initial",
         "energy_final",
         "max_energy_rise",
@@ -161,7 +161,7 @@ fn scenes_and_show_list_the_builtins() {
 
 /// Summary fields that measure the machine, not the numerics: the only content allowed to
 /// differ between two runs.
-const TIMING_FIELDS: [&str; 3] = ["wall_time_s", "ns_per_node_step", "time_shares"];
+const TIMING_FIELDS: [&str; 3] = ["wall_time_s", "ns_per_unknown_step", "time_shares"];
 
 #[test]
 fn two_runs_give_byte_identical_outputs() {
@@ -392,7 +392,7 @@ fn compare_prints_the_agreement_of_each_solver_with_the_first() {
         .lines()
         .find(|l| l.starts_with("| solvers |"))
         .unwrap_or_else(|| panic!("no table: {table}"));
-    for column in ["steps", "max \\|Δu\\|", "max \\|Δreaction\\| (ends)"] {
+    for column in ["steps", "max \\|Δu\\|", "max \\|Δreaction\\| (per group)"] {
         assert!(header.contains(column), "lacks {column}: {header}");
     }
     let osqp = row(&table, "osqp vs exact");
@@ -607,7 +607,10 @@ fn converge_on_a_scene_file_writes_valid_csv_with_energy_and_contact_errors() {
     let records =
         read_csv_strictly(&std::fs::read_to_string(csv_dir.join("convergence.csv")).unwrap());
     let header = &records[0];
-    assert_eq!(header.len(), viscobar::study::converge::CSV_HEADER.len());
+    assert_eq!(
+        header.len(),
+        viscobar::study::convergence_table::CSV_HEADER.len()
+    );
     let column = |name: &str| header.iter().position(|h| h == name).unwrap();
     // exact, osqp 1e-6, osqp 1e-9 at 2 levels.
     assert_eq!(records.len(), 1 + 3 * 2, "{records:?}");

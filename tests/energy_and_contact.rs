@@ -3,8 +3,8 @@
 
 mod common;
 use common::{COMPLEMENTARITY_TOL, ENERGY_RISE_TOL, GAP_TOL, IDENTITY_TOL, REACTION_TOL};
+use viscobar::output::run_in_memory;
 use viscobar::scene::{self, MassVariant, builtin_names};
-use viscobar::time::run::run_in_memory;
 // Defined beside their measurement in the tolerance registry (`viscobar-certificate verify
 // --tolerances`).
 use viscobar_certificate::tolerances::{
@@ -79,21 +79,21 @@ fn complementarity_holds_at_every_step_and_constrained_node() {
             // The record's aggregates run over every constrained node (ends and obstacle).
             if constrained > 0 {
                 assert!(
-                    r.min_gap >= -GAP_TOL,
+                    r.contact.min_gap >= -GAP_TOL,
                     "{name}: gap {:e} at step {}",
-                    r.min_gap,
+                    r.contact.min_gap,
                     r.step
                 );
                 assert!(
-                    r.min_reaction >= -REACTION_TOL,
+                    r.contact.min_reaction >= -REACTION_TOL,
                     "{name}: reaction {:e} at step {}",
-                    r.min_reaction,
+                    r.contact.min_reaction,
                     r.step
                 );
                 assert!(
-                    r.max_complementarity <= COMPLEMENTARITY_TOL,
+                    r.contact.max_complementarity <= COMPLEMENTARITY_TOL,
                     "{name}: |gap·reaction| = {:e} at step {}",
-                    r.max_complementarity,
+                    r.contact.max_complementarity,
                     r.step
                 );
             }

@@ -5,9 +5,10 @@
 mod common;
 
 use common::{IDENTITY_TOL, KINK_ORDER_BAND, builtin};
+use viscobar::ContactEpisode;
 use viscobar::bar::matrices::{MatrixVariant, mass};
+use viscobar::output::text::{TIME_DIGITS, output_time};
 use viscobar::study::accuracy::observed_order;
-use viscobar::time::summary::{ContactEpisode, TIME_DIGITS, output_time};
 use viscobar::{Summary, run_in_memory};
 
 // Defined beside its measurement in the tolerance registry (`viscobar-certificate verify
@@ -116,13 +117,19 @@ fn distributed_obstacle_episodes_are_of_the_whole_set() {
     let (records, summary, _) = run_in_memory("distributed", &scene).unwrap();
     let e = episodes(&summary, "obstacle");
     assert!(!e.is_empty());
-    let in_contact = records.iter().filter(|r| r.contact_nodes > 0).count();
+    let in_contact = records
+        .iter()
+        .filter(|r| r.contact.contact_nodes > 0)
+        .count();
     let covered: f64 = e
         .iter()
         .map(|e| ((e.end - e.start) / scene.time.step).round() + 1.0)
         .sum();
     assert_eq!(covered as usize, in_contact);
-    let peak = records.iter().map(|r| r.total_reaction).fold(0.0, f64::max);
+    let peak = records
+        .iter()
+        .map(|r| r.contact.total_reaction)
+        .fold(0.0, f64::max);
     assert_eq!(e.iter().map(|e| e.peak_reaction).fold(0.0, f64::max), peak);
 }
 

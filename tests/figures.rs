@@ -63,8 +63,14 @@ fn sampled_run_holds_the_runs_mesh_values_and_peak_reactions() {
         let bin = &records[w[0]..w[1]]; // steps w[0]+1 ..= w[1]
         assert_eq!(run.contact.times[b], bin.last().unwrap().time);
         for j in 0..2 {
-            let r = bin.iter().map(|r| r.reaction[j]).fold(f64::MIN, f64::max);
-            let g = bin.iter().map(|r| r.gap[j]).fold(f64::MAX, f64::min);
+            let r = bin
+                .iter()
+                .map(|r| r.contact.groups[j].reaction)
+                .fold(f64::MIN, f64::max);
+            let g = bin
+                .iter()
+                .map(|r| r.contact.groups[j].min_gap)
+                .fold(f64::MAX, f64::min);
             assert_eq!(
                 run.contact.reaction[2 * b + j],
                 r,
@@ -78,7 +84,7 @@ fn sampled_run_holds_the_runs_mesh_values_and_peak_reactions() {
         peak > 0.0,
         "the window must contain contact, or the test checks nothing"
     );
-    let (_, summary, _) = viscobar::time::run::run_in_memory("both-ends", &scene).unwrap();
+    let (_, summary, _) = viscobar::output::run_in_memory("both-ends", &scene).unwrap();
     assert_eq!(run.summary.contact_intervals, summary.contact_intervals);
 }
 

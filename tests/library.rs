@@ -54,7 +54,7 @@ fn bad_fields_built_in_code_are_named() {
 fn with_solver_validates_its_scene() {
     let scene = impact();
     let disc = Discretisation::new(&scene).unwrap();
-    let solver = viscobar::time::simulation::make_solver(&scene, &disc).unwrap();
+    let solver = viscobar::bar::body::make_solver(&scene, &disc).unwrap();
     let mut bad = scene.clone();
     bad.time.end = f64::NAN;
     let e = Simulation::with_solver(&bad, disc, solver).err().unwrap();

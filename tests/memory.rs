@@ -47,7 +47,7 @@ fn peak_heap(scene: &viscobar::Scene, steps: usize) -> usize {
     let base = LIVE.with(Cell::get);
     PEAK.with(|p| p.set(base));
     let mut sim = viscobar::Simulation::new(scene).unwrap();
-    let mut tracker = viscobar::time::summary::Tracker::new(&sim, scene.load.density.is_none());
+    let mut tracker = viscobar::output::Tracker::new(&sim, scene.load.density.is_none());
     for _ in 0..steps {
         tracker.observe(&sim.step().unwrap());
     }

@@ -3,7 +3,7 @@
 
 mod common;
 use viscobar::Simulation;
-use viscobar::time::run::run_to_dir;
+use viscobar::output::run_to_dir;
 
 #[test]
 fn displacement_csv_reads_back_to_the_simulation_bits() {
@@ -27,7 +27,7 @@ fn displacement_csv_reads_back_to_the_simulation_bits() {
             assert_eq!(f[3].to_bits(), v[i].to_bits(), "v in {row}");
         }
     };
-    sim.initial_state_into(&mut u, &mut v);
+    sim.body().initial_state_into(&mut u, &mut v);
     check(&u, &v);
     let steps = scene.steps();
     let keep = |n: usize| n.is_multiple_of(7) || n == steps;
@@ -183,7 +183,7 @@ fn cli_run_with_npy_output_without_the_feature_exits_2_writing_nothing() {
 /// (a bar of 1e24), and times needing every digit.
 #[test]
 fn t_and_x_are_the_display_of_the_rounded_values() {
-    use viscobar::time::summary::output_time;
+    use viscobar::output::text::output_time;
     for (tag, sets) in [
         ("unit", vec!["mesh.elements=80"]),
         ("short", vec!["bar.length=1.23e-5", "mesh.elements=50"]),

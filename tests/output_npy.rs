@@ -6,9 +6,9 @@
 mod common;
 use std::path::{Path, PathBuf};
 use viscobar::Simulation;
-use viscobar::time::npy::ProfileRow;
-use viscobar::time::run::run_to_dir;
-use viscobar::time::summary::output_time;
+use viscobar::output::npy::ProfileRow;
+use viscobar::output::run_to_dir;
+use viscobar::output::text::output_time;
 
 fn fresh_dir(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("viscobar-npy-{tag}-{}", std::process::id()));
@@ -17,7 +17,7 @@ fn fresh_dir(tag: &str) -> PathBuf {
 }
 
 /// The rows of `dir/displacement.npy` through npyz's reader, after checking its header.
-fn read_npy(dir: &Path, rows: u64) -> Vec<ProfileRow> {
+fn read_npy(dir: &Path, rows: u64) -> Vec<ProfileRow<4>> {
     let bytes = std::fs::read(dir.join("displacement.npy")).unwrap();
     let npy = npyz::NpyFile::new(&bytes[..]).unwrap();
     assert_eq!(npy.shape(), &[rows], "shape");
@@ -34,7 +34,7 @@ fn read_npy(dir: &Path, rows: u64) -> Vec<ProfileRow> {
             .collect(),
     );
     assert_eq!(npy.dtype(), expected, "dtype");
-    npy.into_vec::<ProfileRow>().unwrap()
+    npy.into_vec::<ProfileRow<4>>().unwrap()
 }
 
 #[test]
@@ -73,14 +73,15 @@ fn displacement_npy_holds_the_simulation_bits_and_the_csv_rows() {
         let mut check = |t: f64, u: &[f64], v: &[f64], sim: &Simulation| {
             for &i in &written {
                 let r = next.next().expect("a row a written node");
-                assert_eq!(r.t.to_bits(), output_time(t).to_bits(), "t at {t}");
+                let [rt, rx, ru, rv] = r.0;
+                assert_eq!(rt.to_bits(), output_time(t).to_bits(), "t at {t}");
                 let x = output_time(sim.discretisation().x(i));
-                assert_eq!(r.x.to_bits(), x.to_bits(), "x of node {i}");
-                assert_eq!(r.u.to_bits(), u[i].to_bits(), "u at t = {t}, node {i}");
-                assert_eq!(r.v.to_bits(), v[i].to_bits(), "v at t = {t}, node {i}");
+                assert_eq!(rx.to_bits(), x.to_bits(), "x of node {i}");
+                assert_eq!(ru.to_bits(), u[i].to_bits(), "u at t = {t}, node {i}");
+                assert_eq!(rv.to_bits(), v[i].to_bits(), "v at t = {t}, node {i}");
             }
         };
-        sim.initial_state_into(&mut u, &mut v);
+        sim.body().initial_state_into(&mut u, &mut v);
         check(0.0, &u, &v, &sim);
         let steps = scene.steps();
         for n in 1..=steps {
@@ -104,7 +105,7 @@ fn displacement_npy_holds_the_simulation_bits_and_the_csv_rows() {
         for (line, r) in text.lines().skip(1).zip(&rows) {
             let f: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
             let bits = |a: &[f64]| a.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            assert_eq!(bits(&f), bits(&[r.t, r.x, r.u, r.v]), "{line}");
+            assert_eq!(bits(&f), bits(&r.0), "{line}");
             count += 1;
         }
         assert_eq!(count as u64, sampling.rows, "{tag}: CSV rows");
@@ -153,4 +154,47 @@ fn a_run_in_one_format_removes_the_other_formats_stale_profiles() {
     run_to_dir("impact", &csv, &dir, false).unwrap();
     assert!(!dir.join("displacement.npy").exists(), "stale npy removed");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The plane body writes the same format: `t, x, y, ux, uy, vx, vy`, every value the bits of
+/// the CSV of the same run, sampled in both directions by `output.nodes`.
+#[test]
+fn a_plane_run_writes_the_same_rows_as_its_csv() {
+    use viscobar::scene::{AnyScene, load_any};
+    let plane = |extra: &[&str]| {
+        let mut set = vec!["time.end=0.1", "output.every=5", "output.nodes=60"];
+        set.extend(extra);
+        let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+        match load_any("plane-tilted-drop", &set).unwrap().1 {
+            AnyScene::Plane(s) => *s,
+            AnyScene::Bar(_) => unreachable!(),
+        }
+    };
+    let (csv_scene, npy_scene) = (plane(&[]), plane(&["output.format=npy"]));
+    let sampling = npy_scene.output_sampling();
+    let (a, b) = (fresh_dir("plane-csv"), fresh_dir("plane-npy"));
+    viscobar::output::run_plane_to_dir("drop", &csv_scene, &a, false).unwrap();
+    viscobar::output::run_plane_to_dir("drop", &npy_scene, &b, false).unwrap();
+    let bytes = std::fs::read(b.join("displacement.npy")).unwrap();
+    let npy = npyz::NpyFile::new(&bytes[..]).unwrap();
+    assert_eq!(npy.shape(), &[sampling.rows]);
+    let rows = npy.into_vec::<ProfileRow<7>>().unwrap();
+    let text = std::fs::read_to_string(a.join("displacement.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("t,x,y,ux,uy,vx,vy"));
+    let mut count = 0;
+    for (line, r) in lines.zip(&rows) {
+        let f: Vec<u64> = line
+            .split(',')
+            .map(|c| c.parse::<f64>().unwrap().to_bits())
+            .collect();
+        assert_eq!(f, r.0.map(f64::to_bits).to_vec(), "{line}");
+        count += 1;
+    }
+    assert_eq!(count, rows.len());
+    assert_eq!(count as u64, sampling.rows);
+    assert!(sampling.nodes_written <= 60 && sampling.node_stride > 1);
+    for d in [a, b] {
+        std::fs::remove_dir_all(&d).unwrap();
+    }
 }

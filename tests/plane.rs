@@ -3,7 +3,7 @@
 //! `viscobar_certificate::plane_checks` (which also writes VERIFICATION.md's "Plane body" tables).
 //! Run in release (the sparse factorisation is ~150x slower in debug).
 
-use viscobar::plane::run::run_plane_in_memory;
+use viscobar::output::run_plane_in_memory;
 use viscobar_certificate::plane_checks::{
     MANUFACTURED_LEVELS, bar_case, bar_case_scenes, identity_scenes, manufactured_level,
     observed_order,

@@ -1,9 +1,9 @@
-//! Signorini contact on the plane body's edges (issue 21): the bar with contact as an exact
-//! special case, and the contact conditions and energy identity at every node and step of
-//! every built-in plane scene. Run in release.
+//! Signorini contact on the plane body's edges: the bar with contact as an exact special case,
+//! and the contact conditions and energy identity at every node and step of every built-in
+//! plane scene. Run in release.
 
-use viscobar::plane::run::run_plane_in_memory;
 use viscobar_certificate::plane_checks::{bar_case, bar_contact_case_scenes, identity_scenes};
+use viscobar_certificate::plane_contact::checked_run;
 
 // The tolerances of this file: in the registry (viscobar_certificate::tolerances), which measures
 // their worst values over these scenes (`viscobar-certificate verify --tolerances`).
@@ -41,37 +41,35 @@ fn the_bar_with_contact_is_an_exact_special_case_of_the_plane_body() {
 fn contact_conditions_and_energy_identity_hold_at_every_node_and_step_of_every_plane_scene() {
     let mut with_contact = 0;
     for (name, scene) in identity_scenes() {
-        let (records, summary, sim) = run_plane_in_memory(&name, &scene).unwrap();
-        if sim.contact().is_none() {
+        if scene.edges.gaps().unwrap().iter().all(Option::is_none) {
             continue;
         }
+        let (records, summary, checks) = checked_run(&name, &scene).unwrap();
         with_contact += 1;
+        let in_contact = |r: &viscobar::StepRecord| r.contact.contact_nodes;
         assert!(
-            records.iter().any(|r| r.contact.active > 0),
+            records.iter().any(|r| in_contact(r) > 0),
             "{name}: no contact"
         );
         assert!(
-            records.iter().any(|r| r.contact.active > 0)
-                && records.last().unwrap().contact.active
-                    < records.iter().map(|r| r.contact.active).max().unwrap(),
+            in_contact(records.last().unwrap()) < records.iter().map(in_contact).max().unwrap(),
             "{name}: the contact set never shrinks"
         );
-        for r in &records {
-            let c = &r.contact;
+        for (r, c) in records.iter().zip(&checks) {
             assert!(
-                c.penetration <= GAP_TOL * c.gap_scale,
+                c.penetration <= GAP_TOL * c.scale,
                 "{name} step {}: penetration {:e}",
                 r.step,
                 c.penetration
             );
             assert!(
-                c.complementarity <= GAP_TOL * c.gap_scale * c.total_reaction,
+                c.complementarity <= GAP_TOL * c.scale * r.contact.total_reaction,
                 "{name} step {}: r·gap {:e}",
                 r.step,
                 c.complementarity
             );
             assert!(
-                r.contact.dissipation >= -GAP_TOL * r.energy,
+                r.contact_dissipation >= -GAP_TOL * r.energy,
                 "{name} step {}",
                 r.step
             );
@@ -88,7 +86,7 @@ fn contact_conditions_and_energy_identity_hold_at_every_node_and_step_of_every_p
         // The contact term is part of the balance: dropping it breaks the identity.
         let big = records
             .iter()
-            .map(|r| r.contact.dissipation)
+            .map(|r| r.contact_dissipation)
             .fold(0.0, f64::max);
         assert!(
             big > 1e3 * IDENTITY_TOL * records[0].energy,
@@ -125,11 +123,12 @@ fn exact_and_osqp_agree_on_the_two_dimensional_contact_scenes() {
     }
 }
 
-/// Observed orders of the tilted drop's max nodal error against the level-3 exact run: measured
-/// 1.85 and 1.81 (VERIFICATION.md); the scheme is second order for smooth motion, contact
-/// (non-smooth in time) and the reference's own error (a quarter of the finest level's at
-/// order 2) pull the orders below 2. The band: the measured values ± 0.25.
-const ORDER_BAND: (f64, f64) = (1.55, 2.1);
+/// Observed orders of the tilted drop's max nodal error against the level-3 exact run, every
+/// level compared with the reference at the same times from `t = 0`: measured 1.85 and 2.13
+/// (VERIFICATION.md); the scheme is second order for smooth motion, and contact (non-smooth in
+/// time) and the reference's own error move the orders around 2. The band: the measured values
+/// ± 0.25.
+const ORDER_BAND: (f64, f64) = (1.6, 2.38);
 
 #[test]
 fn the_tilted_drop_converges_against_a_finer_exact_run() {
@@ -156,11 +155,11 @@ const PENALTY_MIN_RATIO: f64 = 10.0;
 
 #[test]
 fn the_penalty_tends_to_the_exact_solution_as_epsilon_decreases() {
-    use viscobar::plane::contact::ContactMethod;
+    use viscobar_certificate::plane_contact::Method;
     use viscobar_certificate::plane_contact::*;
     let scene = plane_scene("plane-tilted-drop", &[]).unwrap();
-    let [a, b] = PENALTY_EPSILONS
-        .map(|epsilon| agreement(&scene, ContactMethod::Penalty { epsilon }).unwrap());
+    let [a, b] =
+        PENALTY_EPSILONS.map(|epsilon| agreement(&scene, Method::Penalty { epsilon }).unwrap());
     let (ea, eb) = (a.max_u_deviation / a.max_u, b.max_u_deviation / b.max_u);
     assert!(ea >= PENALTY_MIN_RATIO * eb, "{ea:e} {eb:e}");
     let ratio = plane_penalty_ratio(&b, PENALTY_EPSILONS[1]);

@@ -60,18 +60,16 @@ fn the_tilted_drop_matches_its_reviewed_snapshot() {
         if n > 1 && !(n * (T_POINTS - 1)).is_multiple_of(steps) {
             continue;
         }
-        let c = sim.contact().unwrap();
-        let u = sim.displacement();
+        let u = sim.displacement_dofs();
         let grid = &sim.discretisation().grid;
         let nodes = grid.nodes() as f64;
         let mean_u = [0, 1].map(|k| u.iter().skip(k).step_by(2).sum::<f64>() / nodes);
         let min_bottom_uy = (0..=grid.nx)
             .map(|i| u[2 * grid.node(i, 0) + 1])
             .fold(f64::INFINITY, f64::min);
-        let touching: Vec<_> = c
-            .normals
-            .iter()
-            .zip(c.reactions())
+        // The normals pressed by their obstacle (a positive reaction).
+        let touching: Vec<_> = (sim.body().normals().iter())
+            .zip(sim.reactions())
             .filter(|(_, r)| **r > 0.0)
             .collect();
         rows.push(Row {

@@ -29,10 +29,10 @@ fn run(toml: &str) -> Run {
     let scene = PlaneScene::from_toml(toml, &[]).unwrap_or_else(|e| panic!("{e}\n{toml}"));
     let mut sim = PlaneSimulation::new(&scene).unwrap_or_else(|e| panic!("{e}\n{toml}"));
     let frame = |sim: &PlaneSimulation| {
-        let c = sim.contact().expect("the scene has Signorini edges");
-        let r = c.normals.iter().zip(c.reactions());
+        assert!(!sim.contact().is_empty(), "the scene has Signorini edges");
+        let r = sim.body().normals().iter().zip(sim.reactions());
         let r = r.map(|(n, &r)| ((EDGE_NAMES[n.edge].to_string(), n.node), r));
-        (sim.displacement(), r.collect())
+        (sim.displacement_dofs(), r.collect())
     };
     let mut frames = vec![frame(&sim)];
     for _ in 1..scene.steps() {

@@ -9,8 +9,10 @@ use std::path::Path;
 
 use osqp::Status;
 use viscobar::RunError;
+use viscobar::Simulation;
 use viscobar::linalg::norms::max_abs;
 use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::output::run_in_memory;
 use viscobar::scene::{MassVariant, Scene};
 use viscobar::step::audit::dual_tolerance;
 use viscobar::step::osqp::{OSQP_INFTY, OsqpSettings, OsqpSolver, raw_problem};
@@ -19,8 +21,6 @@ use viscobar::step::penalty::PenaltySettings;
 use viscobar::step::{StepFailure, StepSolver};
 use viscobar::study::accuracy::observed_order;
 use viscobar::study::compare::compare;
-use viscobar::time::run::run_in_memory;
-use viscobar::time::simulation::Simulation;
 use viscobar_certificate::agreement::start_up_problem;
 use viscobar_certificate::agreement::stiff_impact_overrides;
 
@@ -106,18 +106,18 @@ fn check_solver(method: Method) {
             // Every constrained node (the obstacle's too), through the record's aggregates.
             if scene.obstacle.is_some() && matches!(method, Method::Exact) {
                 assert!(
-                    r.min_gap >= -GAP_TOL && r.min_reaction >= -REACTION_TOL,
+                    r.contact.min_gap >= -GAP_TOL && r.contact.min_reaction >= -REACTION_TOL,
                     "{name}: step {}",
                     r.step
                 );
                 assert!(
-                    r.max_complementarity <= COMPLEMENTARITY_TOL,
+                    r.contact.max_complementarity <= COMPLEMENTARITY_TOL,
                     "{name}: step {}",
                     r.step
                 );
             }
             for j in 0..k {
-                let (g, l) = (r.gap[j], r.reaction[j]);
+                let (g, l) = (r.contact.groups[j].min_gap, r.contact.groups[j].reaction);
                 max_reaction = max_reaction.max(l);
                 let at = format!(
                     "{method:?} {name}: step {} end {j}: gap {g:e} r {l:e}",
@@ -309,14 +309,7 @@ fn stiff_impact(ratio: f64, extra: &[&str]) -> Scene {
 }
 
 fn step_failure(
-    result: Result<
-        (
-            Vec<viscobar::time::simulation::StepRecord>,
-            viscobar::time::summary::Summary,
-            Simulation,
-        ),
-        RunError,
-    >,
+    result: Result<(Vec<viscobar::StepRecord>, viscobar::Summary, Simulation), RunError>,
 ) -> (usize, StepFailure) {
     match result {
         Err(RunError::Step { step, failure, .. }) => (step, failure),
@@ -466,8 +459,9 @@ fn runs_are_bit_identical_in_process(method: Method) {
         let ra = a.step().unwrap();
         let rb = b.step().unwrap();
         assert_eq!(bits(&a), bits(&b), "step {}", ra.step);
-        assert_eq!(ra.reaction.map(f64::to_bits), rb.reaction.map(f64::to_bits));
-        contact |= ra.reaction.iter().any(|r| *r > 0.0);
+        let reactions = |r: &viscobar::StepRecord| r.contact.groups.map(|g| g.reaction.to_bits());
+        assert_eq!(reactions(&ra), reactions(&rb));
+        contact |= ra.contact.total_reaction > 0.0;
     }
     assert!(contact, "the comparison covers steps in contact");
 }

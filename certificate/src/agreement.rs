@@ -15,7 +15,9 @@ use std::fmt::Write;
 use viscobar::linalg::ldlt::Ldlt;
 use viscobar::linalg::norms::{max_abs, max_distance};
 use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::output::run_in_memory;
 use viscobar::scene::{self, Scene};
+use viscobar::scheme::RunError;
 use viscobar::step::StepSolver;
 use viscobar::step::audit::dual_tolerance;
 use viscobar::step::exact::ExactSolver;
@@ -23,8 +25,6 @@ use viscobar::step::osqp::{OsqpSettings, OsqpSolver, raw_problem};
 use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
 use viscobar::study::accuracy::observed_order;
 use viscobar::study::compare::compare;
-use viscobar::time::RunError;
-use viscobar::time::run::run_in_memory;
 
 /// The four parts above, as Markdown.
 pub fn markdown() -> Result<String, RunError> {
@@ -49,7 +49,7 @@ fn with_method(m: &str, extra: &[String]) -> Vec<String> {
 /// The audit report of an OSQP or penalty run (both always audit).
 fn audit_of<'a>(
     name: &str,
-    s: &'a viscobar::time::summary::Summary,
+    s: &'a viscobar::output::summary::Summary,
 ) -> Result<&'a viscobar::step::AuditReport, RunError> {
     s.audit.as_ref().ok_or_else(|| RunError::SolverSetup {
         solver: s.solver.clone(),
@@ -392,8 +392,9 @@ pub struct StepProblem {
 pub fn start_up_problem(scene: &Scene) -> Result<StepProblem, RunError> {
     use std::cell::RefCell;
     use std::rc::Rc;
+    use viscobar::bar::body::make_solver;
+    use viscobar::bar::{Discretisation, Simulation};
     use viscobar::step::{SolveInfo, StepFailure};
-    use viscobar::time::simulation::{Discretisation, Simulation, make_solver};
 
     /// Wraps the exact solver and keeps the first problem it is given, with its answer.
     struct Recorder {

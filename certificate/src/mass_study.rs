@@ -7,14 +7,14 @@
 //! variants is in `docs/mass-variants.md`.
 
 use std::fmt::Write;
+use viscobar::bar::Simulation;
 use viscobar::bar::closed_form;
+use viscobar::output::summary::{Summary, Tracker};
 use viscobar::scene::{self, MassVariant, Scene, SceneError};
+use viscobar::scheme::RunError;
 use viscobar::study::accuracy::observed_order;
 use viscobar::study::converge::contact_time_error;
 use viscobar::study::mass_variants::with_mass;
-use viscobar::time::RunError;
-use viscobar::time::simulation::Simulation;
-use viscobar::time::summary::{Summary, Tracker};
 
 /// The two scenes of the study, each run to this time: `impact` through its one contact
 /// episode and release, `falling-bar` through its first episode `[3, 5]` and one unit of flight.
@@ -68,7 +68,7 @@ fn sampled(name: &str, scene: &Scene, level: u32) -> Result<Sampled, RunError> {
     let coarse = |v: &[f64]| v.iter().step_by(stride).copied().collect::<Vec<_>>();
     let (u0, _) = sim.initial_state();
     let mut u = vec![coarse(&u0)];
-    let mut reaction = vec![0.0, sim.first_record().reaction[0]];
+    let mut reaction = vec![0.0, sim.first_record().contact.groups[0].reaction];
     let mut buf = vec![0.0; nodes];
     let mut keep = |sim: &Simulation, u: &mut Vec<Vec<f64>>| {
         if sim.step_index().is_multiple_of(stride) {
@@ -80,7 +80,7 @@ fn sampled(name: &str, scene: &Scene, level: u32) -> Result<Sampled, RunError> {
     for _ in 1..scene.steps() {
         let r = sim.step()?;
         tracker.observe(&r);
-        reaction.push(r.reaction[0]);
+        reaction.push(r.contact.groups[0].reaction);
         keep(&sim, &mut u);
     }
     let summary = tracker.finish(name, &sim, 0.0);

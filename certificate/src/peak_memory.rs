@@ -6,10 +6,10 @@
 //! free-free, released with velocity sin(πx); or an `impact`-like bar flying rigidly at velocity
 //! −1 onto Signorini obstacles at gap 0.5·STEPS·Δt under its left end or both ends, so contact
 //! starts halfway through the run and the exact end solver keeps its columns and reduced
-//! factors. With `100000 2000` it gives `run`'s end-to-end ns_per_node_step at J = 1e5, to
+//! factors. With `100000 2000` it gives `run`'s end-to-end ns_per_unknown_step at J = 1e5, to
 //! compare with the step bench.
 
-use viscobar::time::RunError;
+use viscobar::scheme::RunError;
 
 /// The ends of the bar.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -51,7 +51,7 @@ pub fn run(elements: u64, steps: u64, ends: Ends) -> Result<(), RunError> {
     )?;
     let before = vm_hwm_kib();
     let out = crate::workspace_root().join("target/peak-memory");
-    let summary = viscobar::time::run::run_to_dir("peak-memory", &scene, &out, false)?;
+    let summary = viscobar::output::run::run_to_dir("peak-memory", &scene, &out, false)?;
     let peak = vm_hwm_kib();
     let ends = match ends {
         Ends::Free => "free",
@@ -60,7 +60,7 @@ pub fn run(elements: u64, steps: u64, ends: Ends) -> Result<(), RunError> {
     };
     println!(
         "{ends}: elements {elements}, steps {}, nodes {}: wall {:.1} s, {:.2} ns per node-step",
-        summary.steps, summary.nodes, summary.wall_time_s, summary.ns_per_node_step
+        summary.steps, summary.nodes, summary.wall_time_s, summary.ns_per_unknown_step
     );
     let s = summary.time_shares;
     println!(

@@ -4,21 +4,21 @@
 //! (`tests/plane.rs`, `src/plane/*`) assert on the same computations.
 
 use std::fmt::Write;
-use viscobar::plane::PlaneError;
+use viscobar::bar::Simulation;
+use viscobar::linalg::cholesky::SparseCholesky;
+use viscobar::output::run_plane_in_memory;
+use viscobar::plane::PlaneSimulation;
 use viscobar::plane::closed_form::Manufactured;
-use viscobar::plane::factor::SparseCholesky;
 use viscobar::plane::matrices::{Material, assemble};
 use viscobar::plane::mesh::Grid;
-use viscobar::plane::run::run_plane_in_memory;
-use viscobar::plane::simulation::PlaneSimulation;
 use viscobar::scene::plane::{
     Body, EdgeCondition, EdgeSpec, Edges, PLANE_BUILTIN, PlaneInitial, PlaneLoad, PlaneMesh,
-    PlaneOutput, PlaneScene, Vector, plane_builtin_text,
+    PlaneScene, Vector, plane_builtin_text,
 };
 use viscobar::scene::schema::number_text;
 use viscobar::scene::{Condition, Scene};
+use viscobar::scheme::RunError;
 use viscobar::study::converge::ConvergeError;
-use viscobar::time::{RunError, Simulation};
 
 /// The grids of the matrix table: `(nx, ny, y_grading)`.
 pub const MATRIX_GRIDS: [(usize, usize, f64); 3] = [(4, 2, 1.0), (16, 8, 3.0), (64, 16, 0.2)];
@@ -168,7 +168,7 @@ pub fn plane_of_bar(bar: &Scene, height: f64, ny: u64, y_grading: f64) -> Option
         },
         time: bar.time.clone(),
         solver: Default::default(),
-        output: PlaneOutput::default(),
+        output: Default::default(),
     })
 }
 
@@ -230,16 +230,16 @@ pub fn bar_case(bar: &Scene) -> Result<BarCase, ConvergeError> {
         contact_steps: 0,
     };
     let compare = |b: &Simulation, p: &PlaneSimulation, out: &mut BarCase| {
-        if let Some(c) = p.contact() {
+        if !p.contact().is_empty() {
             let rb = b.reactions()[0];
             out.max_reaction = out.max_reaction.max(rb);
             out.contact_steps += usize::from(rb > 0.0);
-            for (nk, r) in c.normals.iter().zip(c.reactions()) {
+            for (nk, r) in p.body().normals().iter().zip(p.reactions()) {
                 let d = (r - nk.weight * rb).abs();
                 out.max_reaction_deviation = out.max_reaction_deviation.max(d);
             }
         }
-        let (ub, up) = (b.displacement(), p.displacement());
+        let (ub, up) = (b.displacement_dofs(), p.displacement_dofs());
         assert_eq!(ub.len(), grid.nx + 1, "one plane column per bar node");
         for node in 0..grid.nodes() {
             let i = grid.position(node).0;
@@ -328,7 +328,7 @@ pub fn manufactured_level(nx: u64) -> Result<Level, ConvergeError> {
     let e: Vec<f64> = d
         .free
         .iter()
-        .zip(sim.unknowns())
+        .zip(sim.displacement())
         .map(|(&dof, u)| {
             let (x, y) = d.grid.point(dof / 2);
             u - m.displacement(x, y, t)[dof % 2]
@@ -354,14 +354,11 @@ pub fn observed_order(levels: &[Level]) -> f64 {
 }
 
 /// A plane failure in a verification study: a scene error is bad input, anything else a failed
-/// run (exit 1), named after the plane's solver.
-fn plane_error(e: PlaneError) -> ConvergeError {
+/// run (exit 1).
+fn plane_error(e: RunError) -> ConvergeError {
     match e {
-        PlaneError::Scene(s) => ConvergeError::Scene(s),
-        other => ConvergeError::Run(RunError::SolverSetup {
-            solver: viscobar::plane::run::SOLVER_NAME.into(),
-            reason: other.to_string(),
-        }),
+        RunError::Scene(s) => ConvergeError::Scene(s),
+        other => ConvergeError::Run(other),
     }
 }
 

@@ -4,13 +4,11 @@
 //! penalty, and the observed convergence of the tilted drop. The tests
 //! (`tests/plane_contact.rs`) assert on the same computations.
 
-use viscobar::plane::PlaneError;
-use viscobar::plane::contact::ContactMethod;
-use viscobar::plane::simulation::PlaneSimulation;
+use viscobar::plane::PlaneSimulation;
 use viscobar::scene::plane::{AnyScene, PlaneScene, load_any};
-use viscobar::step::osqp::OsqpSettings;
+use viscobar::scene::{SolverMethod, SolverSpec};
+use viscobar::scheme::{RunError, StepRecord};
 use viscobar::study::converge::ConvergeError;
-use viscobar::time::RunError;
 
 /// The built-in scenes of the solver comparison.
 pub const CONTACT_SCENES: [&str; 2] = ["plane-tilted-drop", "plane-curved-obstacle"];
@@ -24,13 +22,52 @@ pub fn plane_scene(name: &str, set: &[String]) -> Result<PlaneScene, ConvergeErr
 }
 
 /// A plane failure in a study: bad input or a failed run.
-pub fn plane_error(e: PlaneError) -> ConvergeError {
+pub fn plane_error(e: RunError) -> ConvergeError {
     match e {
-        PlaneError::Scene(s) => ConvergeError::Scene(s),
-        other => ConvergeError::Run(RunError::SolverSetup {
-            solver: viscobar::plane::run::SOLVER_NAME.into(),
-            reason: other.to_string(),
-        }),
+        RunError::Scene(s) => ConvergeError::Scene(s),
+        other => ConvergeError::Run(other),
+    }
+}
+
+/// A step solver of the comparison: its method and, for the penalty, its ε (the scene's
+/// other settings are the defaults: OSQP at `eps = 1e-10`, polished).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Method {
+    Exact,
+    Osqp,
+    Penalty { epsilon: f64 },
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Exact => "exact",
+            Method::Osqp => "osqp",
+            Method::Penalty { .. } => "penalty",
+        }
+    }
+
+    /// `scene` with its `[solver]` table set to this method.
+    pub fn apply(self, scene: &PlaneScene) -> PlaneScene {
+        let mut s = scene.clone();
+        s.solver = match self {
+            Method::Exact => SolverSpec::default(),
+            Method::Osqp => SolverSpec {
+                method: SolverMethod::Osqp,
+                ..SolverSpec::default()
+            },
+            Method::Penalty { epsilon } => SolverSpec {
+                method: SolverMethod::Penalty,
+                epsilon: Some(epsilon),
+                ..SolverSpec::default()
+            },
+        };
+        s
+    }
+
+    /// The run of `scene` with this method.
+    pub fn simulation(self, scene: &PlaneScene) -> Result<PlaneSimulation, ConvergeError> {
+        PlaneSimulation::new(&self.apply(scene)).map_err(plane_error)
     }
 }
 
@@ -55,15 +92,15 @@ pub struct Agreement {
 }
 
 /// OSQP's settings in the comparison: the bar's defaults (`eps = 1e-10`, polished).
-pub fn osqp_method() -> ContactMethod {
-    ContactMethod::Osqp(OsqpSettings::default())
+pub fn osqp_method() -> Method {
+    Method::Osqp
 }
 
 /// Runs `scene` with the exact solver (whatever its `[solver]` table names) and with `method`
 /// side by side.
-pub fn agreement(scene: &PlaneScene, method: ContactMethod) -> Result<Agreement, ConvergeError> {
-    let mut e = PlaneSimulation::with_method(scene, ContactMethod::Exact).map_err(plane_error)?;
-    let mut o = PlaneSimulation::with_method(scene, method).map_err(plane_error)?;
+pub fn agreement(scene: &PlaneScene, method: Method) -> Result<Agreement, ConvergeError> {
+    let mut e = Method::Exact.simulation(scene)?;
+    let mut o = method.simulation(scene)?;
     let mut a = Agreement {
         method: method.name(),
         steps: scene.steps(),
@@ -78,15 +115,11 @@ pub fn agreement(scene: &PlaneScene, method: ContactMethod) -> Result<Agreement,
     };
     let mut iterations = 0u64;
     let compare = |e: &PlaneSimulation, o: &PlaneSimulation, a: &mut Agreement| {
-        for (x, y) in e.unknowns().iter().zip(o.unknowns()) {
+        for (x, y) in e.displacement().iter().zip(o.displacement()) {
             a.max_u_deviation = a.max_u_deviation.max((x - y).abs());
             a.max_u = a.max_u.max(x.abs());
         }
-        let (re, ro) = (
-            e.contact().expect("a contact scene").reactions(),
-            o.contact().expect("a contact scene").reactions(),
-        );
-        for (x, y) in re.iter().zip(ro) {
+        for (x, y) in e.reactions().iter().zip(o.reactions()) {
             a.max_reaction_deviation = a.max_reaction_deviation.max((x - y).abs());
             a.max_reaction = a.max_reaction.max(*x);
         }
@@ -95,13 +128,13 @@ pub fn agreement(scene: &PlaneScene, method: ContactMethod) -> Result<Agreement,
     for _ in 1..scene.steps() {
         let re = e.step().map_err(plane_error)?;
         let ro = o.step().map_err(plane_error)?;
-        iterations += u64::from(ro.contact.iterations);
-        a.max_active = a.max_active.max(re.contact.active);
-        a.contact_steps += usize::from(re.contact.active > 0);
+        iterations += u64::from(ro.iterations);
+        a.max_active = a.max_active.max(re.contact.contact_nodes);
+        a.contact_steps += usize::from(re.contact.contact_nodes > 0);
         compare(&e, &o, &mut a);
     }
     a.mean_iterations = iterations as f64 / (scene.steps().max(2) - 1) as f64;
-    a.audit_worst_ratio = o.contact().and_then(|c| c.audit()).map(|r| {
+    a.audit_worst_ratio = o.solver_report().map(|r| r.audit).map(|r| {
         [
             r.primal_violation.unwrap_or_default().max_over_tolerance,
             r.negative_reaction.max_over_tolerance,
@@ -144,13 +177,18 @@ pub fn convergence(
 ) -> Result<Vec<ContactLevel>, ConvergeError> {
     // The reference's displacement at the steps that are multiples of 2^(reference − 0).
     let fine = scene.refined(reference);
-    let mut sim = PlaneSimulation::with_method(&fine, ContactMethod::Exact).map_err(plane_error)?;
+    let prepared = PlaneSimulation::prepare(&Method::Exact.apply(&fine)).map_err(plane_error)?;
+    let mut u0 = vec![0.0; 2 * prepared.body().discretisation().grid.nodes()];
+    prepared
+        .body()
+        .scatter_into(prepared.state().u, 1.0, &mut u0);
+    let mut sim = prepared.start().map_err(plane_error)?;
     let stride = 1usize << reference;
-    let mut kept = vec![sim.displacement()];
+    let mut kept = vec![u0];
     for n in 1..fine.steps() {
         sim.step().map_err(plane_error)?;
         if (n + 1).is_multiple_of(stride) {
-            kept.push(sim.displacement());
+            kept.push(sim.displacement_dofs());
         }
     }
     let fine_grid = sim.discretisation().grid.clone();
@@ -161,16 +199,19 @@ pub fn convergence(
     let mut out = Vec::new();
     for &level in levels {
         let s = scene.refined(level);
-        let mut sim =
-            PlaneSimulation::with_method(&s, ContactMethod::Exact).map_err(plane_error)?;
-        let grid = sim.discretisation().grid.clone();
+        let prepared = PlaneSimulation::prepare(&Method::Exact.apply(&s)).map_err(plane_error)?;
+        let grid = prepared.body().discretisation().grid.clone();
+        let mut u0 = vec![0.0; 2 * grid.nodes()];
+        prepared
+            .body()
+            .scatter_into(prepared.state().u, 1.0, &mut u0);
+        let mut sim = prepared.start().map_err(plane_error)?;
         let (f, every) = (1usize << (reference - level), 1usize << level);
         let mut max_error = 0.0f64;
-        let mut measure = |sim: &PlaneSimulation, n: usize| {
+        let mut measure = |u: &[f64], n: usize| {
             if !n.is_multiple_of(every) {
                 return;
             }
-            let u = sim.displacement();
             let r = &kept[n / every];
             for node in 0..grid.nodes() {
                 let (i, j) = grid.position(node);
@@ -180,10 +221,10 @@ pub fn convergence(
                 }
             }
         };
-        measure(&sim, 0);
+        measure(&u0, 0);
         for n in 1..s.steps() {
             sim.step().map_err(plane_error)?;
-            measure(&sim, n + 1);
+            measure(&sim.displacement_dofs(), n + 1);
         }
         out.push(ContactLevel {
             level,
@@ -203,6 +244,51 @@ pub fn orders(levels: &[ContactLevel]) -> Vec<f64> {
         .collect()
 }
 
+/// The contact conditions of a plane run's state at one step: the largest penetration
+/// `max(0, −gap_k)` and `|r_k gap_k|`, and the scale of the gaps' round-off,
+/// `max_k max(|g_k|, |u·n_k|)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GapCheck {
+    pub penetration: f64,
+    pub complementarity: f64,
+    pub scale: f64,
+}
+
+impl GapCheck {
+    /// The check of `sim`'s current state and reactions.
+    pub fn of(sim: &PlaneSimulation) -> Self {
+        let contact = sim.contact();
+        let mut gaps = vec![0.0; contact.len()];
+        sim.gaps_into(&mut gaps);
+        let mut c = Self::default();
+        for ((gap, g), r) in gaps.iter().zip(contact.gaps()).zip(sim.reactions()) {
+            c.penetration = c.penetration.max(-gap);
+            c.complementarity = c.complementarity.max((r * gap).abs());
+            c.scale = c.scale.max(g.abs()).max((gap - g).abs());
+        }
+        c
+    }
+}
+
+/// Runs a plane scene in memory as `viscobar::output::run_plane_in_memory` does, with the
+/// [`GapCheck`] of every step (the start-up step first).
+pub fn checked_run(
+    name: &str,
+    scene: &PlaneScene,
+) -> Result<(Vec<StepRecord>, viscobar::Summary, Vec<GapCheck>), ConvergeError> {
+    let mut sim = PlaneSimulation::new(scene).map_err(plane_error)?;
+    let mut tracker = viscobar::output::Tracker::new(&sim, !sim.is_forced());
+    let (mut records, mut checks) = (vec![sim.first_record()], vec![GapCheck::of(&sim)]);
+    for _ in 1..scene.steps() {
+        let r = sim.step().map_err(plane_error)?;
+        tracker.observe(&r);
+        records.push(r);
+        checks.push(GapCheck::of(&sim));
+    }
+    let summary = tracker.finish(name, &sim, 0.0);
+    Ok((records, summary, checks))
+}
+
 /// The penalty parameters of the comparison with the exact solver.
 pub const PENALTY_EPSILONS: [f64; 2] = [1e-4, 1e-6];
 
@@ -210,7 +296,13 @@ pub const PENALTY_EPSILONS: [f64; 2] = [1e-4, 1e-6];
 #[derive(Clone, Debug)]
 pub struct SceneCheck {
     pub name: String,
-    pub summary: viscobar::plane::run::PlaneSummary,
+    pub summary: viscobar::Summary,
+    /// Contact normals, the most in contact at one step, the steps with some in contact, and
+    /// the contact dissipation summed over the run.
+    pub normals: usize,
+    pub max_in_contact: usize,
+    pub contact_steps: usize,
+    pub dissipation: f64,
 }
 
 /// The exact runs of the built-in contact scenes.
@@ -219,11 +311,16 @@ pub fn scene_checks() -> Result<Vec<SceneCheck>, ConvergeError> {
         .iter()
         .map(|name| {
             let scene = plane_scene(name, &[])?;
-            let (_, summary, _) =
-                viscobar::plane::run::run_plane_in_memory(name, &scene).map_err(plane_error)?;
+            let (records, summary, sim) =
+                viscobar::output::run_plane_in_memory(name, &scene).map_err(plane_error)?;
+            let in_contact = |r: &StepRecord| r.contact.contact_nodes;
             Ok(SceneCheck {
                 name: name.to_string(),
                 summary,
+                normals: sim.contact().len(),
+                max_in_contact: records.iter().map(in_contact).max().unwrap_or(0),
+                contact_steps: records.iter().filter(|r| in_contact(r) > 0).count(),
+                dissipation: records.iter().map(|r| r.contact_dissipation).sum(),
             })
         })
         .collect()
@@ -251,25 +348,25 @@ pub fn markdown() -> Result<String, ConvergeError> {
         );
     }
     md.push_str(
-        "\n| scene | unknowns | normals m | steps | steps in contact | max in contact | max identity residual | max penetration / scale | max abs(r·gap) / scale | contact dissipation | LCP sets tried (mean, max) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "\n| scene | unknowns | normals m | steps | steps in contact | max in contact | max identity residual | max penetration | max abs(r·gap) | contact dissipation | LCP sets tried (mean, max) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for s in scene_checks()? {
-        let (p, c) = (&s.summary, s.summary.contact.clone().unwrap_or_default());
+        let p = &s.summary;
         let _ = writeln!(
             md,
             "| {} | {} | {} | {} | {} | {} | {:.1e} | {:.1e} | {:.1e} | {:.4e} | {:.2}, {} |",
             s.name,
             p.unknowns,
-            c.normals,
+            s.normals,
             p.steps,
-            c.contact_steps,
-            c.max_active,
+            s.contact_steps,
+            s.max_in_contact,
             p.max_identity_residual,
-            c.max_penetration,
-            c.max_complementarity,
-            c.dissipation,
-            c.iterations_mean,
-            c.iterations_max
+            p.max_violation,
+            p.max_complementarity,
+            s.dissipation,
+            p.solver_iterations.mean,
+            p.solver_iterations.max
         );
     }
     md.push_str(
@@ -280,7 +377,7 @@ pub fn markdown() -> Result<String, ConvergeError> {
         let mut methods = vec![(osqp_method(), "osqp, eps = 1e-10".to_string())];
         for e in PENALTY_EPSILONS {
             methods.push((
-                ContactMethod::Penalty { epsilon: e },
+                Method::Penalty { epsilon: e },
                 format!("penalty, ε = {e:e}"),
             ));
         }

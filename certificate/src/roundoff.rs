@@ -3,12 +3,12 @@
 //! distance from `u = t` a run ends at is round-off; the increment form of viscobar's time loop
 //! against the talk's form of the step.
 
+use viscobar::bar::{Discretisation, Simulation};
 use viscobar::linalg::ldlt::Ldlt;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::scene::Scene;
+use viscobar::scheme::RunError;
 use viscobar::study::accuracy::lockstep;
-use viscobar::time::RunError;
-use viscobar::time::simulation::{Discretisation, Simulation};
 
 /// `max_i |u_i − t|`: the distance of a rigid translation's displacement from `u = t`.
 pub fn rigid_drift(u: &[f64], t: f64) -> f64 {
@@ -31,7 +31,7 @@ pub fn rigid_mode_drift(elements: u64, steps: usize) -> Result<(f64, f64), RunEr
     let scene = Scene::from_toml(&text, &[])?;
     let mut sim = Simulation::new(&scene)?;
     lockstep(std::slice::from_mut(&mut sim), steps, |_, _| {})?;
-    let increment = rigid_drift(&sim.displacement(), sim.time());
+    let increment = rigid_drift(&sim.displacement_dofs(), sim.time());
 
     let disc = Discretisation::new(&scene)?;
     let dt = disc.dt;

@@ -16,10 +16,10 @@
 
 use std::fmt::Write;
 use viscobar::scene::Scene;
+use viscobar::scheme::RunError;
 use viscobar::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
 use viscobar::step::osqp::OSQP_DEFAULT_EPS;
 use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
-use viscobar::time::RunError;
 
 /// Full size (`verify --stiff`) or the reduced size of `tests/stiff.rs`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

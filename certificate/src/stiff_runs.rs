@@ -15,17 +15,18 @@ use crate::stiff::{
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::rc::Rc;
+use viscobar::bar::body::make_solver;
+use viscobar::bar::{Discretisation, Simulation};
 use viscobar::linalg::ldlt::Ldlt;
 use viscobar::linalg::norms::{max_abs, max_distance};
 use viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS;
 use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::output::summary::Tracker;
+use viscobar::scheme::RunError;
+use viscobar::scheme::StepRecord;
 use viscobar::step::audit::{KktAudit, Law};
 use viscobar::step::block_pivot::TIE_ULPS;
 use viscobar::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
-use viscobar::time::RunError;
-use viscobar::time::simulation::StepRecord;
-use viscobar::time::simulation::{Discretisation, Simulation, make_solver};
-use viscobar::time::summary::Tracker;
 
 /// What the last solve formed, shared between a run's [`Traced`] solver and its [`Live`]
 /// state: the right-hand side `b̂`, the answer `z`, the reactions `r` and the previous answer

@@ -8,11 +8,11 @@
 use crate::verify::Section;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use viscobar::bar::Simulation;
 use viscobar::scene::{self, Scene};
 use viscobar::study::converge::{
     ConvergeError, OSQP_EPS, PENALTY_EPSILON, Row, SolverSetting, Study, StudyOptions, study_with,
 };
-use viscobar::time::simulation::Simulation;
 
 /// Timing repeats per run; the median is kept.
 pub const REPEATS: usize = 3;

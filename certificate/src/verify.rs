@@ -9,10 +9,10 @@ use std::fmt::Write;
 use viscobar::bar::closed_form;
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
 use viscobar::linalg::norms::max_abs;
+use viscobar::output::run_in_memory;
 use viscobar::scene;
+use viscobar::scheme::RunError;
 use viscobar::study::accuracy::{error_against, observed_order};
-use viscobar::time::RunError;
-use viscobar::time::run::run_in_memory;
 
 /// One generated block of VERIFICATION.md.
 #[derive(Clone, Debug, PartialEq)]

@@ -7,11 +7,11 @@
 
 use std::fmt::Write;
 use viscobar::bar::closed_form::{self, ClosedForm};
+use viscobar::output::run_in_memory;
 use viscobar::scene::{self, Scene};
+use viscobar::scheme::RunError;
 use viscobar::study::accuracy::{error_against, observed_order};
 use viscobar::study::converge::contact_time_error;
-use viscobar::time::RunError;
-use viscobar::time::run::run_in_memory;
 
 /// The built-in scene's name.
 pub const SCENE: &str = "viscous-contact";
@@ -210,7 +210,7 @@ pub fn row(base: &Scene, level: u32) -> Result<Row, RunError> {
     let (mut reaction, mut reaction_interior) = (0.0f64, 0.0f64);
     for r in &records {
         let t_n = (r.step - 1) as f64 * dt;
-        let e = (r.reaction[0] - exact.reaction(t_n)).abs();
+        let e = (r.contact.groups[0].reaction - exact.reaction(t_n)).abs();
         reaction = reaction.max(e);
         if t_n >= exact.t1 + INTERIOR_MARGIN && t_n <= exact.t2 - INTERIOR_MARGIN {
             reaction_interior = reaction_interior.max(e);

@@ -3,7 +3,7 @@
 //! `numpy.load` gives named columns. The shape is known before the first row (the sampling
 //! fixes the row count), so the header is written once, up front.
 
-use npyz::{DType, Deserialize, Serialize, TypeRead, TypeWrite};
+use npyz::{DType, Deserialize, Serialize, TypeRead, TypeWrite, WriterBuilder};
 use std::io::{BufWriter, Read, Write};
 
 /// One row of `N` doubles.

@@ -151,11 +151,11 @@ impl Run<'_> {
         let mut sim = prepared.start()?;
         let mut tracker = Tracker::new(&sim, !sim.is_forced());
         let mut row = Vec::new();
-        let mut write_row = |r: &StepRecord, row: &mut Vec<u8>| {
-            history::row(r, &groups, row);
-            hist.write_all(row)
+        let mut write_row = |hist: &mut std::io::BufWriter<std::fs::File>, r: &StepRecord| {
+            history::row(r, &groups, &mut row);
+            hist.write_all(&row)
         };
-        write_row(&sim.first_record(), &mut row).map_err(io(&hist_path))?;
+        write_row(&mut hist, &sim.first_record()).map_err(io(&hist_path))?;
         let (steps, every) = (self.steps, self.output.every as usize);
         let keep = |n: usize| n.is_multiple_of(every) || n == steps;
         let bar = Progress::new(self.progress, steps, sim.body().unknowns());
@@ -166,7 +166,7 @@ impl Run<'_> {
         for _ in 1..steps {
             let r = sim.step()?;
             tracker.observe(&r);
-            write_row(&r, &mut row).map_err(io(&hist_path))?;
+            write_row(&mut hist, &r).map_err(io(&hist_path))?;
             if keep(r.step) {
                 disp.write(sim.time(), sim.state())
                     .map_err(io(&disp_path))?;
@@ -174,7 +174,6 @@ impl Run<'_> {
             bar.step(r.step);
         }
         bar.finish();
-        drop(write_row);
         hist.flush().map_err(io(&hist_path))?;
         disp.finish().map_err(io(&disp_path))?;
         let mut summary = tracker.finish(self.name, &sim, start.elapsed().as_secs_f64());

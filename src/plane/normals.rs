@@ -1,4 +1,4 @@
-//! The contact normals of the plane body's Signorini edges ([`crate::plane::contact`]): one
+//! The contact normals of the plane body's Signorini edges (its contact set): one
 //! per node of a Signorini edge that is not clamped, `n = σ e_c` its outward normal.
 
 use crate::plane::mesh::Grid;

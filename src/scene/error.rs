@@ -1,5 +1,5 @@
 //! [`SceneError`]: a scene that cannot be run as written, kept apart from failures during a run
-//! ([`crate::time::RunError`]) and from a step solver's own outcome ([`crate::step::StepFailure`]).
+//! ([`crate::scheme::RunError`]) and from a step solver's own outcome ([`crate::step::StepFailure`]).
 
 use crate::step::SettingsError;
 use std::path::PathBuf;

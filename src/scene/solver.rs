@@ -29,7 +29,8 @@ impl SolverMethod {
 }
 
 /// The `[solver]` table. Every setting but `method` belongs to one method; naming it with
-/// another method is refused (see [`Scene::validate`]), so a setting is never silently ignored.
+/// another method is refused (see [`crate::scene::Scene::validate`]), so a setting is never
+/// silently ignored.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolverSpec {

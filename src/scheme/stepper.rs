@@ -462,7 +462,7 @@ impl<B: Body> Unstarted<B> {
         &self.scheme.contact
     }
 
-    /// Takes the start-up step to `u^1` (see [`Scheme::start_up`]).
+    /// Takes the start-up step to `u^1`: the Taylor step projected onto `K_h` in the `C`-norm.
     pub fn start(self) -> Result<Scheme<B>, RunError> {
         let Self { mut scheme, v0 } = self;
         scheme.start_up(&v0)?;

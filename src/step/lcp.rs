@@ -5,7 +5,7 @@
 //! ```
 //!
 //! `S` symmetric positive definite (`m × m`), the condensed contact problem of the plane body
-//! ([`crate::plane::contact`]: `S = E C⁻¹ Eᵀ`). An SPD matrix is a P-matrix, so the solution
+//! ([`crate::step::condensed`]: `S = E C⁻¹ Eᵀ`). An SPD matrix is a P-matrix, so the solution
 //! exists and is unique for every `q` (Cottle, Pang & Stone, *The Linear Complementarity
 //! Problem*, Thm 3.3.7).
 //!

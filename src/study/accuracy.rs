@@ -1,7 +1,7 @@
 //! Error measurement against closed forms, shared by the tests and the CLI studies.
 
-use crate::bar::closed_form::ClosedForm;
 use crate::bar::Simulation;
+use crate::bar::closed_form::ClosedForm;
 use crate::scene::Scene;
 use crate::scheme::{Body, RunError, Scheme, StepRecord};
 

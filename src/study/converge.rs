@@ -293,20 +293,18 @@ fn measure<S: StudyScene>(
                 }
                 true
             }
-            (None, Some(r), Some(at)) => {
+            (None, Some(r), Some(at))
+                if sample < r.coarse_times.len() && k == r.coarse_times[sample] << level =>
+            {
                 // The same time t = c·Δt_0 at this level and in the reference; the reference's
                 // values are on the finest level's nodes.
-                if sample < r.coarse_times.len() && k == r.coarse_times[sample] << level {
-                    sim.displacement_into(u);
-                    let v = &r.values[sample];
-                    for i in 0..dofs {
-                        e[i] = u[i] - v[at[i]];
-                    }
-                    sample += 1;
-                    true
-                } else {
-                    false
+                sim.displacement_into(u);
+                let v = &r.values[sample];
+                for i in 0..dofs {
+                    e[i] = u[i] - v[at[i]];
                 }
+                sample += 1;
+                true
             }
             _ => false,
         };

@@ -17,4 +17,5 @@ pub mod plane_contact_figure;
 pub mod plane_figure;
 pub mod refine;
 pub mod sampled_run;
+pub mod viscosity_sweep;
 pub mod work_precision;

@@ -24,7 +24,7 @@ use crate::viscous_contact;
 use std::fmt::Write;
 use viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS;
 use viscobar::scene::{self, MassVariant};
-use viscobar::time::RunError;
+use viscobar::scheme::RunError;
 
 /// A tolerance more than this many times looser than its measured worst value needs a reason.
 pub const RATIO_FLOOR: f64 = 1e-3;

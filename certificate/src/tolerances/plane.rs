@@ -2,7 +2,7 @@
 //! `plane_contact_cli.rs`), each beside the measurement of what it guards.
 
 use super::{AGREEMENT_ULPS_PER_STEP, Measured};
-use viscobar::time::RunError;
+use viscobar::scheme::RunError;
 
 // ---- tests/plane.rs, tests/plane_contact.rs, tests/plane_cli.rs, tests/plane_contact_cli.rs ----
 
@@ -73,7 +73,7 @@ fn plane_run_error(e: viscobar::study::converge::ConvergeError) -> RunError {
         viscobar::study::converge::ConvergeError::Run(r) => r,
         viscobar::study::converge::ConvergeError::Scene(s) => RunError::Scene(s),
         other => RunError::SolverSetup {
-            solver: viscobar::plane::run::SOLVER_NAME.into(),
+            solver: "exact".into(),
             reason: other.to_string(),
         },
     }
@@ -85,33 +85,28 @@ pub fn plane_worst() -> Result<PlaneWorst, RunError> {
         bar_case, bar_case_scenes, bar_contact_case_scenes, identity_scenes,
     };
     use crate::plane_contact::{
-        CONTACT_SCENES, PENALTY_EPSILONS, agreement, osqp_method, plane_error, plane_scene,
+        CONTACT_SCENES, Method, PENALTY_EPSILONS, agreement, checked_run, osqp_method, plane_scene,
     };
-    use viscobar::plane::contact::ContactMethod;
-    use viscobar::plane::run::run_plane_in_memory;
     let mut w = PlaneWorst::default();
     for (name, scene) in identity_scenes() {
-        let (records, summary, sim) = run_plane_in_memory(&name, &scene)
-            .map_err(plane_error)
-            .map_err(plane_run_error)?;
-        let sim_has_contact = sim.contact().is_some();
+        let (records, summary, checks) = checked_run(&name, &scene).map_err(plane_run_error)?;
+        let sim_has_contact = !scene.edges.gaps()?.iter().all(Option::is_none);
         for r in records.iter().skip(1) {
             w.identity = w.identity.max(r.identity_residual);
         }
         if let Some(rise) = summary.max_energy_rise {
             w.energy_rise = w.energy_rise.max(rise);
         }
-        for r in &records {
-            let c = &r.contact;
+        for (r, c) in records.iter().zip(&checks) {
             if sim_has_contact && r.energy > 0.0 {
-                w.gap = w.gap.max(-c.dissipation / r.energy);
+                w.gap = w.gap.max(-r.contact_dissipation / r.energy);
             }
-            if c.gap_scale > 0.0 {
-                w.gap = w.gap.max(c.penetration / c.gap_scale);
-                if c.total_reaction > 0.0 {
+            if c.scale > 0.0 {
+                w.gap = w.gap.max(c.penetration / c.scale);
+                if r.contact.total_reaction > 0.0 {
                     w.gap = w
                         .gap
-                        .max(c.complementarity / (c.gap_scale * c.total_reaction));
+                        .max(c.complementarity / (c.scale * r.contact.total_reaction));
                 }
             }
         }
@@ -144,7 +139,7 @@ pub fn plane_worst() -> Result<PlaneWorst, RunError> {
         if name == "plane-tilted-drop" {
             let p = agreement(
                 &scene,
-                ContactMethod::Penalty {
+                Method::Penalty {
                     epsilon: smallest_epsilon,
                 },
             )

@@ -6,7 +6,7 @@
 
 use super::exact_sample_error;
 use viscobar::linalg::tridiag::SymTridiag;
-use viscobar::time::RunError;
+use viscobar::scheme::RunError;
 
 // ---- proptests on random SPD tridiagonal problems: tests/active_set.rs, osqp_many_bounds.rs ----
 

@@ -4,10 +4,10 @@
 
 use super::invalid;
 use viscobar::bar::closed_form::{ClosedForm, FallingBar};
+use viscobar::output::run_in_memory;
 use viscobar::scene::{self, MassVariant, builtin_names};
+use viscobar::scheme::RunError;
 use viscobar::study::accuracy::error_against;
-use viscobar::time::RunError;
-use viscobar::time::run::run_in_memory;
 
 /// Relative residual of the energy identity for a solver exact to round-off (exact, penalty):
 /// the identity is exact algebra given `C z = b + r`, so only round-off remains (measured below
@@ -47,9 +47,9 @@ pub fn scene_worst() -> Result<[f64; 5], RunError> {
                 w[1] = w[1].max((r.energy - records[i - 1].energy) / e0);
             }
             if constrained {
-                w[2] = w[2].max(-r.min_gap);
-                w[3] = w[3].max(-r.min_reaction);
-                w[4] = w[4].max(r.max_complementarity);
+                w[2] = w[2].max(-r.contact.min_gap);
+                w[3] = w[3].max(-r.contact.min_reaction);
+                w[4] = w[4].max(r.contact.max_complementarity);
             }
         }
     }
@@ -300,9 +300,9 @@ pub fn impact_contact_errors() -> Result<(usize, f64, f64), RunError> {
         .map_or(f64::INFINITY, |[s, e]| (s - 0.1).abs().max((e - 2.1).abs()));
     let in_contact: Vec<f64> = records
         .iter()
-        .filter_map(|r| match (r.gap.first(), r.reaction.first()) {
-            (Some(&g), Some(&l)) if g <= 1e-12 => Some(l),
-            _ => None,
+        .filter_map(|r| {
+            let end = r.contact.groups[0];
+            (end.min_gap <= 1e-12).then_some(end.reaction)
         })
         .collect();
     let mean_error = if in_contact.is_empty() {
@@ -352,7 +352,7 @@ pub fn start_up_motion() -> Result<Vec<(MassVariant, f64, f64)>, RunError> {
     let mut out = Vec::new();
     for mass in MassVariant::ALL {
         let (_, scene) = scene::load("one-end", &[format!("bar.mass={}", mass.name())])?;
-        let sim = viscobar::time::simulation::Simulation::new(&scene)?;
+        let sim = viscobar::bar::Simulation::new(&scene)?;
         let (u0, _) = sim.initial_state();
         let u1 = sim.displacement();
         let moved = (u1[0] - u0[0]).abs();
@@ -372,7 +372,7 @@ pub const RELEASE_TOL: f64 = 0.025;
 pub const RELEASE_ELEMENTS: [u64; 3] = [100, 200, 400];
 
 /// The release time's error of an `impact` contact episode, `|end − 2.1|`.
-pub fn release_error(e: &viscobar::time::ContactEpisode) -> f64 {
+pub fn release_error(e: &viscobar::output::ContactEpisode) -> f64 {
     (e.end - 2.1).abs()
 }
 
@@ -410,7 +410,7 @@ pub fn thinned_energy_error(every: f64, thinned: f64) -> f64 {
 /// [`thinned_energy_error`] over every built-in scene's measured steps, thinned by
 /// [`THINNING`] against every step.
 pub fn thinned_energy_worst() -> Result<f64, RunError> {
-    use viscobar::time::simulation::Simulation;
+    use viscobar::bar::Simulation;
     let mut worst = 0.0f64;
     for name in builtin_names() {
         let (_, every) = scene::load(name, &[])?;
@@ -459,7 +459,7 @@ pub fn load_vectors(text: &str, n: usize) -> Result<[Vec<f64>; 3], RunError> {
             format!("time.step={}", 1.0 / LOAD_ELEMENTS as f64),
         ],
     )?;
-    let mut sim = viscobar::time::simulation::Simulation::new(&scene)?;
+    let mut sim = viscobar::bar::Simulation::new(&scene)?;
     let disc = sim.discretisation().clone();
     let t = n as f64 * disc.dt;
     let fast = sim.load_vector(n)?.to_vec();
@@ -543,7 +543,9 @@ pub fn resting_bar_worst() -> Result<(f64, bool), RunError> {
     for (r, m) in sim.reactions().iter().zip(&m_one) {
         worst = worst.max((r - m).abs());
     }
-    let all_in_contact = records.iter().all(|r| r.contact_nodes == disc.nodes);
+    let all_in_contact = records
+        .iter()
+        .all(|r| r.contact.contact_nodes == disc.nodes);
     Ok((worst, all_in_contact))
 }
 

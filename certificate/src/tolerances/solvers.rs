@@ -5,11 +5,11 @@
 use super::{GAP_TOL, IDENTITY_TOL, exact_sample_error};
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::scene::{self, MassVariant, Scene, SolverMethod, builtin_names};
+use viscobar::scheme::RunError;
 use viscobar::step::audit::AUDIT_MARGIN;
 use viscobar::step::osqp::OSQP_DEFAULT_EPS;
 use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
 use viscobar::study::compare::{Comparison, compare};
-use viscobar::time::RunError;
 
 // ---- tests/solvers.rs: the three step solvers on every built-in scene ----------------------
 
@@ -143,11 +143,11 @@ pub fn solver_worst(scene: &Scene, cmp: &Comparison) -> SolverWorst {
     for r in &cmp.records {
         w.identity_ratio = w.identity_ratio.max(r.identity_residual / identity_tol);
         if scene.obstacle.is_some() {
-            w.negative_gap = w.negative_gap.max(-r.min_gap);
-            w.negative_reaction = w.negative_reaction.max(-r.min_reaction);
+            w.negative_gap = w.negative_gap.max(-r.contact.min_gap);
+            w.negative_reaction = w.negative_reaction.max(-r.contact.min_reaction);
         }
         for j in 0..k {
-            let (g, l) = (r.gap[j], r.reaction[j]);
+            let (g, l) = (r.contact.groups[j].min_gap, r.contact.groups[j].reaction);
             max_reaction = max_reaction.max(l);
             w.negative_gap = w.negative_gap.max(-g);
             w.negative_reaction = w.negative_reaction.max(-l);
