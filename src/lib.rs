@@ -2,24 +2,16 @@
 //!
 //! A reference implementation of the time-stepping scheme of A. Petrov and M. Schatzman
 //! ("On the numerical approximation of a viscoelastic problem with unilateral constraints",
-//! talk, Lisboa 2009) for the Kelvin–Voigt bar on `[0, L]`:
+//! talk, Lisboa 2009): the Kelvin–Voigt bar `u_tt − u_xx − α u_xxt = l` on `[0, L]` (P1) and the
+//! plane-strain body (Q1), Signorini conditions at the bar's ends, under it, or on the body's
+//! edges; the implicit three-level scheme (VI)_h, each step a constrained quadratic programme.
 //!
-//! ```text
-//!   u_tt − u_xx − α u_xxt = l,   s = u_x + α u_xt,
-//!   0 <= u(0) + a_0 ⊥ −s(0) >= 0,   0 <= u(L) + a_L ⊥ s(L) >= 0   (or free, or clamped ends),
-//! ```
-//!
-//! discretised with P1 elements in space and the implicit three-level scheme (VI)_h in time,
-//! each step a bound-constrained quadratic programme solved exactly.
-//!
-//! Layers, each a folder whose module doc says what it owns; imports point down this list only
-//! (`tests/layers.rs` checks it):
-//! [`linalg`] (tridiagonal and sparse matrices, their factorisations) → [`step`] (the step
-//! problem's solvers and their audit) → [`scene`] (input) → [`scheme`] (the talk's scheme for
-//! any body) → [`bar`] (P1 matrices, the bar's kernels, closed forms) → [`plane`] (the plane
-//! Kelvin–Voigt body, Q1, sparse Cholesky) → [`output`] (runs and their files, both bodies) →
-//! [`study`] (refinement, comparison, mass variants and figures). The certificate (the tables
-//! of VERIFICATION.md, the tolerance registry) is the workspace member `viscobar-certificate`.
+//! Layers, imports pointing down this list only (`tests/layers.rs`): [`linalg`] (tridiagonal
+//! and sparse matrices, their factorisations) → [`step`] (the step problem's solvers and their
+//! audit) → [`scene`] (input) → [`scheme`] (the talk's scheme, for any body) → [`bar`] (P1, its
+//! kernels, closed forms) → [`plane`] (Q1, sparse Cholesky) → [`output`] (runs and their files,
+//! both bodies) → [`study`] (refinement, comparison, mass variants, figures). The certificate
+//! (VERIFICATION.md's tables, the tolerance registry) is the member crate `viscobar-certificate`.
 
 //! # Use as a library
 //!

@@ -1,4 +1,4 @@
-//! The mass variants of `[bar] mass` (issue #19) end to end: the refused combinations through
+//! The mass variants of `[bar] mass` end to end: the refused combinations through
 //! the binary, `--set bar.mass=…` against the library's `run_with_mass`, the massless nodes of
 //! the discretisation, and the bands of VERIFICATION.md's claims ("Mass variants") on the study
 //! itself. The matrices are tested in `tests/matrices.rs`, the solvers with every variant in

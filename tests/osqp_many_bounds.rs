@@ -1,28 +1,10 @@
 //! OSQP against the exact many-bound solver (block principal pivoting) on random larger step
 //! problems with many bounds: up to 400 unknowns, a bound on a random subset of the nodes or on
 //! every node, two problems in a row so that OSQP's warm start and per-step updates are used.
-//!
 //! The agreement is checked against an a-posteriori error bound that is a theorem, not a tuned
-//! tolerance. The step problem `min ½zᵀCz − bᵀz, z_j >= lo_j (j in nodes)` is a mixed linear
-//! complementarity problem whose natural residual is
-//!
-//! ```text
-//!   ν_i(z) = (Cz − b)_i                      (free node i),
-//!   ν_i(z) = min(z_i − lo_j, (Cz − b)_i)     (node i = nodes[j]).
-//! ```
-//!
-//! X. Chen and S. Xiang, "Computation of error bounds for P-matrix linear complementarity
-//! problems", Math. Program. 106 (2006) 513–525: for a P-matrix `C`,
-//! `‖z − z*‖∞ <= max_{d∈[0,1]ⁿ} ‖(I − D + DC)⁻¹‖∞ ‖ν(z)‖∞` (a free row is the case `d_i = 1`),
-//! and for an H-matrix with positive diagonal (the generator's strictly diagonally dominant `C`)
-//! the maximum is at most `κ_H = ‖C̃⁻¹ max(Λ, I)‖∞`, `C̃` the comparison matrix, `Λ = diag C`:
-//! one tridiagonal solve (`chen_xiang_bound_holds` checks that inequality densely on small
-//! matrices). So two answers satisfy `‖z − z'‖∞ <= κ_H (‖ν(z)‖∞ + ‖ν(z')‖∞)`, each residual
-//! recomputed here from `z` alone and widened by its round-off floor.
-//!
-//! Separately the bound must be small: OSQP passed its audit (residuals within
-//! `AUDIT_MARGIN·eps`, which caps `‖ν‖∞` as in [`a_priori_tolerance`]) and the exact answer is at
-//! round-off, so the bound must come out below what those caps allow.
+//! tolerance (Chen & Xiang, Math. Program. 106, 2006: `‖z − z'‖∞ <= κ_H (‖ν(z)‖∞ + ‖ν(z')‖∞)`
+//! for the natural residuals `ν`; derivation: `docs/osqp-agreement-bound.md`), and the bound
+//! must itself be small: below what OSQP's audited residuals allow ([`a_priori_tolerance`]).
 
 mod common;
 

@@ -1,23 +1,15 @@
 //! Snapshot regressions of the talk's figures: for every talk scene, the data its figure is drawn
-//! from, reduced to a small reviewed YAML file in the top-level `snapshots/` folder
-//! (`snapshots/<scene>.snap`). A change to the numbers that moves a figure fails this test; the
-//! README ("Snapshots") says how to review and accept such a change.
+//! from (`u` at 9 nodes by 11 steps, the energy `E^{n−1/2}` recorded by those steps, the contact
+//! intervals per Signorini end and the solver iteration statistics), reduced to a small reviewed
+//! YAML file in `snapshots/<scene>.snap`; README.md ("Snapshots") says how to review a change.
 //!
-//! Content: `u` at 9 nodes by 11 steps (`i = 0, J/8, …, J + 1` and `n = 0, N/10, …, N`; these are
-//! mesh points, so the values are the scheme's own, not interpolated), the energy `E^{n−1/2}`
-//! recorded by those steps, the contact intervals per Signorini end and the solver iteration
-//! statistics.
-//!
-//! Rounding: every quantity is rounded to [`SIGNIFICANT_DIGITS`] significant digits *of its largest
-//! magnitude* (for `u`, a quantum of about 1e-8 · max|u|). That is safe both ways: the round-off of
-//! these runs is about 1e-13 relative (an ulp per operation over 2400 steps of well-conditioned
-//! tridiagonal solves; `libm`'s `sin`/`cos` may differ by an ulp between machines), five orders
-//! below the quantum, so last-bit differences do not churn the snapshots; and the discretisation
-//! error of these meshes (h = π/400, Δt = 0.005) is about 1e-3..1e-2, five orders above it, so any
-//! change that could matter numerically shows. Rounding each value to its own digits would not be
-//! safe: `u(π/4, 0) = 0.3 cos(π/2)` is 2e-17 of pure round-off. A value within 1e-13 of a rounding
-//! boundary can still flip its last digit (chance 2e-13/1e-8 per value, about 1e-2 for the ~460
-//! values here per change of machine or compiler); that shows as a one-digit diff.
+//! Rounding: every quantity to [`SIGNIFICANT_DIGITS`] significant digits *of its largest
+//! magnitude* (for `u` a quantum of about 1e-8 · max|u|): five orders above these runs'
+//! round-off (about 1e-13 relative), so last-bit differences do not churn the snapshots, and
+//! five below their discretisation error (1e-3 … 1e-2), so any change that could matter shows.
+//! Rounding each value to its own digits would not be safe: `u(π/4, 0) = 0.3 cos(π/2)` is 2e-17
+//! of pure round-off. A value within 1e-13 of a rounding boundary can still flip its last digit
+//! (about once per 100 changes of machine or compiler); that shows as a one-digit diff.
 
 use insta::with_settings;
 use serde::Serialize;
@@ -91,7 +83,7 @@ struct Snapshot {
     solver_iterations: Iterations,
 }
 
-/// Snapshots of a talk scene with another mass matrix (issue #19): snapshot name, scene, the
+/// Snapshots of a talk scene with another mass matrix: snapshot name, scene, the
 /// `bar.mass` value.
 const MASS_SNAPSHOTS: [(&str, &str, &str); 1] =
     [("one-end-mass-redistributed", "one-end", "redistributed")];

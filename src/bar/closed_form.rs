@@ -340,7 +340,7 @@ impl ClosedForm for ForcedMode {
 /// that still counts as the same load: the scene's text rounds `π` and its products once more.
 const LOAD_MATCH_TOL: f64 = 1e-12;
 
-/// Viscous contact, manufactured (issue #22): a Kelvin–Voigt bar (`α > 0`) on `[0, L]`,
+/// Viscous contact, manufactured: a Kelvin–Voigt bar (`α > 0`) on `[0, L]`,
 /// Signorini at `x = 0` with gap `a0`, free at `x = L`, with the exact solution
 /// `u(x, t) = g(t) + h(t) w(x)`, `w = sin(kx)/k`, `k = π/(2L)` (so `w(0) = 0`, `w'(0) = 1`,
 /// `w'(L) = 0`, `w'' = −k² w`), under the load `l = u_tt − u_xx − α u_xxt` it defines.

@@ -1,20 +1,14 @@
 //! Extreme eigenvalues and the condition number of a symmetric tridiagonal matrix, in O(n) per
-//! iteration and O(1) extra memory, for the step matrix `C = M/Δt² + (½ + α/(2Δt)) R` at up to
-//! 1e6 nodes, where a dense eigensolver is out of reach.
+//! iteration and O(1) extra memory, for the step matrix `C` at up to 1e6 nodes, where a dense
+//! eigensolver is out of reach.
 //!
 //! Method: Sturm-sequence bisection (Golub & Van Loan, *Matrix Computations*, 4th ed., §8.4.1;
-//! LAPACK `dstebz`). The pivots of `A − x I = L D Lᵀ`,
-//!
-//! ```text
-//!   d_0 = a_0 − x,   d_i = a_i − x − e_{i−1}² / d_{i−1},
-//! ```
-//!
-//! have as many negative entries as `A` has eigenvalues below `x` (Sylvester's law of inertia);
-//! the recurrence is backward stable in the absolute sense (Kahan 1966), so each eigenvalue is
-//! found to within a few ulps of `‖A‖`. Bisection starts from the Gershgorin interval. For the
-//! smallest eigenvalue of an SPD matrix the interval is clipped at 0 and bisection continues
-//! until the interval stops shrinking, so a small eigenvalue is resolved to round-off of `‖A‖`
-//! (relative error about `κ(A)·ε`, which is what the condition number is needed for).
+//! LAPACK `dstebz`): the pivots `d_0 = a_0 − x`, `d_i = a_i − x − e_{i−1}²/d_{i−1}` of
+//! `A − xI = LDLᵀ` have as many negative entries as `A` has eigenvalues below `x` (Sylvester),
+//! and the recurrence is backward stable in the absolute sense (Kahan 1966), so each eigenvalue
+//! is found to a few ulps of `‖A‖`. Bisection starts from the Gershgorin interval; for the
+//! smallest eigenvalue of an SPD matrix it is clipped at 0 and continued until the interval stops
+//! shrinking, so a small eigenvalue is resolved to round-off of `‖A‖` (relative error `κ(A)ε`).
 
 use crate::linalg::tridiag::SymTridiag;
 

@@ -1,22 +1,11 @@
 //! A manufactured solution of the plane Kelvin–Voigt body on `(0, W) × (0, H)`, clamped on
-//! all four edges:
-//!
-//! ```text
-//!   u(x, y, t) = g(t) Φ(x, y),   g(t) = cos(ωt) + β sin(ωt),
-//!   Φ = (a₁ sin(πx/W) sin(πy/H), a₂ sin(2πx/W) sin(2πy/H)),
-//! ```
-//!
-//! and its load `l = ρ u_tt − div σ`, `σ = A ε(u + α u_t)`. With constant Lamé coefficients
-//! `div A ε(Φ) = (λ + μ) ∇ div Φ + μ ΔΦ =: LΦ`, so
-//! `l = ρ g'' Φ − (g + α g') LΦ`, `g'' = −ω² g`, and for `Φ = (X₁Y₁, X₂Y₂)`
-//!
-//! ```text
-//!   (LΦ)_x = (λ + 2μ) X₁''Y₁ + μ X₁Y₁'' + (λ + μ) X₂'Y₂',
-//!   (LΦ)_y = μ X₂''Y₂ + (λ + 2μ) X₂Y₂'' + (λ + μ) X₁'Y₁'.
-//! ```
-//!
+//! all four edges, `u(x, y, t) = (cos ωt + β sin ωt) Φ(x, y)` with
+//! `Φ = (a₁ sin(πx/W) sin(πy/H), a₂ sin(2πx/W) sin(2πy/H))`, and its load
+//! `l = ρ u_tt − div σ`, `σ = A ε(u + α u_t)` (derivation: [docs/plane-manufactured.md]).
 //! `Φ` vanishes on the boundary, so the clamped conditions hold; the unit test checks `l`
 //! against finite differences of `u` and the scene's load text against `l`.
+//!
+//! [docs/plane-manufactured.md]: ../docs/plane-manufactured.md
 
 use crate::scene::plane::{
     Body, EdgeCondition, EdgeSpec, Edges, PlaneInitial, PlaneLoad, PlaneMesh, PlaneScene, Vector,

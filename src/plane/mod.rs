@@ -8,21 +8,7 @@
 //!
 //! Imports [`crate::linalg`], [`crate::step`], [`crate::scene`] and [`crate::scheme`].
 //!
-//! ```
-//! use viscobar::scene::{AnyScene, load_any};
-//! use viscobar::plane::PlaneSimulation;
-//!
-//! let set = ["mesh.nx=16".to_string(), "time.end=0.1".to_string()];
-//! let AnyScene::Plane(scene) = load_any("plane-strip", &set)?.1 else { unreachable!() };
-//! let mut sim = PlaneSimulation::new(&scene)?;
-//! let first = sim.first_record();
-//! for _ in 1..scene.steps() {
-//!     let r = sim.step()?;
-//!     // The energy identity holds to round-off; without load the energy only decays.
-//!     assert!(r.identity_residual < 1e-12 && r.energy <= first.energy);
-//! }
-//! # Ok::<(), Box<dyn std::error::Error>>(())
-//! ```
+//! A plane run is a [`PlaneSimulation`]; `examples/plane_tilted_drop_exact.rs` steps one.
 
 pub mod body;
 pub mod closed_form;

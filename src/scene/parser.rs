@@ -1,27 +1,9 @@
 //! The parser of scene expressions ([`crate::scene::expr`]): a small recursive-descent parser
-//! from text to the expression tree.
-//!
-//! # Grammar
-//!
-//! | What | Written | Example | Value |
-//! |---|---|---|---|
-//! | numbers | `12`, `0.5`, `.5`, `5.`, `1e6`, `2.5E-3` | `1e-2` | 0.01 |
-//! | variables | `x` in every field; `y` in plane scenes ([`Expression::parse_plane`]); `t` only in `load.density` | `2*x` at x = 0.25 | 0.5 |
-//! | constants | `pi` (also `PI`, `π`), `e` (also `E`), `tau` (also `TAU`, `τ`) | `2*pi` | 6.283185307179586 |
-//! | arithmetic | `+ - * /`, left-associative; `*` `/` bind tighter than `+` `-` | `8/4/2` | 1 |
-//! | power | `^`, right-associative, tighter than unary minus: `-a^b` is `-(a^b)` | `2^3^2`, `-2^2` | 512, −4 |
-//! | unary sign | `-a`, `+a`; allowed after `^` | `2^-1` | 0.5 |
-//! | comparisons | `< <= > >= == !=`, loosest of all, one per level, give 1 (true) or 0 (false) | `-0.3*(x<2)` at x = 1 | −0.3 |
-//! | piecewise | `if(c, a, b)`: `a` where `c` ≠ 0, else `b`; `step(s)`: 1 for `s >= 0` (so `step(0) = 1`), 0 for `s < 0` | `if(x<0.5, 1, 2)` at x = 0.75 | 2 |
-//! | one argument | `sin cos tan asin acos atan sinh cosh tanh asinh acosh atanh exp ln log log2 log10 sqrt cbrt abs sign signum floor ceil round trunc fract step` | `sqrt(16)` | 4 |
-//! | several arguments | `min(a, b, …)`, `max(a, b, …)` (two or more), `atan2(y, x)`, `if(c, a, b)`; nest freely | `max(0,min(1,2-x))` at x = 1.5 | 0.5 |
-//!
-//! `log` is the natural logarithm, as `ln`. `sign(s)` is −1, 0 or 1 (`sign(0) = 0`), while
-//! `signum` is Rust's `f64::signum` (`signum(0) = 1`). Spaces are ignored. Any NaN in a
-//! comparison, in `step`, `sign` or in the condition of `if` gives NaN, so that an undefined value
-//! is reported rather than silently read as false.
-//!
-//! A parse error names the field, the text and the column (counted in characters from 1), e.g.
+//! from text to the expression tree. The grammar (numbers, `x`, `y`, `t`, constants, `+ - * /`
+//! left-associative, `^` right-associative and tighter than unary minus, comparisons loosest,
+//! `if`, `step`, the one- and several-argument functions) is README.md's "Expressions" table.
+//! Spaces are ignored; nesting is bounded by [`MAX_DEPTH`]. A parse error names the field, the
+//! text and the column (counted in characters from 1), e.g.
 //! ``` `initial.displacement` = "max(0,min(1,2-x)": unclosed parenthesis opened at column 4```.
 
 use crate::scene::SceneError;

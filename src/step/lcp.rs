@@ -1,23 +1,16 @@
-//! Exact solver of the dense linear complementarity problem
-//!
-//! ```text
-//!   w = S r + q >= 0,   r >= 0,   rᵀ w = 0,
-//! ```
-//!
-//! `S` symmetric positive definite (`m × m`), the condensed contact problem of the plane body
-//! ([`crate::step::condensed`]: `S = E C⁻¹ Eᵀ`). An SPD matrix is a P-matrix, so the solution
+//! Exact solver of the dense linear complementarity problem `w = S r + q >= 0, r >= 0,
+//! rᵀw = 0` with `S` symmetric positive definite (`m × m`; the condensed contact problem
+//! `S = E C⁻¹ Eᵀ` of [`crate::step::condensed`]). An SPD matrix is a P-matrix, so the solution
 //! exists and is unique for every `q` (Cottle, Pang & Stone, *The Linear Complementarity
 //! Problem*, Thm 3.3.7).
 //!
 //! Method: block principal pivoting (Júdice & Pires, Comput. Oper. Res. 21, 1994) safeguarded
-//! by Murty's least-index single pivoting rule, which is finite on every P-matrix LCP (Murty,
-//! Linear Algebra Appl. 1974); the bar's [`crate::step::block_pivot`] does the same on a
-//! tridiagonal matrix. For an active set `A` (its complement `F`), `r_F = 0`, `w_A = 0`:
-//! `S_AA r_A = −q_A` by a dense Cholesky into a buffer kept for the run, then
-//! `w_F = q_F + S_FA r_A`. Indices with `r_k < 0` on `A` or `w_k < 0` on `F`, beyond round-off,
-//! are infeasible; the block rule flips them all while their number decreases (with
-//! [`BLOCK_PATIENCE`] tries of grace), then Murty's rule flips the least one. The active set
-//! is kept for the next call (warm start). [`DenseLcp::solve`] allocates nothing.
+//! by Murty's least-index rule, finite on every P-matrix LCP (Murty 1974), as the bar's
+//! [`crate::step::block_pivot`] on a tridiagonal matrix. For an active set `A`: `S_AA r_A =
+//! −q_A` by a dense Cholesky in a buffer kept for the run, `w_F = q_F + S_FA r_A`; the infeasible
+//! indices (beyond round-off) are flipped all at once while their number decreases (with
+//! [`BLOCK_PATIENCE`] tries of grace), then one at a time by Murty's rule. The active set is
+//! kept for the next call (warm start). [`DenseLcp::solve`] allocates nothing.
 
 use crate::step::block_pivot::{BLOCK_PATIENCE, TIE_ULPS};
 

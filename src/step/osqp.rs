@@ -1,23 +1,16 @@
-//! The OSQP step solver: the step problem handed to OSQP (B. Stellato, G. Banjac, P. Goulart,
-//! A. Bemporad, S. Boyd, "OSQP: an operator splitting solver for quadratic programs", Math.
-//! Prog. Comp. 12, 2020), through the `osqp` crate 0.6.3 (OSQP 0.6 with its bundled QDLDL).
+//! The OSQP step solver (B. Stellato, G. Banjac, P. Goulart, A. Bemporad, S. Boyd, "OSQP: an
+//! operator splitting solver for quadratic programs", Math. Prog. Comp. 12, 2020), through the
+//! `osqp` crate 0.6.3 (OSQP 0.6 with its bundled QDLDL), for either body.
 //!
 //! QP form: `minimise ½ zᵀPz + qᵀz  s.t.  l <= Az <= u` with `P = C` (its upper triangle, from
-//! the body's [`SpdSystem`]), `q = −b`, `A` the rows `s_k e_{i_k}ᵀ` of the constraints,
-//! `l = lo` (it moves every step with `u^n`) and `u = `[`OSQP_INFTY`]. OSQP is set up once per
-//! run; each step updates `q` and `l` and warm-starts from the previous step's answer, which is
-//! close since the increment varies smoothly in time. With no constraint `A` is `0 × n`: OSQP
-//! accepts it (checked in tests) and solves the unconstrained problem by its ADMM iteration
-//! like any other, so the `osqp` method still uses OSQP there.
-//!
-//! OSQP's dual `y` is negative at an active lower bound, so the reaction is `r = −y`.
-//!
-//! Every answer OSQP reports as solved is audited ([`crate::step::audit`]); a status other than
-//! "solved" (or "solved inaccurate" with `accept_inaccurate`) or a failed audit is an error.
-//!
-//! Determinism: OSQP runs single-threaded, and the rho adaptation interval is fixed (OSQP's
-//! default adapts after a fraction of the set-up *time*), so a run gives the same bits every
-//! time on a given machine and build.
+//! the body's [`SpdSystem`]), `q = −b`, `A` the rows `s_k e_{i_k}ᵀ`, `l = lo`, `u = `
+//! [`OSQP_INFTY`]; OSQP's dual at an active lower bound is negative, so `r = −y`. Set up once
+//! per run; each step updates `q` and `l` and warm-starts from the previous answer. Without
+//! constraints `A` is `0 × n` and OSQP solves the unconstrained problem by its ADMM iteration.
+//! Every answer reported solved is audited ([`crate::step::audit`]); another status (but
+//! "solved inaccurate" with `accept_inaccurate`) or a failed audit is an error. Determinism:
+//! single-threaded, and the rho adaptation interval fixed (OSQP's default adapts after a
+//! fraction of the set-up *time*), so a run gives the same bits every time on a machine.
 
 use crate::linalg::system::{Csc, SpdSystem, TridiagSystem};
 use crate::linalg::tridiag::SymTridiag;

@@ -1,15 +1,10 @@
 //! The penalty step solver: the talk's penalised problem (PP) (Petrov & Schatzman 2009), normal
 //! compliance. The unilateral constraint at each Signorini node is replaced by the force
 //! `(u + a)⁻/ε`, taken implicitly at `t^{n+1}`; in the increment `z` the step reads
-//!
-//! ```text
-//!   C z = b + Σ_j r_j e_j,   ε r_j = max(0, lo_j − z_j),
-//! ```
-//!
-//! the optimality condition of the strictly convex problem
-//! `min ½ zᵀCz − bᵀz + Σ_j ((lo_j − z_j)⁺)²/(2ε)`, so it has exactly one solution. The gap
-//! `z_j − lo_j = −ε r_j` is negative in contact: penetration ≈ ε × reaction, and
-//! complementarity holds only in the limit ε → 0.
+//! `C z = b + Σ_j r_j e_j`, `ε r_j = max(0, lo_j − z_j)`, the optimality condition of the
+//! strictly convex problem `min ½ zᵀCz − bᵀz + Σ_j ((lo_j − z_j)⁺)²/(2ε)`, so it has exactly
+//! one solution. The gap `z_j − lo_j = −ε r_j` is negative in contact: penetration ≈ ε ×
+//! reaction, and complementarity holds only in the limit ε → 0.
 //!
 //! Each step solves the LCP in the reactions by enumerating the at most four supports, then
 //! computes the answer by a direct solve on the chosen one; why this is exact and backward
