@@ -5,9 +5,9 @@
 //! tests against the worst value it guards ([`tolerances`]), the stiff and extreme case matrix
 //! ([`stiff`], [`stiff_runs`]), the step solvers' agreement ([`agreement`]) with the dense
 //! brute-force [`oracle`], the rigid mode's round-off ([`roundoff`]), the mass variants side by
-//! side ([`mass_study`]), the plane body's checks ([`plane_checks`], [`plane_contact`]), the
-//! manufactured viscous contact ([`viscous_contact`]), error against run time ([`timings`]);
-//! and the tools that write the measured blocks of the READMEs ([`bench_table`], [`peak_memory`]).
+//! side ([`mass_study`]), the plane body's checks ([`plane_checks`], [`plane_contact`],
+//! [`plane_symmetry`]), the manufactured viscous contact ([`viscous_contact`]), error against
+//! run time ([`timings`]); the writers of the READMEs' blocks ([`bench_table`], [`peak_memory`]).
 //!
 //! A member crate of the viscobar workspace, beside the library and not part of its API: it
 //! imports `viscobar`, and the integration tests of `viscobar` import it (a dev-dependency),
@@ -21,6 +21,7 @@ pub mod oracle;
 pub mod peak_memory;
 pub mod plane_checks;
 pub mod plane_contact;
+pub mod plane_symmetry;
 pub mod roundoff;
 pub mod stiff;
 pub mod stiff_runs;

@@ -1,5 +1,5 @@
 //! The plane body's tolerances (`tests/plane.rs`, `plane_contact.rs`, `plane_cli.rs`,
-//! `plane_contact_cli.rs`), each beside the measurement of what it guards.
+//! `plane_contact_cli.rs`, `plane_symmetry.rs`), each beside the measurement of what it guards.
 
 use super::{AGREEMENT_ULPS_PER_STEP, Measured};
 use viscobar::scheme::RunError;
@@ -26,6 +26,13 @@ pub const PLANE_OSQP_AGREEMENT_TOL: f64 = 1e-7;
 /// twice itself where the wave reflects, and the release delayed by O(ε) can double that again
 /// (the bar's `PENALTY_AGREEMENT_FACTOR`, one contact episode): `|u − u_exact| ≤ 4 ε r_max`.
 pub const PLANE_PENALTY_FACTOR: f64 = 4.0;
+
+// ---- tests/plane_symmetry.rs ------------------------------------------------------------------
+
+/// Image run vs image of the run, u relative to max |u|: round-off of another elimination order.
+pub const PLANE_SYMMETRY_DISPLACEMENT_TOL: f64 = 1e-14;
+/// Reactions likewise (relative to max r): cancelling gaps times `S⁻¹ ~ M/Δt²`, an order above u.
+pub const PLANE_SYMMETRY_REACTION_TOL: f64 = 1e-13;
 
 /// Plane OSQP against exact over its a-posteriori bound: per step, two backward-stable solves of
 /// the step's active-set system differ by [`AGREEMENT_ULPS_PER_STEP`] ε relative (the bar's
@@ -153,6 +160,7 @@ pub fn plane_worst() -> Result<PlaneWorst, RunError> {
 /// The registry's rows of the plane tolerances.
 pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
     let w = plane_worst()?;
+    let symmetry = crate::plane_symmetry::worst_deviation()?;
     let rows = [
         (
             "PLANE_IDENTITY_TOL",
@@ -204,6 +212,20 @@ pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
             w.penalty_ratio,
             "the penetration ε r, doubled at a reflection and again by the delayed release \
              (plane-tilted-drop, one episode)",
+        ),
+        (
+            "PLANE_SYMMETRY_DISPLACEMENT_TOL",
+            "tests/plane_symmetry.rs",
+            PLANE_SYMMETRY_DISPLACEMENT_TOL,
+            symmetry.u,
+            "another elimination order on the image mesh (every mirror and turn of the tests)",
+        ),
+        (
+            "PLANE_SYMMETRY_REACTION_TOL",
+            "tests/plane_symmetry.rs",
+            PLANE_SYMMETRY_REACTION_TOL,
+            symmetry.r,
+            "the reactions from nearly closed gaps times S⁻¹ (every mirror and turn of the tests)",
         ),
     ];
     Ok(rows
