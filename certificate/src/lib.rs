@@ -17,6 +17,7 @@
 pub mod agreement;
 pub mod bench_table;
 pub mod mass_study;
+pub mod moving;
 pub mod oracle;
 pub mod peak_memory;
 pub mod plane_checks;

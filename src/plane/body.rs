@@ -11,7 +11,7 @@ use crate::linalg::system::SparseSystem;
 use crate::plane::energy::{StrainForms, measure};
 use crate::plane::matrices::{Material, assemble};
 use crate::plane::mesh::Grid;
-use crate::plane::normals::{Normal, normals};
+use crate::plane::normals::{Normal, edge_motion, normals};
 use crate::scene::SolverMethod;
 use crate::scene::expr::Expression;
 use crate::scene::plane::{EDGE_NAMES, PlaneScene};
@@ -296,7 +296,7 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
         }
     }
     let normals = normals(&disc.grid, &disc.index, &gaps, &u0_full)?;
-    let contact = contact_set(&normals);
+    let contact = contact_set(&normals).with_motion(edge_motion(&gaps, &normals));
     let restrict = |v: &[f64]| disc.free.iter().map(|&d| v[d]).collect::<Vec<f64>>();
     let (displacement, velocity) = (restrict(&u0_full), restrict(&v0_full));
     let c = disc.step_matrix();

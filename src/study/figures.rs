@@ -124,6 +124,34 @@ pub fn write_talk_figures(out: &Path, overrides: &[String]) -> Result<Vec<PathBu
     Ok(written)
 }
 
+/// Runs one bar scene and writes its figure (the colour map of u(x, t) beside its contact
+/// panel, as [`write_talk_figures`] draws each talk scene) as `<name>.png` and `<name>.svg`
+/// into `out`; returns the files written (`viscobar run SCENE --figure`).
+pub fn write_scene_figure(
+    name: &str,
+    scene: &scene::Scene,
+    out: &Path,
+) -> Result<Vec<PathBuf>, FigureError> {
+    let run = sample_run(name, scene, Sampling::for_figure(scene)).map_err(|source| {
+        FigureError::Run {
+            scene: name.to_string(),
+            source,
+        }
+    })?;
+    register_font()?;
+    std::fs::create_dir_all(out).map_err(|source| FigureError::Write {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let mut written = Vec::new();
+    for ext in ["png", "svg"] {
+        let path = out.join(format!("{name}.{ext}"));
+        write_figure(&path, &TalkFigure::Scene(&run))?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
 /// A figure to draw: one scene, or a talk figure (its title and its two scenes).
 #[derive(Clone, Copy)]
 enum TalkFigure<'a> {

@@ -206,8 +206,20 @@ pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
              (plane-tilted-drop, one episode)",
         ),
     ];
+    let galilean = crate::moving::galilean_plane()?
+        .ratio()
+        .max(crate::moving::galilean_bar()?.ratio());
+    let moving = [(
+        "moving obstacle: relative |Δu|, |Δr| of the shifted run / (steps · GALILEAN_ULPS_PER_STEP ε)",
+        "tests/moving_obstacles.rs",
+        1.0,
+        galilean,
+        "Galilean invariance, plane and bar: the shift v t rounded and K's translation \
+         round-off, per step, accumulated linearly",
+    )];
     Ok(rows
         .into_iter()
+        .chain(moving)
         .map(|(name, used_in, tolerance, worst, note)| Measured {
             name: name.into(),
             used_in,
