@@ -16,6 +16,7 @@
 
 pub mod agreement;
 pub mod bench_table;
+pub mod locking;
 pub mod mass_study;
 pub mod moving;
 pub mod oracle;

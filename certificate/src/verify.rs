@@ -63,6 +63,10 @@ pub fn sections() -> Result<Vec<Section>, viscobar::study::converge::ConvergeErr
             markdown: crate::plane_contact::markdown()?,
         },
         Section {
+            id: "locking",
+            markdown: crate::locking::markdown()?,
+        },
+        Section {
             id: "moving",
             markdown: crate::moving::markdown()?,
         },

@@ -9,7 +9,7 @@ use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::sparse::Pattern;
 use crate::linalg::system::SparseSystem;
 use crate::plane::energy::{StrainForms, measure};
-use crate::plane::matrices::{Material, assemble};
+use crate::plane::matrices::{Material, assemble, assemble_with};
 use crate::plane::mesh::Grid;
 use crate::plane::normals::{Normal, edge_motion, normals};
 use crate::scene::SolverMethod;
@@ -57,7 +57,8 @@ impl PlaneDiscretisation {
             mu: scene.plane.mu,
             density: scene.plane.density,
         };
-        let full = assemble(&grid, material);
+        let rule = scene.plane.integration;
+        let full = assemble_with(&grid, material, rule);
         let [left, right, bottom, top] = scene.edges.clamped();
         let mut index = vec![None; grid.dofs()];
         let mut free = Vec::new();
@@ -77,7 +78,7 @@ impl PlaneDiscretisation {
         let (pattern, from) = full.pattern.restrict(&index);
         let mass = from.iter().map(|&k| full.mass[k]).collect();
         let stiffness = from.iter().map(|&k| full.stiffness[k]).collect();
-        let forms = StrainForms::new(&grid, material, &index);
+        let forms = StrainForms::with_rule(&grid, material, &index, rule);
         Self {
             forms,
             grid,

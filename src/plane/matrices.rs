@@ -5,12 +5,15 @@
 //! ```
 //!
 //! assembled cell by cell with 2 × 2 Gauss points, exact for both on rectangles (the mass
-//! integrand is bi-quadratic, the stiffness one at most bi-quadratic). Both share one
-//! symmetric CSR pattern (the 3 × 3 node stencil, two components per node); the clamped
+//! integrand is bi-quadratic, the stiffness one at most bi-quadratic). With selective reduced
+//! integration ([`Integration::Selective`]) the `λ` term is taken at the cell centre (one
+//! point), the `2μ ε:ε` term still at 2 × 2: no volumetric locking as `λ/μ → ∞`. Both share
+//! one symmetric CSR pattern (the 3 × 3 node stencil, two components per node); the clamped
 //! degrees of freedom are then removed ([`Pattern::restrict`]).
 
 use crate::linalg::sparse::Pattern;
 use crate::plane::mesh::Grid;
+pub use crate::scene::plane::Integration;
 
 /// The material: Lamé coefficients and density.
 #[derive(Clone, Copy, Debug)]
@@ -60,8 +63,23 @@ fn gauss() -> [f64; 2] {
 }
 
 /// The 8 × 8 element mass and stiffness of a `hx × hy` cell, local nodes in the order of
-/// [`Grid::cell_nodes`], local dofs `2a + c`.
+/// [`Grid::cell_nodes`], local dofs `2a + c` (full integration).
 pub fn element(hx: f64, hy: f64, m: Material) -> ([[f64; 8]; 8], [[f64; 8]; 8]) {
+    element_with(hx, hy, m, Integration::Full)
+}
+
+/// [`element`] with the stiffness integrated by `rule`: `Full`, every term at 2 × 2 Gauss
+/// points; `Selective`, the `λ div u div v` term at the centre (weight `hx hy`), the
+/// `2μ ε(u):ε(v)` term at 2 × 2.
+pub fn element_with(
+    hx: f64,
+    hy: f64,
+    m: Material,
+    rule: Integration,
+) -> ([[f64; 8]; 8], [[f64; 8]; 8]) {
+    if rule == Integration::Selective {
+        return selective_element(hx, hy, m);
+    }
     // Local node a at (sx[a], sy[a]) of the unit square.
     let (sx, sy) = ([0.0, 1.0, 1.0, 0.0], [0.0, 0.0, 1.0, 1.0]);
     let hat = |s: f64, at: f64| if s == 0.0 { 1.0 - at } else { at };
@@ -97,13 +115,70 @@ pub fn element(hx: f64, hy: f64, m: Material) -> ([[f64; 8]; 8], [[f64; 8]; 8]) 
     (me, ke)
 }
 
-/// Assembles `M` and `K` on all degrees of freedom.
+/// The element of [`Integration::Selective`] ([`element_with`]).
+fn selective_element(hx: f64, hy: f64, m: Material) -> ([[f64; 8]; 8], [[f64; 8]; 8]) {
+    let (sx, sy) = ([0.0, 1.0, 1.0, 0.0], [0.0, 0.0, 1.0, 1.0]);
+    let hat = |s: f64, at: f64| if s == 0.0 { 1.0 - at } else { at };
+    let slope = |s: f64| if s == 0.0 { -1.0 } else { 1.0 };
+    let (mut me, mut ke) = ([[0.0; 8]; 8], [[0.0; 8]; 8]);
+    let weight = 0.25 * hx * hy;
+    let two_mu = 2.0 * m.mu;
+    for xi in gauss() {
+        for eta in gauss() {
+            let mut n = [0.0; 4];
+            let (mut nx, mut ny) = ([0.0; 4], [0.0; 4]);
+            for a in 0..4 {
+                n[a] = hat(sx[a], xi) * hat(sy[a], eta);
+                nx[a] = slope(sx[a]) / hx * hat(sy[a], eta);
+                ny[a] = hat(sx[a], xi) * slope(sy[a]) / hy;
+            }
+            for a in 0..4 {
+                for b in 0..4 {
+                    let (nn, xx, yy) = (n[a] * n[b], nx[a] * nx[b], ny[a] * ny[b]);
+                    let (xy, yx) = (nx[a] * ny[b], ny[a] * nx[b]);
+                    let mass = weight * m.density * nn;
+                    me[2 * a][2 * b] += mass;
+                    me[2 * a + 1][2 * b + 1] += mass;
+                    ke[2 * a][2 * b] += weight * (two_mu * xx + m.mu * yy);
+                    ke[2 * a + 1][2 * b + 1] += weight * (m.mu * xx + two_mu * yy);
+                    ke[2 * a][2 * b + 1] += weight * (m.mu * yx);
+                    ke[2 * a + 1][2 * b] += weight * (m.mu * xy);
+                }
+            }
+        }
+    }
+    // λ div u div v at the centre, weight hx hy.
+    let (mut cx, mut cy) = ([0.0; 4], [0.0; 4]);
+    for a in 0..4 {
+        cx[a] = slope(sx[a]) / hx * 0.5;
+        cy[a] = 0.5 * slope(sy[a]) / hy;
+    }
+    let centre = hx * hy * m.lambda;
+    for a in 0..4 {
+        for b in 0..4 {
+            let (xx, yy) = (cx[a] * cx[b], cy[a] * cy[b]);
+            let (xy, yx) = (cx[a] * cy[b], cy[a] * cx[b]);
+            ke[2 * a][2 * b] += centre * xx;
+            ke[2 * a + 1][2 * b + 1] += centre * yy;
+            ke[2 * a][2 * b + 1] += centre * xy;
+            ke[2 * a + 1][2 * b] += centre * yx;
+        }
+    }
+    (me, ke)
+}
+
+/// Assembles `M` and `K` on all degrees of freedom (full integration).
 pub fn assemble(grid: &Grid, material: Material) -> Matrices {
+    assemble_with(grid, material, Integration::Full)
+}
+
+/// Assembles `M` and `K` on all degrees of freedom, `K` integrated by `rule`.
+pub fn assemble_with(grid: &Grid, material: Material, rule: Integration) -> Matrices {
     let pattern = stencil(grid);
     let mut mass = vec![0.0; pattern.nnz()];
     let mut stiffness = vec![0.0; pattern.nnz()];
     for j in 0..grid.ny {
-        let (me, ke) = element(grid.hx, grid.hy(j), material);
+        let (me, ke) = element_with(grid.hx, grid.hy(j), material, rule);
         for i in 0..grid.nx {
             let nodes = grid.cell_nodes(i, j);
             for (a, &na) in nodes.iter().enumerate() {

@@ -61,6 +61,36 @@ pub struct Body {
     /// Kelvin–Voigt `α >= 0` (default 0): `σ = A ε(u) + α A ε(u_t)`.
     #[serde(default)]
     pub viscosity: f64,
+    /// How `K` is integrated (default `full`); `selective` takes the `λ` term at the cell
+    /// centre, so that a nearly incompressible body does not lock.
+    #[serde(default, skip_serializing_if = "Integration::is_full")]
+    pub integration: Integration,
+}
+
+/// `[plane] integration`: the quadrature of the stiffness `K` (and of its energy forms).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Integration {
+    /// Every term at the 2 × 2 Gauss points: exact on rectangles; locks as `λ/μ → ∞`.
+    #[default]
+    Full,
+    /// Selective reduced integration: `λ div u div v` at the cell centre (one point),
+    /// `2μ ε(u):ε(v)` at 2 × 2 (Hughes, *The Finite Element Method*, §4.5).
+    Selective,
+}
+
+impl Integration {
+    fn is_full(&self) -> bool {
+        *self == Integration::Full
+    }
+
+    /// `full` or `selective`, as in the scene.
+    pub fn name(self) -> &'static str {
+        match self {
+            Integration::Full => "full",
+            Integration::Selective => "selective",
+        }
+    }
 }
 
 fn one_f64() -> f64 {
