@@ -5,11 +5,12 @@
 use crate::bar::Simulation;
 use crate::output::files::write_whole;
 use crate::output::history;
-use crate::output::profiles::Profiles;
 use crate::output::summary::{Summary, Tracker};
+use crate::output::vtk::KeptSteps;
 use crate::plane::PlaneSimulation;
 use crate::scene::plane::PlaneScene;
 use crate::scene::{OutputFormat, OutputSampling, OutputSpec, Scene};
+use crate::scheme::contact::ContactSet;
 use crate::scheme::{Body, RunError, Scheme, StepRecord, Unstarted};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -114,14 +115,18 @@ impl Run<'_> {
         out: &Path,
     ) -> Result<Summary, RunError> {
         let format = self.sampling.format;
-        let files = ["history.csv", format.file(), "summary.json"];
+        let mut files = vec!["history.csv", format.file(), "summary.json"];
+        files.extend(format.folder());
         let io = |path: PathBuf, source| RunError::Write { path, source };
         let summary = write_whole(out, &files, io, |tmp| {
             self.write_files(prepared, start, tmp)
         })?;
-        for other in [OutputFormat::Csv, OutputFormat::Npy] {
+        for other in [OutputFormat::Csv, OutputFormat::Npy, OutputFormat::Vtu] {
             if other != format {
                 let _ = std::fs::remove_file(out.join(other.file()));
+                if let Some(folder) = other.folder() {
+                    let _ = std::fs::remove_dir_all(out.join(folder));
+                }
             }
         }
         Ok(summary)
@@ -144,11 +149,11 @@ impl Run<'_> {
         let moving = prepared.contact().is_moving();
         hist.write_all(history::header(&groups, moving).as_bytes())
             .map_err(io(&hist_path))?;
-        // `t = 0` is written before the start-up step moves `u^0` on.
-        let disp_path = dir.join(self.sampling.file);
-        let mut disp = Profiles::new(create(&disp_path)?, prepared.body(), &self.sampling)
-            .map_err(io(&disp_path))?;
-        disp.write(0.0, prepared.state()).map_err(io(&disp_path))?;
+        // `t = 0` is written before the start-up step moves `u^0` on (no reactions yet).
+        let (body, contact) = (prepared.body(), prepared.contact());
+        let mut disp = KeptSteps::new(dir, body, contact, &self.sampling)?;
+        let rest = vec![0.0; contact.len()];
+        disp.write(0, 0.0, prepared.state(), (body, contact, &rest))?;
         let mut sim = prepared.start()?;
         let mut tracker = Tracker::new(&sim, !sim.is_forced());
         let mut row = Vec::new();
@@ -160,23 +165,24 @@ impl Run<'_> {
         let (steps, every) = (self.steps, self.output.every as usize);
         let keep = |n: usize| n.is_multiple_of(every) || n == steps;
         let bar = Progress::new(self.progress, steps, sim.body().unknowns());
+        fn kept<B: Body>(sim: &Scheme<B>) -> (&B, &ContactSet, &[f64]) {
+            (sim.body(), sim.contact(), sim.reactions())
+        }
         if keep(1) {
-            disp.write(sim.time(), sim.state())
-                .map_err(io(&disp_path))?;
+            disp.write(1, sim.time(), sim.state(), kept(&sim))?;
         }
         for _ in 1..steps {
             let r = sim.step()?;
             tracker.observe(&r);
             write_row(&mut hist, &r).map_err(io(&hist_path))?;
             if keep(r.step) {
-                disp.write(sim.time(), sim.state())
-                    .map_err(io(&disp_path))?;
+                disp.write(r.step, sim.time(), sim.state(), kept(&sim))?;
             }
             bar.step(r.step);
         }
         bar.finish();
         hist.flush().map_err(io(&hist_path))?;
-        disp.finish().map_err(io(&disp_path))?;
+        disp.finish()?;
         let mut summary = tracker.finish(self.name, &sim, start.elapsed().as_secs_f64());
         summary.output = Some(self.sampling);
         let json_path = dir.join("summary.json");

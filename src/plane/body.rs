@@ -12,6 +12,7 @@ use crate::plane::energy::{StrainForms, measure};
 use crate::plane::matrices::{Material, assemble, assemble_with};
 use crate::plane::mesh::Grid;
 use crate::plane::normals::{Normal, edge_motion, normals};
+use crate::plane::stress;
 use crate::scene::SolverMethod;
 use crate::scene::expr::Expression;
 use crate::scene::plane::{EDGE_NAMES, PlaneScene};
@@ -245,6 +246,16 @@ impl Body for PlaneBody {
 
     fn unknown_of(&self, dof: usize) -> Option<usize> {
         self.disc.index[dof]
+    }
+
+    /// [`crate::plane::stress`]: the cell-centre stresses, averaged at the nodes.
+    fn nodal_stress(&self, u: &[f64], v: &[f64]) -> Option<Vec<[f64; 4]>> {
+        let d = &self.disc;
+        let (mut uf, mut vf) = (vec![0.0; d.grid.dofs()], vec![0.0; d.grid.dofs()]);
+        self.scatter_into(u, 1.0, &mut uf);
+        self.scatter_into(v, 1.0, &mut vf);
+        let cells = stress::cell_stress(&d.grid, d.material, d.alpha, &uf, &vf);
+        Some(stress::nodal_stress(&d.grid, &cells))
     }
 }
 

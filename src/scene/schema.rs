@@ -447,6 +447,16 @@ impl Scene {
 
     /// Checks every field; the error names the field, the value and what is allowed.
     pub fn validate(&self) -> Result<(), SceneError> {
+        if self.output.format == crate::scene::OutputFormat::Vtu {
+            return Err(SceneError::Invalid {
+                field: "output.format".into(),
+                value: "\"vtu\"".into(),
+                allowed: "ParaView output is the plane body's (its mesh, stress tensor and \
+                          contact along its edges); a bar writes its profiles as \"csv\" or \
+                          \"npy\""
+                    .into(),
+            });
+        }
         positive("bar.length", self.bar.length)?;
         if !(self.bar.viscosity.is_finite() && self.bar.viscosity >= 0.0) {
             return Err(invalid(
