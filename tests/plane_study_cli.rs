@@ -153,3 +153,58 @@ fn a_moving_obstacle_adds_the_obstacle_work_column() {
     assert!(work > 0.0, "a rising floor does positive work: {work}");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// README's plane study, as written there: its scene file runs with `--figure` and writes the
+/// ParaView files, and `converge` takes it (shortened here: two levels to `t = 0.1`).
+#[test]
+fn the_readme_plane_study_runs_as_written() {
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    let section = &readme[readme.find("### A plane study, step by step").unwrap()..];
+    let start = section.find("```toml\n").unwrap() + "```toml\n".len();
+    let toml = &section[start..start + section[start..].find("```").unwrap()];
+    let dir = out_dir("readme");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("study.toml");
+    std::fs::write(&file, toml).unwrap();
+    let out = dir.join("out");
+    let o = viscobar(&[
+        "run",
+        file.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--figure",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in [
+        "solution.pvd",
+        "vtu/step-000.vtu",
+        "vtu/step-240.vtu",
+        "deformed.png",
+        "contact-pressure.png",
+    ] {
+        assert!(out.join(f).exists(), "{f}");
+    }
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    assert!(history.lines().next().unwrap().contains(",obstacle_work,"));
+    let conv = dir.join("converge");
+    let o = viscobar(&[
+        "converge",
+        file.to_str().unwrap(),
+        "--levels",
+        "2",
+        "--reference-level",
+        "2",
+        "--solvers",
+        "exact",
+        "--repeats",
+        "0",
+        "--set",
+        "time.end=0.1",
+        "--out",
+        conv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(conv.join("convergence.csv").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -24,6 +24,7 @@ pub mod peak_memory;
 pub mod plane_checks;
 pub mod plane_contact;
 pub mod roundoff;
+pub mod scale;
 pub mod stiff;
 pub mod stiff_runs;
 pub mod timings;

@@ -6,11 +6,10 @@ use crate::bar::Simulation;
 use crate::output::files::write_whole;
 use crate::output::history;
 use crate::output::summary::{Summary, Tracker};
-use crate::output::vtk::KeptSteps;
+use crate::output::vtk::{Kept, KeptSteps};
 use crate::plane::PlaneSimulation;
 use crate::scene::plane::PlaneScene;
 use crate::scene::{OutputFormat, OutputSampling, OutputSpec, Scene};
-use crate::scheme::contact::ContactSet;
 use crate::scheme::{Body, RunError, Scheme, StepRecord, Unstarted};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -165,7 +164,7 @@ impl Run<'_> {
         let (steps, every) = (self.steps, self.output.every as usize);
         let keep = |n: usize| n.is_multiple_of(every) || n == steps;
         let bar = Progress::new(self.progress, steps, sim.body().unknowns());
-        fn kept<B: Body>(sim: &Scheme<B>) -> (&B, &ContactSet, &[f64]) {
+        fn kept<B: Body>(sim: &Scheme<B>) -> Kept<'_, B> {
             (sim.body(), sim.contact(), sim.reactions())
         }
         if keep(1) {

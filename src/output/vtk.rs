@@ -15,6 +15,9 @@ use crate::scheme::contact::ContactSet;
 use crate::scheme::{Body, RunError, State};
 use std::path::{Path, PathBuf};
 
+/// What a kept step shows besides the state: the body, its constraints and their reactions.
+pub type Kept<'a, B> = (&'a B, &'a ContactSet, &'a [f64]);
+
 /// The writer of a run's kept steps.
 pub enum KeptSteps {
     Table {
@@ -62,18 +65,15 @@ impl KeptSteps {
         step: usize,
         t: f64,
         state: State<'_>,
-        (body, contact, reactions): (&B, &ContactSet, &[f64]),
+        kept: Kept<'_, B>,
     ) -> Result<(), RunError> {
         match self {
             KeptSteps::Table { profiles, path } => profiles.write(t, state).map_err(io(path)),
             #[cfg(feature = "vtk")]
-            KeptSteps::Vtu(s) => {
-                let _ = step;
-                s.write(step, t, state, (body, contact, reactions))
-            }
+            KeptSteps::Vtu(s) => s.write(step, t, state, kept),
             #[cfg(not(feature = "vtk"))]
             _ => {
-                let _ = (step, body, contact, reactions);
+                let _ = (step, kept);
                 unreachable!("no other writer without the `vtk` feature")
             }
         }
@@ -93,7 +93,7 @@ impl KeptSteps {
 pub mod series {
     //! The ParaView writer ([`VtuSeries`]).
 
-    use super::io;
+    use super::{Kept, io};
     use crate::output::profiles::written_nodes;
     use crate::output::text::push_time;
     use crate::plane::stress::von_mises;
@@ -190,7 +190,7 @@ pub mod series {
             step: usize,
             t: f64,
             state: State<'_>,
-            (body, contact, reactions): (&B, &ContactSet, &[f64]),
+            (body, contact, reactions): Kept<'_, B>,
         ) -> Result<(), RunError> {
             let k = body.components();
             let v: Vec<f64> = state.w.iter().map(|w| w * state.scale).collect();

@@ -15,11 +15,12 @@ use crate::plane::normals::{Normal, edge_motion, normals};
 use crate::plane::stress;
 use crate::scene::SolverMethod;
 use crate::scene::expr::Expression;
+use crate::scene::plane::PENALTY_CONDENSED_MAX_NORMALS;
 use crate::scene::plane::{EDGE_NAMES, PlaneScene};
 use crate::scheme::body::{Body, EnergySums, FullMassRows};
 use crate::scheme::contact::{ContactSet, Group, Positions};
 use crate::scheme::{Load, RunError, Scheme, Setup, Unstarted};
-use crate::step::{CondensedSolver, OsqpSolver, StepSolver};
+use crate::step::{CondensedSolver, OsqpSolver, SparsePenaltySolver, StepSolver};
 
 /// A run of a plane scene: the scheme stepping the plane body.
 pub type PlaneSimulation = Scheme<PlaneBody>;
@@ -318,7 +319,11 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
         SolverMethod::Exact => Box::new(CondensedSolver::new(system()?, constraints, 0.0)?),
         SolverMethod::Penalty => {
             let epsilon = scene.solver.penalty_settings().epsilon;
-            Box::new(CondensedSolver::new(system()?, constraints, epsilon)?)
+            if constraints.len() as u64 <= PENALTY_CONDENSED_MAX_NORMALS {
+                Box::new(CondensedSolver::new(system()?, constraints, epsilon)?)
+            } else {
+                Box::new(SparsePenaltySolver::new(system()?, constraints, epsilon)?)
+            }
         }
         SolverMethod::Osqp => Box::new(OsqpSolver::with_system(
             system()?,

@@ -104,11 +104,12 @@ impl StrainForms {
     /// `(|x|²_K, |y|²_K)` in one pass over the cells, `x(k)`, `y(k)` the values of unknown
     /// `k` (each sum in the order of a pass of its own: the same bits).
     pub fn quad_pair(&self, x: impl Fn(usize) -> f64, y: impl Fn(usize) -> f64) -> (f64, f64) {
-        if self.rule == Integration::Selective {
-            return self.selective_quad_pair(x, y);
-        }
-        let (lam, mu) = (self.material.lambda, self.material.mu);
-        let density = |ux: [f64; 4], uy: [f64; 4], gx: &[f64; 4], gy: &[f64; 4]| {
+        // The λ taken at the Gauss points: all of it (full), none (selective: at the centre,
+        // with four times the Gauss weight, `hx hy`).
+        let selective = self.rule == Integration::Selective;
+        let mu = self.material.mu;
+        let lam = if selective { 0.0 } else { self.material.lambda };
+        let strains = |ux: [f64; 4], uy: [f64; 4], gx: &[f64; 4], gy: &[f64; 4]| {
             let (mut exx, mut eyy, mut gxy) = (0.0, 0.0, 0.0);
             for a in 1..4 {
                 let (dx, dy) = (ux[a] - ux[0], uy[a] - uy[0]);
@@ -116,8 +117,17 @@ impl StrainForms {
                 eyy += gy[a] * dy;
                 gxy += gy[a] * dx + gx[a] * dy;
             }
+            (exx, eyy, gxy)
+        };
+        let density = |ux: [f64; 4], uy: [f64; 4], gx: &[f64; 4], gy: &[f64; 4]| {
+            let (exx, eyy, gxy) = strains(ux, uy, gx, gy);
             let tr = exx + eyy;
             lam * tr * tr + mu * (2.0 * (exx * exx + eyy * eyy) + gxy * gxy)
+        };
+        let volume = |ux: [f64; 4], uy: [f64; 4], (cx, cy): &([f64; 4], [f64; 4])| {
+            let (exx, eyy, _) = strains(ux, uy, cx, cy);
+            let tr = exx + eyy;
+            4.0 * self.material.lambda * tr * tr
         };
         let (mut total_x, mut total_y) = (0.0, 0.0);
         for j in 0..self.ny {
@@ -130,53 +140,10 @@ impl StrainForms {
                     row_x += density(xx, xy, &gx[g], &gy[g]);
                     row_y += density(yx, yy, &gx[g], &gy[g]);
                 }
-            }
-            total_x += weight * row_x;
-            total_y += weight * row_y;
-        }
-        (total_x, total_y)
-    }
-}
-
-impl StrainForms {
-    /// [`StrainForms::quad_pair`] of selective integration: `2μ ε:ε` at the Gauss points, the
-    /// `λ (tr ε)²` term at the centre with four times the Gauss weight (`hx hy`).
-    fn selective_quad_pair(
-        &self,
-        x: impl Fn(usize) -> f64,
-        y: impl Fn(usize) -> f64,
-    ) -> (f64, f64) {
-        let (lam, mu) = (self.material.lambda, self.material.mu);
-        let strains = |ux: [f64; 4], uy: [f64; 4], gx: &[f64; 4], gy: &[f64; 4]| {
-            let (mut exx, mut eyy, mut gxy) = (0.0, 0.0, 0.0);
-            for a in 1..4 {
-                let (dx, dy) = (ux[a] - ux[0], uy[a] - uy[0]);
-                exx += gx[a] * dx;
-                eyy += gy[a] * dy;
-                gxy += gy[a] * dx + gx[a] * dy;
-            }
-            (exx, eyy, gxy)
-        };
-        let shear =
-            |(exx, eyy, gxy): (f64, f64, f64)| mu * (2.0 * (exx * exx + eyy * eyy) + gxy * gxy);
-        let volume = |(exx, eyy, _): (f64, f64, f64)| {
-            let tr = exx + eyy;
-            4.0 * lam * tr * tr
-        };
-        let (mut total_x, mut total_y) = (0.0, 0.0);
-        for j in 0..self.ny {
-            let (gx, gy, weight) = &self.rows[j];
-            let (cx, cy) = &self.centres[j];
-            let (mut row_x, mut row_y) = (0.0, 0.0);
-            for cell in &self.cells[j * self.nx..(j + 1) * self.nx] {
-                let (xx, xy) = (gather(cell, &x, 0), gather(cell, &x, 1));
-                let (yx, yy) = (gather(cell, &y, 0), gather(cell, &y, 1));
-                for g in 0..4 {
-                    row_x += shear(strains(xx, xy, &gx[g], &gy[g]));
-                    row_y += shear(strains(yx, yy, &gx[g], &gy[g]));
+                if selective {
+                    row_x += volume(xx, xy, &self.centres[j]);
+                    row_y += volume(yx, yy, &self.centres[j]);
                 }
-                row_x += volume(strains(xx, xy, cx, cy));
-                row_y += volume(strains(yx, yy, cx, cy));
             }
             total_x += weight * row_x;
             total_y += weight * row_y;

@@ -77,16 +77,19 @@ pub fn element_with(
     m: Material,
     rule: Integration,
 ) -> ([[f64; 8]; 8], [[f64; 8]; 8]) {
-    if rule == Integration::Selective {
-        return selective_element(hx, hy, m);
-    }
     // Local node a at (sx[a], sy[a]) of the unit square.
     let (sx, sy) = ([0.0, 1.0, 1.0, 0.0], [0.0, 0.0, 1.0, 1.0]);
     let hat = |s: f64, at: f64| if s == 0.0 { 1.0 - at } else { at };
     let slope = |s: f64| if s == 0.0 { -1.0 } else { 1.0 };
     let (mut me, mut ke) = ([[0.0; 8]; 8], [[0.0; 8]; 8]);
     let weight = 0.25 * hx * hy;
-    let l2m = m.lambda + 2.0 * m.mu;
+    // The λ taken at the Gauss points: all of it (full), none (selective: at the centre).
+    let lambda = if rule == Integration::Full {
+        m.lambda
+    } else {
+        0.0
+    };
+    let l2m = lambda + 2.0 * m.mu;
     for xi in gauss() {
         for eta in gauss() {
             let mut n = [0.0; 4];
@@ -106,46 +109,14 @@ pub fn element_with(
                     me[2 * a + 1][2 * b + 1] += mass;
                     ke[2 * a][2 * b] += weight * (l2m * xx + m.mu * yy);
                     ke[2 * a + 1][2 * b + 1] += weight * (m.mu * xx + l2m * yy);
-                    ke[2 * a][2 * b + 1] += weight * (m.lambda * xy + m.mu * yx);
-                    ke[2 * a + 1][2 * b] += weight * (m.lambda * yx + m.mu * xy);
+                    ke[2 * a][2 * b + 1] += weight * (lambda * xy + m.mu * yx);
+                    ke[2 * a + 1][2 * b] += weight * (lambda * yx + m.mu * xy);
                 }
             }
         }
     }
-    (me, ke)
-}
-
-/// The element of [`Integration::Selective`] ([`element_with`]).
-fn selective_element(hx: f64, hy: f64, m: Material) -> ([[f64; 8]; 8], [[f64; 8]; 8]) {
-    let (sx, sy) = ([0.0, 1.0, 1.0, 0.0], [0.0, 0.0, 1.0, 1.0]);
-    let hat = |s: f64, at: f64| if s == 0.0 { 1.0 - at } else { at };
-    let slope = |s: f64| if s == 0.0 { -1.0 } else { 1.0 };
-    let (mut me, mut ke) = ([[0.0; 8]; 8], [[0.0; 8]; 8]);
-    let weight = 0.25 * hx * hy;
-    let two_mu = 2.0 * m.mu;
-    for xi in gauss() {
-        for eta in gauss() {
-            let mut n = [0.0; 4];
-            let (mut nx, mut ny) = ([0.0; 4], [0.0; 4]);
-            for a in 0..4 {
-                n[a] = hat(sx[a], xi) * hat(sy[a], eta);
-                nx[a] = slope(sx[a]) / hx * hat(sy[a], eta);
-                ny[a] = hat(sx[a], xi) * slope(sy[a]) / hy;
-            }
-            for a in 0..4 {
-                for b in 0..4 {
-                    let (nn, xx, yy) = (n[a] * n[b], nx[a] * nx[b], ny[a] * ny[b]);
-                    let (xy, yx) = (nx[a] * ny[b], ny[a] * nx[b]);
-                    let mass = weight * m.density * nn;
-                    me[2 * a][2 * b] += mass;
-                    me[2 * a + 1][2 * b + 1] += mass;
-                    ke[2 * a][2 * b] += weight * (two_mu * xx + m.mu * yy);
-                    ke[2 * a + 1][2 * b + 1] += weight * (m.mu * xx + two_mu * yy);
-                    ke[2 * a][2 * b + 1] += weight * (m.mu * yx);
-                    ke[2 * a + 1][2 * b] += weight * (m.mu * xy);
-                }
-            }
-        }
+    if rule == Integration::Full {
+        return (me, ke);
     }
     // λ div u div v at the centre, weight hx hy.
     let (mut cx, mut cy) = ([0.0; 4], [0.0; 4]);

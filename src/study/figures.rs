@@ -100,26 +100,15 @@ pub fn write_talk_figures(out: &Path, overrides: &[String]) -> Result<Vec<PathBu
         runs.push(sample_run(name, scene, sampling).map_err(run_err(name))?);
     }
     register_font()?;
-    std::fs::create_dir_all(out).map_err(|source| FigureError::Write {
-        path: out.to_path_buf(),
-        source,
-    })?;
+    create_folder(out)?;
     let mut written = Vec::new();
     for run in &runs {
-        for ext in ["png", "svg"] {
-            let path = out.join(format!("{}.{ext}", run.name));
-            write_figure(&path, &TalkFigure::Scene(run))?;
-            written.push(path);
-        }
+        written.extend(write_both(out, &run.name, &TalkFigure::Scene(run))?);
     }
     for (k, (stem, caption, _)) in TALK_FIGURES.iter().enumerate() {
         let pair = [&runs[2 * k], &runs[2 * k + 1]];
         let title = format!("Figure {}: {caption}", k + 1);
-        for ext in ["png", "svg"] {
-            let path = out.join(format!("{stem}.{ext}"));
-            write_figure(&path, &TalkFigure::Pair(&title, pair))?;
-            written.push(path);
-        }
+        written.extend(write_both(out, stem, &TalkFigure::Pair(&title, pair))?);
     }
     Ok(written)
 }
@@ -139,14 +128,24 @@ pub fn write_scene_figure(
         }
     })?;
     register_font()?;
+    create_folder(out)?;
+    write_both(out, name, &TalkFigure::Scene(&run))
+}
+
+/// `out` and its parents, made if missing.
+fn create_folder(out: &Path) -> Result<(), FigureError> {
     std::fs::create_dir_all(out).map_err(|source| FigureError::Write {
         path: out.to_path_buf(),
         source,
-    })?;
+    })
+}
+
+/// `<stem>.png` and `<stem>.svg` of `figure` in `out`; returns their paths.
+fn write_both(out: &Path, stem: &str, figure: &TalkFigure) -> Result<Vec<PathBuf>, FigureError> {
     let mut written = Vec::new();
     for ext in ["png", "svg"] {
-        let path = out.join(format!("{name}.{ext}"));
-        write_figure(&path, &TalkFigure::Scene(&run))?;
+        let path = out.join(format!("{stem}.{ext}"));
+        write_figure(&path, figure)?;
         written.push(path);
     }
     Ok(written)

@@ -27,6 +27,10 @@ pub const PLANE_OSQP_AGREEMENT_TOL: f64 = 1e-7;
 /// twice itself where the wave reflects, and the release delayed by O(ε) can double that again
 /// (the bar's `PENALTY_AGREEMENT_FACTOR`, one contact episode): `|u − u_exact| ≤ 4 ε r_max`.
 pub const PLANE_PENALTY_FACTOR: f64 = 4.0;
+/// The sparse penalty solver against the condensed one, relative to `max |z|` and `max r`:
+/// both backward-stable solves of the same law, of `C + D_A/ε` and of `S_AA + εI`, whose
+/// conditioning grows as `1/ε` (measured 1e-13 at `ε = 1e-6`, 1e-15 at `1e-3`).
+pub const SPARSE_PENALTY_AGREEMENT_TOL: f64 = 1e-11;
 
 /// Plane OSQP against exact over its a-posteriori bound: per step, two backward-stable solves of
 /// the step's active-set system differ by [`AGREEMENT_ULPS_PER_STEP`] ε relative (the bar's
@@ -257,6 +261,19 @@ pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
             "cantilever at ν = 0.4999, both rules, 80 steps",
         ),
     ];
+    let sparse = crate::scale::EPSILONS
+        .iter()
+        .map(|&e| crate::scale::sparse_penalty_agreement(e))
+        .collect::<Result<Vec<f64>, RunError>>()?
+        .into_iter()
+        .fold(0.0, f64::max);
+    let locking = locking.into_iter().chain([(
+        "SPARSE_PENALTY_AGREEMENT_TOL",
+        "tests/plane_scale.rs",
+        SPARSE_PENALTY_AGREEMENT_TOL,
+        sparse,
+        "the sparse Newton iteration against the condensed LCP on S + εI, ε = 1e-3 and 1e-6",
+    )]);
     let moving = [(
         "moving obstacle: relative |Δu|, |Δr| of the shifted run / (steps · GALILEAN_ULPS_PER_STEP ε)",
         "tests/moving_obstacles.rs",
