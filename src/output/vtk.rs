@@ -10,7 +10,9 @@
 //! node without one) and `contact_constraints` (their number: 0, 1, or 2 at a corner).
 
 use crate::output::profiles::Profiles;
-use crate::scene::{OutputFormat, OutputSampling};
+#[cfg(feature = "vtk")]
+use crate::scene::OutputFormat;
+use crate::scene::OutputSampling;
 use crate::scheme::contact::ContactSet;
 use crate::scheme::{Body, RunError, State};
 use std::path::{Path, PathBuf};
@@ -60,6 +62,7 @@ impl KeptSteps {
 
     /// Writes step `step` at time `t`: the state, and for ParaView the stress, reactions and
     /// gaps.
+    #[cfg_attr(not(feature = "vtk"), expect(unused_variables))]
     pub fn write<B: Body>(
         &mut self,
         step: usize,
@@ -71,11 +74,6 @@ impl KeptSteps {
             KeptSteps::Table { profiles, path } => profiles.write(t, state).map_err(io(path)),
             #[cfg(feature = "vtk")]
             KeptSteps::Vtu(s) => s.write(step, t, state, kept),
-            #[cfg(not(feature = "vtk"))]
-            _ => {
-                let _ = (step, kept);
-                unreachable!("no other writer without the `vtk` feature")
-            }
         }
     }
 
@@ -97,7 +95,7 @@ pub mod series {
     use crate::output::profiles::written_nodes;
     use crate::output::text::push_time;
     use crate::plane::stress::von_mises;
-    use crate::scene::OutputSampling;
+    use crate::scene::{OutputSampling, written_on_axis};
     use crate::scheme::contact::ContactSet;
     use crate::scheme::{Body, RunError, State};
     use std::io::Write;
@@ -141,13 +139,7 @@ pub mod series {
             let lattice = body.lattice();
             let stride = usize::try_from(sampling.node_stride).unwrap_or(usize::MAX);
             let nodes = written_nodes(lattice, stride);
-            let axis = |count: usize| {
-                let mut n = count.div_ceil(stride.max(1));
-                if (count - 1) % stride.max(1) != 0 {
-                    n += 1;
-                }
-                n
-            };
+            let axis = |count: usize| written_on_axis(count as u64, stride as u64) as usize;
             let written_lattice = [axis(lattice[0]), axis(lattice[1])];
             let mut written = vec![None; body.nodes()];
             let mut points = Vec::with_capacity(3 * nodes.len());

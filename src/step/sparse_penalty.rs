@@ -154,10 +154,10 @@ impl SparsePenaltySolver {
         }
         let out = &mut self.newton;
         out.copy_from_slice(rhs);
-        for k in 0..self.constraints.len() {
+        let (unknowns, signs) = (&self.constraints.unknowns, &self.constraints.directions);
+        for (k, lo) in lower.iter().enumerate() {
             if self.active[k] {
-                let (i, s) = (self.constraints.unknowns[k], self.constraints.directions[k]);
-                out[i] += s * lower[k] / self.epsilon;
+                out[unknowns[k]] += signs[k] * lo / self.epsilon;
             }
         }
         self.factor.solve_in_place(out);
