@@ -13,6 +13,10 @@
 //! set-up cost of `S` (the contact run's set-up minus the free one's) and OSQP's step over the
 //! exact one (up to 5e4 unknowns). `plane-contact/kratos-block-30x15-200-steps` is the built-in
 //! `plane-block-drop` end to end in memory, the size of a Kratos comparison run (`bench_kratos`).
+//!
+//! `plane-scale`: the resting block at 1e5 unknowns with 1000 contact normals (the exact step)
+//! and with 5000 (the penalty law's sparse Newton iteration), against its free step
+//! (`cargo bench --bench plane -- plane-scale`).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use std::time::Instant;
@@ -226,10 +230,82 @@ fn bench_kratos(c: &mut Criterion) {
     }
 }
 
+/// `(nx, ny, solver)` of the scale bench: 1e5 unknowns with 1000 contact normals (exact,
+/// condensed `S` of 8 MB), and with 5000 (the penalty law beyond the condensed switch: the
+/// sparse Newton iteration, no dense matrix).
+const SCALE_SIZES: [(u64, u64, SolverMethod); 2] = [
+    (999, 49, SolverMethod::Exact),
+    (4999, 9, SolverMethod::Penalty),
+];
+
+/// Contact at scale: the resting block's contact step at 1e5 unknowns with 1000 normals
+/// (exact) and 5000 (penalty, sparse), against the free step of the same body; prints the
+/// set-up of each run and the ratio.
+fn bench_scale(c: &mut Criterion) {
+    let mut group = c.benchmark_group("plane-scale");
+    group.sample_size(10);
+    let mut rows = Vec::new();
+    for (nx, ny, method) in SCALE_SIZES {
+        let t = Instant::now();
+        let mut free = PlaneSimulation::new(&resting(nx, ny, false)).unwrap();
+        let setup_free = t.elapsed().as_secs_f64();
+        let mut scene = resting(nx, ny, true);
+        scene.solver = SolverSpec {
+            method,
+            ..SolverSpec::default()
+        };
+        let t = Instant::now();
+        let mut sim = PlaneSimulation::new(&scene).unwrap();
+        let setup = t.elapsed().as_secs_f64();
+        let n = sim.discretisation().unknowns();
+        let m = sim.contact().len();
+        for _ in 0..20 {
+            sim.step().unwrap();
+        }
+        let id = format!("{n}-m{m}");
+        let name = format!("{}-step", sim.solver_name());
+        group.bench_function(BenchmarkId::new(name, &id), |b| {
+            b.iter(|| sim.step().unwrap())
+        });
+        group.bench_function(BenchmarkId::new("free-step", &id), |b| {
+            b.iter(|| free.step().unwrap())
+        });
+        let step = median(5, || {
+            sim.step().unwrap();
+        });
+        let unconstrained = median(5, || {
+            free.step().unwrap();
+        });
+        let active = sim.step().unwrap().contact.contact_nodes;
+        rows.push((
+            n,
+            m,
+            sim.solver_name(),
+            active,
+            step,
+            unconstrained,
+            setup,
+            setup_free,
+        ));
+    }
+    group.finish();
+    println!(
+        "\n| unknowns | m | solver | in contact | step ms | free step ms | step / free | set-up s | free set-up s |\n|---|---|---|---|---|---|---|---|---|"
+    );
+    for (n, m, solver, active, step, free, setup, setup_free) in rows {
+        println!(
+            "| {n} | {m} | {solver} | {active} | {:.3} | {:.3} | {:.2} | {setup:.2} | {setup_free:.2} |",
+            step * 1e3,
+            free * 1e3,
+            step / free
+        );
+    }
+}
+
 // No HTML plots, as in benches/step.rs (criterion's plotters backend would need a font).
 criterion_group! {
     name = benches;
     config = Criterion::default().without_plots();
-    targets = bench, bench_contact, bench_kratos
+    targets = bench, bench_contact, bench_kratos, bench_scale
 }
 criterion_main!(benches);

@@ -27,8 +27,8 @@
 //! let scene = Scene {
 //!     description: None,
 //!     bar: Bar { length: 1.0, viscosity: 0.0, matrices: Default::default(), mass: Default::default() },
-//!     left: EndSpec { condition: Condition::Signorini, gap: Some(0.1) },
-//!     right: EndSpec { condition: Condition::Free, gap: None },
+//!     left: EndSpec::new(Condition::Signorini, Some(0.1)),
+//!     right: EndSpec::new(Condition::Free, None),
 //!     initial: Initial { displacement: "0".into(), velocity: "-1".into() },
 //!     load: Default::default(),
 //!     obstacle: None,

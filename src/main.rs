@@ -34,8 +34,10 @@ enum Command {
         /// Override a scene key, e.g. --set time.step=0.001 (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
-        /// Plane scenes: also draw the deformed mesh coloured by the von Mises stress at
-        /// 6 times (plane.png, plane.svg in the output folder).
+        /// Also draw the run's figures into the output folder: for a plane scene the deformed
+        /// mesh coloured by the von Mises stress at 6 times (deformed.png, deformed.svg) and,
+        /// with Signorini edges, the contact pressure along them (contact-pressure.png, .svg);
+        /// for a bar scene u(x, t) beside the contact reactions (<scene>.png, <scene>.svg).
         #[arg(long)]
         figure: bool,
     },
@@ -325,13 +327,16 @@ fn run_any(name: &str, out: Option<PathBuf>, set: &[String], figure: bool) -> Re
     let (scene_name, any) = scene::load_any(name, set).map_err(|e| fail(e.to_string(), 2))?;
     match any {
         scene::AnyScene::Bar(bar) => {
+            let out = out.unwrap_or_else(|| PathBuf::from("out").join(&scene_name));
+            run(&scene_name, &bar, &out).map_err(|e| fail(e.to_string(), e.exit_code()))?;
             if figure {
-                return Err(fail(
-                    "--figure draws plane scenes; for a bar scene use `viscobar figures`".into(),
-                    2,
-                ));
+                let files = viscobar::study::figures::write_scene_figure(&scene_name, &bar, &out)
+                    .map_err(|e| fail(e.to_string(), e.exit_code()))?;
+                for f in &files {
+                    println!("wrote {}", f.display());
+                }
             }
-            run(&scene_name, *bar, out).map_err(|e| fail(e.to_string(), e.exit_code()))
+            Ok(())
         }
         scene::AnyScene::Plane(plane) => {
             let out = out.unwrap_or_else(|| PathBuf::from("out").join(&scene_name));
@@ -366,13 +371,12 @@ fn plane_figure(name: &str, scene: &scene::PlaneScene, out: &std::path::Path) ->
 
 fn run(
     scene_name: &str,
-    scene: viscobar::Scene,
-    out: Option<PathBuf>,
+    scene: &viscobar::Scene,
+    out: &std::path::Path,
 ) -> Result<(), viscobar::RunError> {
-    let out = out.unwrap_or_else(|| PathBuf::from("out").join(scene_name));
     let summary =
-        viscobar::output::run_to_dir(scene_name, &scene, &out, std::io::stderr().is_terminal())?;
-    report(&summary, &out);
+        viscobar::output::run_to_dir(scene_name, scene, out, std::io::stderr().is_terminal())?;
+    report(&summary, out);
     Ok(())
 }
 

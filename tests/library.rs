@@ -2,7 +2,7 @@
 //! by every public constructor, which returns the error a scene file would give.
 
 use viscobar::bar::Discretisation;
-use viscobar::scene::builtin_text;
+use viscobar::scene::{Condition, EndSpec, builtin_text};
 use viscobar::{RunError, Scene, SceneError, Simulation};
 
 fn impact() -> Scene {
@@ -39,7 +39,9 @@ fn bad_fields_built_in_code_are_named() {
         ("time.step", |s| s.time.step = -0.01),
         ("bar.viscosity", |s| s.bar.viscosity = f64::NAN),
         ("bar.length", |s| s.bar.length = 0.0),
-        ("left.gap", |s| s.left.gap = Some(f64::INFINITY)),
+        ("left.gap", |s| {
+            s.left = EndSpec::new(Condition::Signorini, Some(f64::INFINITY))
+        }),
     ];
     for (field, spoil) in cases {
         let mut scene = impact();

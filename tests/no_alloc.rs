@@ -39,8 +39,14 @@ static GLOBAL: Counting = Counting;
 
 #[test]
 fn steps_do_not_allocate() {
-    for name in viscobar::scene::builtin_names() {
-        let (_, scene) = viscobar::scene::load(name, &[]).unwrap();
+    // The built-in scenes, and `impact` with its obstacle approaching (moving gaps).
+    let moving = ["left.gap=\"0.1 - 0.5*t\"".to_string()];
+    let runs = (viscobar::scene::builtin_names()
+        .into_iter()
+        .map(|n| (n, &[][..])))
+    .chain([("impact", &moving[..])]);
+    for (name, overrides) in runs {
+        let (_, scene) = viscobar::scene::load(name, overrides).unwrap();
         let mut sim = viscobar::Simulation::new(&scene).unwrap();
         sim.step().unwrap(); // warm-up outside the count
         let before = allocations();
@@ -68,6 +74,17 @@ fn plane_steps_do_not_allocate() {
         };
         scenes.push((name.to_string(), *scene));
     }
+    // A floor rising into the block (a moving obstacle: its gaps evaluated every step).
+    let AnyScene::Plane(rising) = load_any(
+        "plane-tilted-drop",
+        &["edges.bottom.gap=\"0.05 - 0.3*t\"".into()],
+    )
+    .unwrap()
+    .1
+    else {
+        panic!("a plane scene");
+    };
+    scenes.push(("rising floor".into(), *rising));
     scenes.push((
         "manufactured".into(),
         viscobar::plane::closed_form::Manufactured::default().scene(8, 4, 2.0, 0.125, 20.0),

@@ -16,13 +16,16 @@
 
 pub mod agreement;
 pub mod bench_table;
+pub mod locking;
 pub mod mass_study;
+pub mod moving;
 pub mod oracle;
 pub mod peak_memory;
 pub mod plane_checks;
 pub mod plane_contact;
 pub mod plane_symmetry;
 pub mod roundoff;
+pub mod scale;
 pub mod stiff;
 pub mod stiff_runs;
 pub mod timings;

@@ -147,10 +147,11 @@ pub fn plane_of_bar(bar: &Scene, height: f64, ny: u64, y_grading: f64) -> Option
             mu: 0.5,
             density: 1.0,
             viscosity: bar.bar.viscosity,
+            integration: Default::default(),
         },
         edges: Edges {
-            left: edge(bar.left.condition, bar.left.gap, true)?,
-            right: edge(bar.right.condition, bar.right.gap, false)?,
+            left: edge(bar.left.condition, bar.left.constant_gap(), true)?,
+            right: edge(bar.right.condition, bar.right.constant_gap(), false)?,
             bottom: EdgeSpec::default(),
             top: EdgeSpec::default(),
         },

@@ -62,6 +62,14 @@ pub fn sections() -> Result<Vec<Section>, viscobar::study::converge::ConvergeErr
             id: "plane-contact",
             markdown: crate::plane_contact::markdown()?,
         },
+        Section {
+            id: "locking",
+            markdown: crate::locking::markdown()?,
+        },
+        Section {
+            id: "moving",
+            markdown: crate::moving::markdown()?,
+        },
     ])
 }
 

@@ -179,7 +179,7 @@ pub fn closed_form(scene: &Scene) -> closed_form::ViscousContact {
         closed_form::ViscousContact {
             length: scene.bar.length,
             alpha: scene.bar.viscosity,
-            gap: scene.left.gap.expect("Signorini left end"),
+            gap: scene.left.constant_gap().expect("Signorini left end"),
             t1,
             t2,
             pulse: closed_form::VISCOUS_CONTACT_PULSE,

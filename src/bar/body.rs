@@ -290,7 +290,7 @@ fn setup(
         v
     };
     let (displacement, velocity) = (restrict(u0_full), restrict(v0_full));
-    let contact = contact_set(&disc);
+    let contact = contact_set(&disc).with_motion(disc.motion.clone());
     let body = BarBody {
         uniform: disc.mass.uniform().zip(disc.stiffness.uniform()),
         inv_dt2: 1.0 / (dt * dt),

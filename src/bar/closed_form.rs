@@ -506,7 +506,7 @@ pub fn for_scene(name: &str, scene: &Scene) -> Option<Box<dyn ClosedForm>> {
         }),
         "impact" if ends == (Signorini, Free) && elastic && velocity0 < 0.0 => Box::new(Impact {
             length: scene.bar.length,
-            gap: scene.left.gap?,
+            gap: scene.left.constant_gap()?,
             speed: -velocity0,
         }),
         "clamped-impact"
@@ -514,7 +514,7 @@ pub fn for_scene(name: &str, scene: &Scene) -> Option<Box<dyn ClosedForm>> {
                 && elastic
                 && velocity0 == 0.0
                 && scene.bar.length == 1.0
-                && scene.left.gap == Some(0.0) =>
+                && scene.left.constant_gap() == Some(0.0) =>
         {
             Box::new(ClampedImpact)
         }
@@ -547,14 +547,18 @@ pub fn for_scene(name: &str, scene: &Scene) -> Option<Box<dyn ClosedForm>> {
                 return None;
             }
             let gravity = -load.eval(0.0, 0.0).ok()?;
-            Box::new(FallingBar::new(scene.bar.length, gravity, scene.left.gap?)?)
+            Box::new(FallingBar::new(
+                scene.bar.length,
+                gravity,
+                scene.left.constant_gap()?,
+            )?)
         }
         "viscous-contact" if ends == (Signorini, Free) && scene.bar.viscosity > 0.0 => {
             let [t1, t2] = VISCOUS_CONTACT_WINDOW;
             let vc = ViscousContact {
                 length: scene.bar.length,
                 alpha: scene.bar.viscosity,
-                gap: scene.left.gap?,
+                gap: scene.left.constant_gap()?,
                 t1,
                 t2,
                 pulse: VISCOUS_CONTACT_PULSE,

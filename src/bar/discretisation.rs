@@ -8,6 +8,7 @@ use crate::scene::SceneError;
 use crate::scene::expr::Expression;
 use crate::scene::nodal::{BLOCK, block_pool, eval_block};
 use crate::scene::{Condition, Scene, Side};
+use crate::scheme::contact::{GapMotion, MovingGap};
 
 /// A constrained node: `u[node] >= -gap`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,6 +46,43 @@ pub struct Discretisation {
     pub stiffness: SymTridiag,
     pub step_matrix: SymTridiag,
     pub constraints: Vec<Constraint>,
+    /// The Signorini ends whose obstacle moves (a gap `a(t)` that depends on `t`): the
+    /// constraints' gaps at every step (`constraints` hold them at `t = 0`); `None` when none
+    /// moves.
+    pub motion: Option<GapMotion>,
+}
+
+/// The moving end obstacles of `scene` on its `constraints`: a Signorini end whose `a(t)`
+/// depends on `t` moves its constraint's gap to `min(a(t), g)`, `g` the obstacle's gap at the
+/// end node under an obstacle (its constraint's gap at `t = 0` is that bound's too).
+fn end_motion(scene: &Scene, constraints: &[Constraint]) -> Option<GapMotion> {
+    let obstacle = scene
+        .obstacle
+        .as_ref()
+        .and_then(|o| o.gap.expression("obstacle.gap").ok());
+    let mut laws = Vec::new();
+    let mut moving = Vec::new();
+    for (side, a) in scene.moving_ends() {
+        if !a.depends_on_t() {
+            continue;
+        }
+        let Some(k) = constraints.iter().position(|c| c.side == Some(side)) else {
+            continue;
+        };
+        let x = constraints[k].node as f64 * scene.dx();
+        let cap = obstacle
+            .as_ref()
+            .and_then(|g| g.eval(x, 0.0).ok())
+            .unwrap_or(f64::INFINITY);
+        moving.push(MovingGap {
+            constraint: k,
+            law: laws.len(),
+            s: 0.0,
+            cap,
+        });
+        laws.push(a);
+    }
+    GapMotion::new(laws, moving)
 }
 
 impl Discretisation {
@@ -121,6 +159,7 @@ impl Discretisation {
                     .collect::<Result<Vec<_>, SceneError>>()?
             }
         };
+        let motion = end_motion(scene, &constraints);
         Ok(Self {
             nodes,
             dx,
@@ -134,6 +173,7 @@ impl Discretisation {
             stiffness,
             step_matrix,
             constraints,
+            motion,
         })
     }
 

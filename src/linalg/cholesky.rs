@@ -33,6 +33,8 @@ pub struct SparseCholesky {
     values: Vec<f64>,
     /// Work space of a solve, kept for the run.
     solve_buffer: MemBuffer,
+    /// Work space of [`SparseCholesky::refactor`], made on its first call.
+    factor_buffer: Option<MemBuffer>,
     n: usize,
 }
 
@@ -56,6 +58,7 @@ impl SparseCholesky {
             symbolic,
             values,
             solve_buffer,
+            factor_buffer: None,
             n: pattern.n,
         };
         this.factor(pattern, a, matrix)?;
@@ -81,11 +84,41 @@ impl SparseCholesky {
         a: &[f64],
         matrix: &'static str,
     ) -> Result<(), FactorError> {
+        let mut buffer = MemBuffer::new(self.factor_scratch());
+        self.factor_with(pattern, a, matrix, &mut buffer)
+    }
+
+    /// [`SparseCholesky::factor`] with its work space kept (made on the first call): a matrix
+    /// that changes from step to step (the sparse penalty solver's `C + D/ε`) is refactorised
+    /// without allocating; the symbolic analysis is the pattern's, made once.
+    pub fn refactor(
+        &mut self,
+        pattern: &Pattern,
+        a: &[f64],
+        matrix: &'static str,
+    ) -> Result<(), FactorError> {
+        let mut buffer = match self.factor_buffer.take() {
+            Some(b) => b,
+            None => MemBuffer::new(self.factor_scratch()),
+        };
+        let result = self.factor_with(pattern, a, matrix, &mut buffer);
+        self.factor_buffer = Some(buffer);
+        result
+    }
+
+    fn factor_scratch(&self) -> faer::dyn_stack::StackReq {
+        self.symbolic
+            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+    }
+
+    fn factor_with(
+        &mut self,
+        pattern: &Pattern,
+        a: &[f64],
+        matrix: &'static str,
+        buffer: &mut MemBuffer,
+    ) -> Result<(), FactorError> {
         let a = SparseColMatRef::new(Self::structure(pattern), a);
-        let mut buffer = MemBuffer::new(
-            self.symbolic
-                .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
-        );
         self.symbolic
             .factorize_numeric_llt(
                 &mut self.values,
@@ -93,7 +126,7 @@ impl SparseCholesky {
                 Side::Lower,
                 LltRegularization::default(),
                 Par::Seq,
-                MemStack::new(&mut buffer),
+                MemStack::new(buffer),
                 Default::default(),
             )
             .map_err(|e| match e {

@@ -22,6 +22,11 @@ pub fn write_whole<T, E>(
         std::fs::create_dir_all(&tmp).map_err(|e| write_err(tmp.clone(), e))?;
         let outcome = write(&tmp).and_then(|value| {
             for file in files {
+                // A folder of files (ParaView's `vtu/`) replaces the one of an earlier run.
+                if tmp.join(file).is_dir() && out.join(file).is_dir() {
+                    std::fs::remove_dir_all(out.join(file))
+                        .map_err(|e| write_err(out.join(file), e))?;
+                }
                 std::fs::rename(tmp.join(file), out.join(file))
                     .map_err(|e| write_err(out.join(file), e))?;
             }

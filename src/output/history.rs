@@ -2,6 +2,8 @@
 //! terms (empty on steps whose identity was not measured), then per group of constraints its
 //! contact state (a single constraint: `gap_G,reaction_G`; a set: the constraints in contact,
 //! the extent `s` of the contact, the least gap and the total reaction), then the iterations.
+//! A run whose obstacles move has one more energy column, `obstacle_work`, after
+//! `identity_residual`.
 
 use crate::output::text::{push_time, push_value};
 use crate::scheme::StepRecord;
@@ -12,9 +14,15 @@ use std::io::Write;
 const ENERGY_COLUMNS: &str =
     "step,t,energy,work,viscous_dissipation,contact_dissipation,identity_residual";
 
-/// The header line for a run with the contact `groups`.
-pub fn header(groups: &[Group]) -> String {
+/// The column of a run whose obstacles move.
+const OBSTACLE_COLUMN: &str = ",obstacle_work";
+
+/// The header line for a run with the contact `groups`, and `obstacle_work` when `moving`.
+pub fn header(groups: &[Group], moving: bool) -> String {
     let mut h = String::from(ENERGY_COLUMNS);
+    if moving {
+        h.push_str(OBSTACLE_COLUMN);
+    }
     for g in groups {
         let n = g.name;
         if g.range.len() == 1 {
@@ -29,8 +37,8 @@ pub fn header(groups: &[Group]) -> String {
     h
 }
 
-/// Appends the row of `r` (`row` is cleared first); `groups` as in the header.
-pub fn row(r: &StepRecord, groups: &[Group], row: &mut Vec<u8>) {
+/// Appends the row of `r` (`row` is cleared first); `groups` and `moving` as in the header.
+pub fn row(r: &StepRecord, groups: &[Group], moving: bool, row: &mut Vec<u8>) {
     row.clear();
     write!(row, "{},", r.step).expect("writing to a vector");
     push_time(r.time, row);
@@ -45,6 +53,12 @@ pub fn row(r: &StepRecord, groups: &[Group], row: &mut Vec<u8>) {
         // Not measured ([output] diagnostics_every): empty cells, not zeros.
         if r.measured {
             push_value(v, row);
+        }
+    }
+    if moving {
+        row.push(b',');
+        if r.measured {
+            push_value(r.obstacle_work, row);
         }
     }
     for (g, s) in groups.iter().zip(&r.contact.groups) {

@@ -1,7 +1,7 @@
 //! A run's outputs, through the same code for both bodies: `summary.json` ([`summary`]),
 //! `history.csv` ([`history`]) and the profile file ([`profiles`], `displacement.csv` or
-//! `displacement.npy`), the text of their numbers ([`text`]), written whole or not at all
-//! ([`files`]) by the run loop ([`run`]).
+//! `displacement.npy`) or the ParaView files ([`vtk`]), the text of their numbers ([`text`]),
+//! written whole or not at all ([`files`]) by the run loop ([`run`]).
 //!
 //! Imports every layer below it.
 
@@ -13,6 +13,7 @@ pub mod profiles;
 pub mod run;
 pub mod summary;
 pub mod text;
+pub mod vtk;
 
 pub use run::{run_in_memory, run_plane_in_memory, run_plane_to_dir, run_to_dir};
 pub use summary::{ContactEpisode, Summary, Tracker};

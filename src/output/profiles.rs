@@ -107,6 +107,13 @@ impl Profiles {
                     Writer::Plane(ProfileNpy::new(file, cols, sampling.rows)?, points)
                 }
             }
+            OutputFormat::Vtu => {
+                let _ = rounded;
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::Unsupported,
+                    "output.format = \"vtu\" is written by crate::output::vtk, not as a table",
+                ));
+            }
             #[cfg(not(feature = "npy"))]
             OutputFormat::Npy => {
                 let _ = rounded;

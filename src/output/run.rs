@@ -5,8 +5,8 @@
 use crate::bar::Simulation;
 use crate::output::files::write_whole;
 use crate::output::history;
-use crate::output::profiles::Profiles;
 use crate::output::summary::{Summary, Tracker};
+use crate::output::vtk::{Kept, KeptSteps};
 use crate::plane::PlaneSimulation;
 use crate::scene::plane::PlaneScene;
 use crate::scene::{OutputFormat, OutputSampling, OutputSpec, Scene};
@@ -114,14 +114,18 @@ impl Run<'_> {
         out: &Path,
     ) -> Result<Summary, RunError> {
         let format = self.sampling.format;
-        let files = ["history.csv", format.file(), "summary.json"];
+        let mut files = vec!["history.csv", format.file(), "summary.json"];
+        files.extend(format.folder());
         let io = |path: PathBuf, source| RunError::Write { path, source };
         let summary = write_whole(out, &files, io, |tmp| {
             self.write_files(prepared, start, tmp)
         })?;
-        for other in [OutputFormat::Csv, OutputFormat::Npy] {
+        for other in [OutputFormat::Csv, OutputFormat::Npy, OutputFormat::Vtu] {
             if other != format {
                 let _ = std::fs::remove_file(out.join(other.file()));
+                if let Some(folder) = other.folder() {
+                    let _ = std::fs::remove_dir_all(out.join(folder));
+                }
             }
         }
         Ok(summary)
@@ -141,41 +145,43 @@ impl Run<'_> {
         let hist_path = dir.join("history.csv");
         let mut hist = std::io::BufWriter::with_capacity(1 << 16, create(&hist_path)?);
         let groups = prepared.contact().groups().to_vec();
-        hist.write_all(history::header(&groups).as_bytes())
+        let moving = prepared.contact().is_moving();
+        hist.write_all(history::header(&groups, moving).as_bytes())
             .map_err(io(&hist_path))?;
-        // `t = 0` is written before the start-up step moves `u^0` on.
-        let disp_path = dir.join(self.sampling.file);
-        let mut disp = Profiles::new(create(&disp_path)?, prepared.body(), &self.sampling)
-            .map_err(io(&disp_path))?;
-        disp.write(0.0, prepared.state()).map_err(io(&disp_path))?;
+        // `t = 0` is written before the start-up step moves `u^0` on (no reactions yet).
+        let (body, contact) = (prepared.body(), prepared.contact());
+        let mut disp = KeptSteps::new(dir, body, contact, &self.sampling)?;
+        let rest = vec![0.0; contact.len()];
+        disp.write(0, 0.0, prepared.state(), (body, contact, &rest))?;
         let mut sim = prepared.start()?;
         let mut tracker = Tracker::new(&sim, !sim.is_forced());
         let mut row = Vec::new();
         let mut write_row = |hist: &mut std::io::BufWriter<std::fs::File>, r: &StepRecord| {
-            history::row(r, &groups, &mut row);
+            history::row(r, &groups, moving, &mut row);
             hist.write_all(&row)
         };
         write_row(&mut hist, &sim.first_record()).map_err(io(&hist_path))?;
         let (steps, every) = (self.steps, self.output.every as usize);
         let keep = |n: usize| n.is_multiple_of(every) || n == steps;
         let bar = Progress::new(self.progress, steps, sim.body().unknowns());
+        fn kept<B: Body>(sim: &Scheme<B>) -> Kept<'_, B> {
+            (sim.body(), sim.contact(), sim.reactions())
+        }
         if keep(1) {
-            disp.write(sim.time(), sim.state())
-                .map_err(io(&disp_path))?;
+            disp.write(1, sim.time(), sim.state(), kept(&sim))?;
         }
         for _ in 1..steps {
             let r = sim.step()?;
             tracker.observe(&r);
             write_row(&mut hist, &r).map_err(io(&hist_path))?;
             if keep(r.step) {
-                disp.write(sim.time(), sim.state())
-                    .map_err(io(&disp_path))?;
+                disp.write(r.step, sim.time(), sim.state(), kept(&sim))?;
             }
             bar.step(r.step);
         }
         bar.finish();
         hist.flush().map_err(io(&hist_path))?;
-        disp.finish().map_err(io(&disp_path))?;
+        disp.finish()?;
         let mut summary = tracker.finish(self.name, &sim, start.elapsed().as_secs_f64());
         summary.output = Some(self.sampling);
         let json_path = dir.join("summary.json");

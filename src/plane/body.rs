@@ -9,16 +9,18 @@ use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::sparse::Pattern;
 use crate::linalg::system::SparseSystem;
 use crate::plane::energy::{StrainForms, measure};
-use crate::plane::matrices::{Material, assemble};
+use crate::plane::matrices::{Material, assemble, assemble_with};
 use crate::plane::mesh::Grid;
-use crate::plane::normals::{Normal, normals};
+use crate::plane::normals::{Normal, edge_motion, normals};
+use crate::plane::stress;
 use crate::scene::SolverMethod;
 use crate::scene::expr::Expression;
+use crate::scene::plane::PENALTY_CONDENSED_MAX_NORMALS;
 use crate::scene::plane::{EDGE_NAMES, PlaneScene};
 use crate::scheme::body::{Body, EnergySums, FullMassRows};
 use crate::scheme::contact::{ContactSet, Group, Positions};
 use crate::scheme::{Load, RunError, Scheme, Setup, Unstarted};
-use crate::step::{CondensedSolver, OsqpSolver, StepSolver};
+use crate::step::{CondensedSolver, OsqpSolver, SparsePenaltySolver, StepSolver};
 
 /// A run of a plane scene: the scheme stepping the plane body.
 pub type PlaneSimulation = Scheme<PlaneBody>;
@@ -57,7 +59,8 @@ impl PlaneDiscretisation {
             mu: scene.plane.mu,
             density: scene.plane.density,
         };
-        let full = assemble(&grid, material);
+        let rule = scene.plane.integration;
+        let full = assemble_with(&grid, material, rule);
         let [left, right, bottom, top] = scene.edges.clamped();
         let mut index = vec![None; grid.dofs()];
         let mut free = Vec::new();
@@ -77,7 +80,7 @@ impl PlaneDiscretisation {
         let (pattern, from) = full.pattern.restrict(&index);
         let mass = from.iter().map(|&k| full.mass[k]).collect();
         let stiffness = from.iter().map(|&k| full.stiffness[k]).collect();
-        let forms = StrainForms::new(&grid, material, &index);
+        let forms = StrainForms::with_rule(&grid, material, &index, rule);
         Self {
             forms,
             grid,
@@ -245,6 +248,16 @@ impl Body for PlaneBody {
     fn unknown_of(&self, dof: usize) -> Option<usize> {
         self.disc.index[dof]
     }
+
+    /// [`crate::plane::stress`]: the cell-centre stresses, averaged at the nodes.
+    fn nodal_stress(&self, u: &[f64], v: &[f64]) -> Option<Vec<[f64; 4]>> {
+        let d = &self.disc;
+        let (mut uf, mut vf) = (vec![0.0; d.grid.dofs()], vec![0.0; d.grid.dofs()]);
+        self.scatter_into(u, 1.0, &mut uf);
+        self.scatter_into(v, 1.0, &mut vf);
+        let cells = stress::cell_stress(&d.grid, d.material, d.alpha, &uf, &vf);
+        Some(stress::nodal_stress(&d.grid, &cells))
+    }
 }
 
 /// The contact set of the Signorini edges' normals: `u·n <= g` at each, `n = σ e_c`, is the
@@ -296,7 +309,7 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
         }
     }
     let normals = normals(&disc.grid, &disc.index, &gaps, &u0_full)?;
-    let contact = contact_set(&normals);
+    let contact = contact_set(&normals).with_motion(edge_motion(&gaps, &normals));
     let restrict = |v: &[f64]| disc.free.iter().map(|&d| v[d]).collect::<Vec<f64>>();
     let (displacement, velocity) = (restrict(&u0_full), restrict(&v0_full));
     let c = disc.step_matrix();
@@ -306,7 +319,11 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
         SolverMethod::Exact => Box::new(CondensedSolver::new(system()?, constraints, 0.0)?),
         SolverMethod::Penalty => {
             let epsilon = scene.solver.penalty_settings().epsilon;
-            Box::new(CondensedSolver::new(system()?, constraints, epsilon)?)
+            if constraints.len() as u64 <= PENALTY_CONDENSED_MAX_NORMALS {
+                Box::new(CondensedSolver::new(system()?, constraints, epsilon)?)
+            } else {
+                Box::new(SparsePenaltySolver::new(system()?, constraints, epsilon)?)
+            }
         }
         SolverMethod::Osqp => Box::new(OsqpSolver::with_system(
             system()?,

@@ -186,6 +186,7 @@ impl Manufactured {
                 mu: self.mu,
                 density: self.density,
                 viscosity: self.viscosity,
+                integration: Default::default(),
             },
             edges: Edges {
                 left: clamped.clone(),

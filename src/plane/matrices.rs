@@ -5,12 +5,15 @@
 //! ```
 //!
 //! assembled cell by cell with 2 × 2 Gauss points, exact for both on rectangles (the mass
-//! integrand is bi-quadratic, the stiffness one at most bi-quadratic). Both share one
-//! symmetric CSR pattern (the 3 × 3 node stencil, two components per node); the clamped
+//! integrand is bi-quadratic, the stiffness one at most bi-quadratic). With selective reduced
+//! integration ([`Integration::Selective`]) the `λ` term is taken at the cell centre (one
+//! point), the `2μ ε:ε` term still at 2 × 2: no volumetric locking as `λ/μ → ∞`. Both share
+//! one symmetric CSR pattern (the 3 × 3 node stencil, two components per node); the clamped
 //! degrees of freedom are then removed ([`Pattern::restrict`]).
 
 use crate::linalg::sparse::Pattern;
 use crate::plane::mesh::Grid;
+pub use crate::scene::plane::Integration;
 
 /// The material: Lamé coefficients and density.
 #[derive(Clone, Copy, Debug)]
@@ -60,15 +63,33 @@ fn gauss() -> [f64; 2] {
 }
 
 /// The 8 × 8 element mass and stiffness of a `hx × hy` cell, local nodes in the order of
-/// [`Grid::cell_nodes`], local dofs `2a + c`.
+/// [`Grid::cell_nodes`], local dofs `2a + c` (full integration).
 pub fn element(hx: f64, hy: f64, m: Material) -> ([[f64; 8]; 8], [[f64; 8]; 8]) {
+    element_with(hx, hy, m, Integration::Full)
+}
+
+/// [`element`] with the stiffness integrated by `rule`: `Full`, every term at 2 × 2 Gauss
+/// points; `Selective`, the `λ div u div v` term at the centre (weight `hx hy`), the
+/// `2μ ε(u):ε(v)` term at 2 × 2.
+pub fn element_with(
+    hx: f64,
+    hy: f64,
+    m: Material,
+    rule: Integration,
+) -> ([[f64; 8]; 8], [[f64; 8]; 8]) {
     // Local node a at (sx[a], sy[a]) of the unit square.
     let (sx, sy) = ([0.0, 1.0, 1.0, 0.0], [0.0, 0.0, 1.0, 1.0]);
     let hat = |s: f64, at: f64| if s == 0.0 { 1.0 - at } else { at };
     let slope = |s: f64| if s == 0.0 { -1.0 } else { 1.0 };
     let (mut me, mut ke) = ([[0.0; 8]; 8], [[0.0; 8]; 8]);
     let weight = 0.25 * hx * hy;
-    let l2m = m.lambda + 2.0 * m.mu;
+    // The λ taken at the Gauss points: all of it (full), none (selective: at the centre).
+    let lambda = if rule == Integration::Full {
+        m.lambda
+    } else {
+        0.0
+    };
+    let l2m = lambda + 2.0 * m.mu;
     for xi in gauss() {
         for eta in gauss() {
             let mut n = [0.0; 4];
@@ -88,22 +109,47 @@ pub fn element(hx: f64, hy: f64, m: Material) -> ([[f64; 8]; 8], [[f64; 8]; 8]) 
                     me[2 * a + 1][2 * b + 1] += mass;
                     ke[2 * a][2 * b] += weight * (l2m * xx + m.mu * yy);
                     ke[2 * a + 1][2 * b + 1] += weight * (m.mu * xx + l2m * yy);
-                    ke[2 * a][2 * b + 1] += weight * (m.lambda * xy + m.mu * yx);
-                    ke[2 * a + 1][2 * b] += weight * (m.lambda * yx + m.mu * xy);
+                    ke[2 * a][2 * b + 1] += weight * (lambda * xy + m.mu * yx);
+                    ke[2 * a + 1][2 * b] += weight * (lambda * yx + m.mu * xy);
                 }
             }
+        }
+    }
+    if rule == Integration::Full {
+        return (me, ke);
+    }
+    // λ div u div v at the centre, weight hx hy.
+    let (mut cx, mut cy) = ([0.0; 4], [0.0; 4]);
+    for a in 0..4 {
+        cx[a] = slope(sx[a]) / hx * 0.5;
+        cy[a] = 0.5 * slope(sy[a]) / hy;
+    }
+    let centre = hx * hy * m.lambda;
+    for a in 0..4 {
+        for b in 0..4 {
+            let (xx, yy) = (cx[a] * cx[b], cy[a] * cy[b]);
+            let (xy, yx) = (cx[a] * cy[b], cy[a] * cx[b]);
+            ke[2 * a][2 * b] += centre * xx;
+            ke[2 * a + 1][2 * b + 1] += centre * yy;
+            ke[2 * a][2 * b + 1] += centre * xy;
+            ke[2 * a + 1][2 * b] += centre * yx;
         }
     }
     (me, ke)
 }
 
-/// Assembles `M` and `K` on all degrees of freedom.
+/// Assembles `M` and `K` on all degrees of freedom (full integration).
 pub fn assemble(grid: &Grid, material: Material) -> Matrices {
+    assemble_with(grid, material, Integration::Full)
+}
+
+/// Assembles `M` and `K` on all degrees of freedom, `K` integrated by `rule`.
+pub fn assemble_with(grid: &Grid, material: Material, rule: Integration) -> Matrices {
     let pattern = stencil(grid);
     let mut mass = vec![0.0; pattern.nnz()];
     let mut stiffness = vec![0.0; pattern.nnz()];
     for j in 0..grid.ny {
-        let (me, ke) = element(grid.hx, grid.hy(j), material);
+        let (me, ke) = element_with(grid.hx, grid.hy(j), material, rule);
         for i in 0..grid.nx {
             let nodes = grid.cell_nodes(i, j);
             for (a, &na) in nodes.iter().enumerate() {

@@ -16,5 +16,6 @@ pub mod energy;
 pub mod matrices;
 pub mod mesh;
 pub mod normals;
+pub mod stress;
 
 pub use body::{PlaneBody, PlaneDiscretisation, PlaneSimulation};

@@ -5,6 +5,7 @@ use crate::plane::mesh::Grid;
 use crate::scene::SceneError;
 use crate::scene::expr::Expression;
 use crate::scene::plane::EDGE_NAMES;
+use crate::scheme::contact::{GapMotion, MovingGap};
 
 /// One contact normal.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -65,11 +66,13 @@ pub fn normals(
             };
             let un = sign * u0_full[2 * node + c];
             if un > gap {
+                // `+ 0.0`: a zero component times σ = −1 is −0, printed "-0".
                 return Err(SceneError::Invalid {
                     field: "initial.displacement".into(),
-                    value: format!("u·n = {un} at node {node} (s = {s})"),
+                    value: format!("u·n = {} at node {node} (s = {s})", un + 0.0),
                     allowed: format!(
-                        "the initial state must be admissible: u·n <= {gap} (`{field}`)"
+                        "the initial state must be admissible: u·n <= {} (`{field}` at t = 0)",
+                        gap + 0.0
                     ),
                 });
             }
@@ -95,4 +98,29 @@ pub fn normals(
         }
     }
     Ok(out)
+}
+
+/// The moving obstacles of the edges whose gap depends on `t`: normal `k` of such an edge
+/// (in the order of [`normals`], which is the contact set's) gets `g(s_k, t)` at each step.
+/// `None` when no edge's obstacle moves.
+pub fn edge_motion(gaps: &[Option<Expression>; 4], normals: &[Normal]) -> Option<GapMotion> {
+    let mut laws = Vec::new();
+    let mut law_of_edge = [None; 4];
+    for (edge, g) in gaps.iter().enumerate() {
+        if let Some(g) = g.as_ref().filter(|g| g.depends_on_t()) {
+            law_of_edge[edge] = Some(laws.len());
+            laws.push(g.clone());
+        }
+    }
+    let moving = (normals.iter().enumerate())
+        .filter_map(|(k, nk)| {
+            Some(MovingGap {
+                constraint: k,
+                law: law_of_edge[nk.edge]?,
+                s: nk.s,
+                cap: f64::INFINITY,
+            })
+        })
+        .collect();
+    GapMotion::new(laws, moving)
 }

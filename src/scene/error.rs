@@ -36,6 +36,14 @@ pub enum SceneError {
         t: f64,
         value: f64,
     },
+    #[error("`{field}` = \"{text}\" evaluates to {value} at s = {s}, t = {t}")]
+    NonFiniteEdge {
+        field: String,
+        text: String,
+        s: f64,
+        t: f64,
+        value: f64,
+    },
     #[error("`{field}` = \"{text}\" evaluates to {value} at x = {x}, y = {y}, t = {t}")]
     NonFinitePlane {
         field: String,

@@ -8,7 +8,7 @@
 
 use crate::scene::SceneError;
 
-/// A parsed expression `f(x, t)`.
+/// A parsed expression `f(x, y, t)` (an edge's gap: `f(s, t)`).
 #[derive(Clone, Debug)]
 pub struct Expression {
     pub(super) text: String,
@@ -17,6 +17,8 @@ pub struct Expression {
     pub(super) uses_x: bool,
     pub(super) uses_y: bool,
     pub(super) uses_t: bool,
+    /// An edge's gap: `x` is the edge's coordinate `s` (named so in errors).
+    pub(super) edge: bool,
 }
 
 #[derive(Clone, Debug)]
@@ -267,6 +269,7 @@ impl Expression {
             // Parts come from separating a bar load, which never reads `y`.
             uses_y: false,
             uses_t,
+            edge: false,
         }
     }
 
@@ -300,6 +303,14 @@ impl Expression {
         let v = self.root.eval(x, 0.0, t);
         if v.is_finite() {
             Ok(v)
+        } else if self.edge {
+            Err(SceneError::NonFiniteEdge {
+                field: self.field.clone(),
+                text: self.text.clone(),
+                s: x,
+                t,
+                value: v,
+            })
         } else {
             Err(SceneError::NonFinite {
                 field: self.field.clone(),

@@ -38,6 +38,9 @@ pub enum OutputFormat {
     Csv,
     /// `displacement.npy`: a structured array `t, x, u, v` of `<f8` (cargo feature `npy`).
     Npy,
+    /// ParaView: `solution.pvd`, a collection of one `vtu/step-N.vtu` per kept step (plane
+    /// scenes; cargo feature `vtk`, on by default).
+    Vtu,
 }
 
 impl OutputFormat {
@@ -50,7 +53,22 @@ impl OutputFormat {
         match self {
             OutputFormat::Csv => "displacement.csv",
             OutputFormat::Npy => "displacement.npy",
+            OutputFormat::Vtu => "solution.pvd",
         }
+    }
+
+    /// `csv`, `npy` or `vtu`, as in the scene.
+    pub fn name(self) -> &'static str {
+        match self {
+            OutputFormat::Csv => "csv",
+            OutputFormat::Npy => "npy",
+            OutputFormat::Vtu => "vtu",
+        }
+    }
+
+    /// The folder a format writes beside its file (`vtu/` of [`OutputFormat::Vtu`]).
+    pub fn folder(self) -> Option<&'static str> {
+        (self == OutputFormat::Vtu).then_some("vtu")
     }
 
     /// Refuses `npy` in a build without the `npy` feature, naming `output.format`.
@@ -61,6 +79,15 @@ impl OutputFormat {
                 value: "\"npy\"".into(),
                 allowed: "this build has no npy writer: build with the cargo feature `npy` \
                           (`cargo run --release --features npy -- run ...`), or use \"csv\""
+                    .into(),
+            });
+        }
+        if self == OutputFormat::Vtu && !cfg!(feature = "vtk") {
+            return Err(SceneError::Invalid {
+                field: "output.format".into(),
+                value: "\"vtu\"".into(),
+                allowed: "this build has no VTK writer: build with the cargo feature `vtk` (on \
+                          by default), or use \"csv\""
                     .into(),
             });
         }

@@ -2,8 +2,8 @@
 //! from text to the expression tree. The grammar (numbers, `x`, `y`, `t`, constants, `+ - * /`
 //! left-associative, `^` right-associative and tighter than unary minus, comparisons loosest,
 //! `if`, `step`, the one- and several-argument functions) is README.md's "Expressions" table.
-//! Spaces are ignored; nesting is bounded by `MAX_DEPTH`. A parse error names the field, the
-//! text and the column (counted in characters from 1), e.g.
+//! Spaces are ignored; nesting is bounded by `MAX_DEPTH` (200). A parse error names the field,
+//! the text and the column (counted in characters from 1), e.g.
 //! ``` `initial.displacement` = "max(0,min(1,2-x)": unclosed parenthesis opened at column 4```.
 
 use crate::scene::SceneError;
@@ -182,8 +182,10 @@ struct Parser<'a> {
     depth: usize,
     allow_t: bool,
     allow_y: bool,
-    /// An edge's gap: the only variable is `s`, read as `x` (the edge's coordinate).
+    /// An edge's gap: the variables are `s`, read as `x` (the edge's coordinate), and `t`.
     edge: bool,
+    /// A bar end's gap: `t` is the only variable.
+    time_only: bool,
     field: &'a str,
     uses_x: bool,
     uses_y: bool,
@@ -390,7 +392,7 @@ impl Parser<'_> {
                 self.uses_x = true;
                 return Ok(Node::X);
             }
-            "x" if !self.edge => {
+            "x" if !self.edge && !self.time_only => {
                 self.uses_x = true;
                 return Ok(Node::X);
             }
@@ -413,7 +415,8 @@ impl Parser<'_> {
             ));
         }
         let vars = match (self.allow_y, self.allow_t) {
-            _ if self.edge => "s",
+            _ if self.edge => "s, t",
+            _ if self.time_only => "t",
             (false, false) => "x",
             (false, true) => "x, t",
             (true, false) => "x, y",
@@ -422,7 +425,17 @@ impl Parser<'_> {
         let mut msg = format!(
             "unknown variable `{name}` at column {col} (allowed: {vars}, constants pi, e, tau)"
         );
-        if name == "t" {
+        if self.edge && matches!(name, "x" | "y") {
+            msg.push_str(
+                "; an edge's gap is a function of the edge's coordinate `s` (x along bottom and \
+                 top, y along left and right) and of the time `t`",
+            );
+        } else if self.time_only && name == "x" {
+            msg.push_str(&format!(
+                "; `{}` (an end's obstacle) may depend on t only",
+                self.field
+            ));
+        } else if name == "t" {
             let only = if self.allow_y { "x and y" } else { "x" };
             msg.push_str(&format!("; `{}` may depend on {only} only", self.field));
         } else if matches!(name, "inf" | "infinity" | "nan" | "NaN") {
@@ -523,11 +536,18 @@ impl Expression {
         Self::parse_with(field, text, allow_t, true)
     }
 
-    /// An edge's gap of a plane scene: an expression in the edge's coordinate `s` only (`x`
-    /// along the bottom and top, `y` along the left and right edge), evaluated by
-    /// [`Expression::eval`] with `s` in place of `x`.
+    /// An edge's gap of a plane scene: an expression in the edge's coordinate `s` (`x` along
+    /// the bottom and top, `y` along the left and right edge) and the time `t` (a moving
+    /// obstacle), evaluated by [`Expression::eval`] with `s` in place of `x`; a value that is
+    /// not finite is reported at `s` and `t`.
     pub fn parse_edge(field: &str, text: &str) -> Result<Self, SceneError> {
-        Self::parse_full(field, text, false, false, true)
+        Self::parse_full(field, text, true, false, Mode::Edge)
+    }
+
+    /// A bar end's gap: an expression in the time `t` only (an obstacle moving along the bar),
+    /// evaluated by [`Expression::eval`] (its `x` unused).
+    pub fn parse_time(field: &str, text: &str) -> Result<Self, SceneError> {
+        Self::parse_full(field, text, true, false, Mode::TimeOnly)
     }
 
     fn parse_with(
@@ -536,7 +556,7 @@ impl Expression {
         allow_t: bool,
         allow_y: bool,
     ) -> Result<Self, SceneError> {
-        Self::parse_full(field, text, allow_t, allow_y, false)
+        Self::parse_full(field, text, allow_t, allow_y, Mode::Field)
     }
 
     fn parse_full(
@@ -544,8 +564,9 @@ impl Expression {
         text: &str,
         allow_t: bool,
         allow_y: bool,
-        edge: bool,
+        mode: Mode,
     ) -> Result<Self, SceneError> {
+        let edge = mode == Mode::Edge;
         let bad = |reason: String| SceneError::Expression {
             field: field.to_string(),
             text: text.to_string(),
@@ -559,6 +580,7 @@ impl Expression {
             allow_t,
             allow_y,
             edge,
+            time_only: mode == Mode::TimeOnly,
             field,
             uses_x: false,
             uses_y: false,
@@ -572,6 +594,16 @@ impl Expression {
             uses_x: parser.uses_x,
             uses_y: parser.uses_y,
             uses_t: parser.uses_t,
+            edge,
         })
     }
+}
+
+/// The variables of a parsed field: `x` (and `y`, `t` as allowed), an edge's `s` and `t`, or
+/// `t` alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Mode {
+    Field,
+    Edge,
+    TimeOnly,
 }

@@ -13,7 +13,7 @@ use crate::scene::schema::{
 };
 /// The built-in plane scenes (kept beside the bar's list in [`crate::scene::schema`]).
 pub use crate::scene::schema::{PLANE_BUILTIN, plane_builtin_text};
-use crate::scene::solver::SolverSpec;
+use crate::scene::solver::{SolverMethod, SolverSpec};
 use crate::scene::{SceneError, builtin_names, builtin_text};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -61,6 +61,36 @@ pub struct Body {
     /// Kelvin–Voigt `α >= 0` (default 0): `σ = A ε(u) + α A ε(u_t)`.
     #[serde(default)]
     pub viscosity: f64,
+    /// How `K` is integrated (default `full`); `selective` takes the `λ` term at the cell
+    /// centre, so that a nearly incompressible body does not lock.
+    #[serde(default, skip_serializing_if = "Integration::is_full")]
+    pub integration: Integration,
+}
+
+/// `[plane] integration`: the quadrature of the stiffness `K` (and of its energy forms).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Integration {
+    /// Every term at the 2 × 2 Gauss points: exact on rectangles; locks as `λ/μ → ∞`.
+    #[default]
+    Full,
+    /// Selective reduced integration: `λ div u div v` at the cell centre (one point),
+    /// `2μ ε(u):ε(v)` at 2 × 2 (Hughes, *The Finite Element Method*, §4.5).
+    Selective,
+}
+
+impl Integration {
+    fn is_full(&self) -> bool {
+        *self == Integration::Full
+    }
+
+    /// `full` or `selective`, as in the scene.
+    pub fn name(self) -> &'static str {
+        match self {
+            Integration::Full => "full",
+            Integration::Selective => "selective",
+        }
+    }
 }
 
 fn one_f64() -> f64 {
@@ -122,10 +152,14 @@ fn optional_expression<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<
 /// The edges in the order `left, right, bottom, top` ([`Edges::all`]).
 pub const EDGE_NAMES: [&str; 4] = ["left", "right", "bottom", "top"];
 
-/// Largest number of contact normals `m` of a plane scene: the condensed matrix `S` and the
-/// factor of its active block are two dense `m × m` arrays, 2 · 8 · m² bytes = 256 MiB at
-/// this limit; beyond, the exact step's memory is no longer O(nnz(L)) dominated.
-pub const MAX_CONTACT_NORMALS: u64 = 4096;
+/// Bytes per pair of contact normals of the exact step: the condensed matrix `S` and the
+/// factor of its active block are two dense `m × m` arrays of doubles.
+pub const EXACT_BYTES_PER_NORMAL_PAIR: u64 = 16;
+/// The penalty law is solved on the condensed `S + εI` (as the exact step) up to this many
+/// normals (256 MiB of dense arrays), and beyond by the sparse Newton iteration
+/// ([`crate::step::SparsePenaltySolver`]), which needs no dense matrix: a fixed switch, so that
+/// a scene gives the same bits on every machine.
+pub const PENALTY_CONDENSED_MAX_NORMALS: u64 = 4096;
 
 /// `[edges]`: `left` (x = 0), `right` (x = W), `bottom` (y = 0), `top` (y = H); free when absent.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
@@ -426,16 +460,26 @@ impl PlaneScene {
         self.expressions()?;
         self.edges.gaps()?;
         let m = self.contact_normals();
-        if m > MAX_CONTACT_NORMALS {
-            return Err(SceneError::Invalid {
-                field: "edges".into(),
-                value: format!("{m} contact normals"),
-                allowed: format!(
-                    "at most {MAX_CONTACT_NORMALS} contact normals m (the dense m x m matrix of \
-                     the exact step and its factor take 16 m^2 bytes): coarsen the Signorini \
-                     edges' mesh"
-                ),
-            });
+        if self.solver.method == SolverMethod::Exact {
+            let dense = m
+                .saturating_mul(m)
+                .saturating_mul(EXACT_BYTES_PER_NORMAL_PAIR);
+            if needed.saturating_add(dense) > available {
+                return Err(SceneError::Invalid {
+                    field: "edges".into(),
+                    value: format!("{m} contact normals"),
+                    allowed: format!(
+                        "the exact step's dense S = E C^-1 E^T and the factor of its active \
+                         block take {EXACT_BYTES_PER_NORMAL_PAIR} m^2 = {dense} bytes ({:.1} \
+                         GiB) beside the run's {:.1} GiB, more than the {:.1} GiB available: \
+                         use solver.method = \"penalty\" or \"osqp\" (no dense matrix), or \
+                         coarsen the Signorini edges' mesh",
+                        dense as f64 / GIB,
+                        needed as f64 / GIB,
+                        available as f64 / GIB
+                    ),
+                });
+            }
         }
         Ok(())
     }

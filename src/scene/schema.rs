@@ -128,9 +128,40 @@ pub enum Condition {
 #[serde(deny_unknown_fields)]
 pub struct EndSpec {
     pub condition: Condition,
-    /// The gap `a` of a Signorini end (constraint `u(end) >= -a`).
+    /// The gap `a` of a Signorini end (constraint `u(end) >= -a`): a number, or an expression
+    /// in `t` (an obstacle moving along the bar; `a(0) >= 0`, later values of either sign).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub gap: Option<f64>,
+    pub gap: Option<GapValue>,
+}
+
+impl EndSpec {
+    /// An end with `condition` and, for a Signorini end, the constant gap `gap`.
+    pub fn new(condition: Condition, gap: Option<f64>) -> Self {
+        Self {
+            condition,
+            gap: gap.map(GapValue::Number),
+        }
+    }
+
+    /// The gap when it is a number (`None` when absent or an expression in `t`).
+    pub fn constant_gap(&self) -> Option<f64> {
+        match self.gap {
+            Some(GapValue::Number(v)) => Some(v),
+            _ => None,
+        }
+    }
+
+    /// The gap `a(t)` as an expression in `t` for the scene field `field` (`None` when absent).
+    pub fn gap_expression(&self, field: &str) -> Result<Option<Expression>, SceneError> {
+        match &self.gap {
+            None => Ok(None),
+            Some(GapValue::Number(v)) if !v.is_finite() => {
+                Err(invalid(field, *v, "must be a finite number >= 0"))
+            }
+            Some(GapValue::Number(v)) => Expression::parse_time(field, &number_text(*v)).map(Some),
+            Some(GapValue::Expression(text)) => Expression::parse_time(field, text).map(Some),
+        }
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -178,8 +209,8 @@ pub struct Obstacle {
     pub gap: GapValue,
 }
 
-/// A number or an expression in `x`.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+/// A number or an expression (in `x` for the obstacle, in `t` for an end).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum GapValue {
     Number(f64),
@@ -394,8 +425,9 @@ pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(String, Scene),
 
 impl Scene {
     /// Parses TOML text, applies `key=value` overrides and validates. An override's key is
-    /// `section.field`; its value is read as a TOML value (`0.1`, `"x*(1 - x)"`, `true`), and a
-    /// value that is not valid TOML (a bare word such as `osqp`) is taken as a string. A number
+    /// `section.field` (or `section.table.field`, e.g. `edges.bottom.gap`); its value is read
+    /// as a TOML value (`0.1`, `"x*(1 - x)"`, `true`), and a value that is not valid TOML (a
+    /// bare word such as `osqp`) is taken as a string. A number
     /// is accepted wherever an expression is (`initial.displacement = 0.1`, in the file or
     /// through `--set`), kept as its text ([`number_text`]).
     pub fn from_toml(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
@@ -415,6 +447,16 @@ impl Scene {
 
     /// Checks every field; the error names the field, the value and what is allowed.
     pub fn validate(&self) -> Result<(), SceneError> {
+        if self.output.format == crate::scene::OutputFormat::Vtu {
+            return Err(SceneError::Invalid {
+                field: "output.format".into(),
+                value: "\"vtu\"".into(),
+                allowed: "ParaView output is the plane body's (its mesh, stress tensor and \
+                          contact along its edges); a bar writes its profiles as \"csv\" or \
+                          \"npy\""
+                    .into(),
+            });
+        }
         positive("bar.length", self.bar.length)?;
         if !(self.bar.viscosity.is_finite() && self.bar.viscosity >= 0.0) {
             return Err(invalid(
@@ -424,27 +466,36 @@ impl Scene {
             ));
         }
         for (side, end) in [("left", &self.left), ("right", &self.right)] {
-            match (end.condition, end.gap) {
+            let field = format!("{side}.gap");
+            match (end.condition, &end.gap) {
                 (Condition::Signorini, None) => {
                     return Err(SceneError::Invalid {
-                        field: format!("{side}.gap"),
+                        field,
                         value: "missing".into(),
-                        allowed: "a signorini end needs a finite gap >= 0".into(),
+                        allowed: "a signorini end needs a finite gap >= 0 (a number, or an \
+                                  expression in t)"
+                            .into(),
                     });
                 }
-                (Condition::Signorini, Some(a)) if !(a.is_finite() && a >= 0.0) => {
-                    return Err(invalid(
-                        &format!("{side}.gap"),
-                        a,
-                        "must be a finite number >= 0",
-                    ));
+                (Condition::Signorini, Some(_)) => {
+                    let a = end.gap_expression(&field)?.expect("given").eval(0.0, 0.0)?;
+                    if a < 0.0 {
+                        return Err(invalid(
+                            &field,
+                            a,
+                            "must be a finite number >= 0 (at t = 0)",
+                        ));
+                    }
                 }
                 (Condition::Free | Condition::Clamped, Some(a)) => {
-                    return Err(invalid(
-                        &format!("{side}.gap"),
-                        a,
-                        "only a signorini end has a gap",
-                    ));
+                    return Err(SceneError::Invalid {
+                        field,
+                        value: match a {
+                            GapValue::Number(v) => v.to_string(),
+                            GapValue::Expression(text) => format!("\"{text}\""),
+                        },
+                        allowed: "only a signorini end has a gap".into(),
+                    });
                 }
                 _ => {}
             }
@@ -587,11 +638,39 @@ impl Scene {
             .sampling(self.steps() as u64, [self.elements() as u64 + 1, 1])
     }
 
-    /// The Signorini ends as `(side, gap)`, left first.
+    /// The Signorini ends as `(side, gap)`, left first; the gap at `t = 0` (a validated scene's
+    /// gaps evaluate; one that does not is left out, as [`Scene::validate`] refuses it).
     pub fn signorini_ends(&self) -> Vec<(Side, f64)> {
+        let end = |side: Side| {
+            if side == Side::Left {
+                &self.left
+            } else {
+                &self.right
+            }
+        };
+        self.moving_ends()
+            .into_iter()
+            .filter_map(|(side, a)| {
+                let a0 = end(side).constant_gap().or_else(|| a.eval(0.0, 0.0).ok())?;
+                Some((side, a0))
+            })
+            .collect()
+    }
+
+    /// Whether a Signorini end's gap depends on `t` (an end obstacle that moves).
+    pub fn has_moving_ends(&self) -> bool {
+        self.moving_ends().iter().any(|(_, a)| a.depends_on_t())
+    }
+
+    /// The Signorini ends as `(side, a(t))`, left first (a constant gap as a constant
+    /// expression); ends whose gap does not parse are left out ([`Scene::validate`] refuses
+    /// them).
+    pub fn moving_ends(&self) -> Vec<(Side, Expression)> {
         let mut v = Vec::new();
         for (side, end) in [(Side::Left, &self.left), (Side::Right, &self.right)] {
-            if let (Condition::Signorini, Some(a)) = (end.condition, end.gap) {
+            if end.condition == Condition::Signorini
+                && let Ok(Some(a)) = end.gap_expression(&format!("{}.gap", side.name()))
+            {
                 v.push((side, a));
             }
         }
@@ -706,15 +785,23 @@ pub(crate) fn apply_override(table: &mut toml::Table, assignment: &str) -> Resul
         Err(_) => toml::Value::String(raw.to_string()),
     };
     let parts: Vec<&str> = key.split('.').collect();
-    if parts.len() != 2 || parts.iter().any(|p| p.is_empty()) {
-        return Err(fail("the key must be section.field, e.g. bar.viscosity"));
+    if parts.len() < 2 || parts.iter().any(|p| p.is_empty()) {
+        return Err(fail(
+            "the key must be section.field (or section.table.field), e.g. bar.viscosity or \
+             edges.bottom.gap",
+        ));
     }
-    let section = table
-        .entry(parts[0].to_string())
-        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-    let section = section
-        .as_table_mut()
-        .ok_or_else(|| fail("that section is not a table"))?;
-    section.insert(parts[1].to_string(), value);
+    // Each part but the last names a table (inline or not), made when absent.
+    let (field, tables) = parts.split_last().expect("at least two parts");
+    let mut section = table;
+    for (depth, name) in tables.iter().enumerate() {
+        let entry = section
+            .entry(name.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        section = entry
+            .as_table_mut()
+            .ok_or_else(|| fail(&format!("`{}` is not a table", parts[..=depth].join("."))))?;
+    }
+    section.insert(field.to_string(), value);
     Ok(())
 }

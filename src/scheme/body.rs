@@ -68,4 +68,10 @@ pub trait Body {
     fn point(&self, node: usize) -> (f64, Option<f64>);
     /// The unknown of a degree of freedom (`None` when clamped).
     fn unknown_of(&self, dof: usize) -> Option<usize>;
+    /// `[σ_xx, σ_yy, σ_xy, σ_zz]` at every node of the displacement `u` and the velocity `v`
+    /// on the unknowns, for output (may allocate); `None` for a body whose outputs show no
+    /// stress tensor (the bar).
+    fn nodal_stress(&self, _u: &[f64], _v: &[f64]) -> Option<Vec<[f64; 4]>> {
+        None
+    }
 }

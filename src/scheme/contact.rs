@@ -5,8 +5,10 @@
 //! edge's `u·n <= g` is `s = −σ` for the outward normal `n = σ e_c`). Its reaction `r_k >= 0`
 //! pushes along `s_k e_{i_k}`. One definition of "in contact" serves every body and output:
 //! [`in_contact`]. The constraints form named groups (an end of the bar, an edge of the plane,
-//! the bar's whole obstacle), whose contact episodes the outputs report.
+//! the bar's whole obstacle), whose contact episodes the outputs report. An obstacle may move
+//! ([`GapMotion`]): its gaps `g_k(t)` are then set before each step's bounds.
 
+use crate::scene::{Expression, SceneError};
 use crate::step::Constraints;
 use std::ops::Range;
 
@@ -68,6 +70,57 @@ pub struct ContactSet {
     directions: Vec<f64>,
     positions: Positions,
     groups: Vec<Group>,
+    /// The obstacles that move, if any ([`ContactSet::with_motion`]).
+    motion: Option<Box<GapMotion>>,
+}
+
+/// One constraint whose obstacle moves: `g_k(t) = min(law(s, t), cap)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MovingGap {
+    /// The constraint `k`.
+    pub constraint: usize,
+    /// Its law, an index into [`GapMotion`]'s laws.
+    pub law: usize,
+    /// The first argument of the law: the edge coordinate `s` (0 for a bar's end).
+    pub s: f64,
+    /// A fixed bound the gap never exceeds (a bar's obstacle under a moving end; `+∞` else).
+    pub cap: f64,
+}
+
+/// Obstacles moving along their normals: the gaps `g_k(t)` of some constraints, evaluated
+/// at every step (no allocation), and the gaps of the two steps before, for the obstacle's
+/// work `W = −½ Σ_k r_k (g_k^{n+1} − g_k^{n−1})` in the energy identity
+/// ([docs/moving-obstacles.md](../../docs/moving-obstacles.md)).
+#[derive(Clone, Debug)]
+pub struct GapMotion {
+    laws: Vec<Expression>,
+    moving: Vec<MovingGap>,
+    /// `g^{n−1}` and `g^n` of every constraint (`g^{n+1}` is the set's own `gaps`).
+    earlier: Vec<f64>,
+    previous: Vec<f64>,
+}
+
+impl GapMotion {
+    /// The moving constraints `moving` with their `laws` (expressions in `s` and `t`); `None`
+    /// when nothing moves.
+    pub fn new(laws: Vec<Expression>, moving: Vec<MovingGap>) -> Option<Self> {
+        (!moving.is_empty()).then(|| Self {
+            laws,
+            moving,
+            earlier: Vec::new(),
+            previous: Vec::new(),
+        })
+    }
+
+    /// The moving constraints.
+    pub fn moving(&self) -> &[MovingGap] {
+        &self.moving
+    }
+
+    /// `g_k(t)` of a moving constraint.
+    pub fn gap_at(&self, m: &MovingGap, t: f64) -> Result<f64, SceneError> {
+        Ok(self.laws[m.law].eval(m.s, t)?.min(m.cap))
+    }
 }
 
 /// The sums of one pass over some constraints.
@@ -114,7 +167,66 @@ impl ContactSet {
             directions,
             positions,
             groups,
+            motion: None,
         }
+    }
+
+    /// The set with its obstacles moving by `motion` (the gaps given to [`ContactSet::new`]
+    /// are those at `t = 0`); `None` keeps them fixed.
+    pub fn with_motion(mut self, motion: Option<GapMotion>) -> Self {
+        self.motion = motion.map(|mut m| {
+            m.earlier = self.gaps.clone();
+            m.previous = self.gaps.clone();
+            Box::new(m)
+        });
+        self
+    }
+
+    /// Whether an obstacle moves.
+    pub fn is_moving(&self) -> bool {
+        self.motion.is_some()
+    }
+
+    /// The motion of the obstacles, if any.
+    pub fn motion(&self) -> Option<&GapMotion> {
+        self.motion.as_deref()
+    }
+
+    /// Moves the obstacles to `t = t_{n+1}` before the bounds of the step to it: `g^{n−1} ←
+    /// g^n ← g^{n+1} ← g(t)`. Does nothing (and allocates nothing) when no obstacle moves; an
+    /// error names the gap's field and the point where it is not finite.
+    pub fn advance_gaps(&mut self, t: f64) -> Result<(), SceneError> {
+        let Some(motion) = self.motion.as_deref_mut() else {
+            return Ok(());
+        };
+        std::mem::swap(&mut motion.earlier, &mut motion.previous);
+        motion.previous.copy_from_slice(&self.gaps);
+        for m in &motion.moving {
+            self.gaps[m.constraint] = motion.laws[m.law].eval(m.s, t)?.min(m.cap);
+        }
+        Ok(())
+    }
+
+    /// `g_k^{n+1} − g_k^{n−1}` (0 for a fixed obstacle).
+    #[inline(always)]
+    fn gap_change(&self, k: usize) -> f64 {
+        self.motion
+            .as_deref()
+            .map_or(0.0, |m| self.gaps[k] - m.earlier[k])
+    }
+
+    /// The obstacles' work over the step just taken, `W = −½ Σ_k r_k (g_k^{n+1} − g_k^{n−1})`:
+    /// positive when an obstacle pushing on the body advances into it (0 without motion).
+    pub fn obstacle_work(&self, r: &[f64]) -> f64 {
+        let Some(motion) = self.motion.as_deref() else {
+            return 0.0;
+        };
+        let mut work = 0.0;
+        for m in &motion.moving {
+            let k = m.constraint;
+            work += -0.5 * r[k] * (self.gaps[k] - motion.earlier[k]);
+        }
+        work
     }
 
     /// No constraint.
@@ -231,7 +343,12 @@ impl ContactSet {
                 p.count += 1;
             }
             if dissipation {
-                p.dissipation += -0.5 * reaction * s * (z[l] + w[l]);
+                let change = self.gap_change(k);
+                p.dissipation += if change == 0.0 {
+                    -0.5 * reaction * s * (z[l] + w[l])
+                } else {
+                    -0.5 * reaction * (s * (z[l] + w[l]) + change)
+                };
             }
         }
         p
@@ -254,7 +371,8 @@ impl ContactSet {
 
     /// The contact state of `u = u^{n+1}` (`z` its increment, `w` the one before, `r` the
     /// reactions) into `state`; with `dissipation` also the contact dissipation
-    /// `D = −½ Σ_k r_k s_k (u^{n+1} − u^{n−1})_{i_k}`, returned (0 without).
+    /// `D = −½ Σ_k r_k (s_k (u^{n+1} − u^{n−1})_{i_k} + g_k^{n+1} − g_k^{n−1})`, returned (0
+    /// without); `g^{n+1} − g^{n−1} = 0` for a fixed obstacle.
     pub fn measure(
         &self,
         (u, z, w, r): (&[f64], &[f64], &[f64], &[f64]),
@@ -278,7 +396,9 @@ impl ContactSet {
                     extent: [position, position],
                     min_gap: gap,
                     reaction: r[k],
-                    dissipation: if dissipation {
+                    dissipation: if dissipation && self.gap_change(k) != 0.0 {
+                        -0.5 * r[k] * (s * (z[l] + w[l]) + self.gap_change(k))
+                    } else if dissipation {
                         -0.5 * r[k] * s * (z[l] + w[l])
                     } else {
                         0.0

@@ -26,10 +26,14 @@ pub struct StepRecord {
     pub work: f64,
     /// `α/(4Δt) |u^{n+1} − u^{n−1}|²_K >= 0`.
     pub viscous_dissipation: f64,
-    /// `D = −½ Σ_k r_k s_k (u^{n+1} − u^{n−1})_{i_k} >= 0`.
+    /// `D = −½ Σ_k r_k (s_k (u^{n+1} − u^{n−1})_{i_k} + g_k^{n+1} − g_k^{n−1}) >= 0`.
     pub contact_dissipation: f64,
-    /// `|E^{n+1/2} − E^{n−1/2} − work + viscous + D|` over the largest of those terms.
+    /// `|E^{n+1/2} − E^{n−1/2} − work − obstacle_work + viscous + D|` over the largest of
+    /// those terms.
     pub identity_residual: f64,
+    /// `W = −½ Σ_k r_k (g_k^{n+1} − g_k^{n−1})`, the work of moving obstacles (0 when none
+    /// moves; of either sign).
+    pub obstacle_work: f64,
     /// The contact state of `u^{n+1}`.
     pub contact: ContactState,
     /// The step solver's iterations (active sets tried, ADMM iterations…).
@@ -153,6 +157,7 @@ impl<B: Body> Scheme<B> {
             self.w[i] = dt * v0[i] + 0.5 * dt * dt * acc[i];
         }
         self.body.step_matrix_mul(&self.w, &mut self.b);
+        self.contact.advance_gaps(dt)?;
         self.contact.lower_bounds_into(&self.u, &mut self.lower);
         self.solver.set_state_scale(max_abs(&self.u));
         let info = (self.solver)
@@ -215,7 +220,10 @@ impl<B: Body> Scheme<B> {
     /// ```
     ///
     ///    `D = −½ Σ_k r_k s_k δ_{i_k} = ½ Σ_k r_k (s_k u^{n−1}_{i_k} + g_k) >= 0` by
-    ///    complementarity and the admissibility of `u^{n−1}`: contact only dissipates.
+    ///    complementarity and the admissibility of `u^{n−1}`: contact only dissipates. A moving
+    ///    obstacle adds its work `W = −½ Σ_k r_k (g_k^{n+1} − g_k^{n−1})` to the right-hand
+    ///    side and `g^{n+1} − g^{n−1}` to `D`'s bracket ([`ContactSet::advance_gaps`],
+    ///    [docs/moving-obstacles.md](../../docs/moving-obstacles.md)).
     ///
     /// The identity is measured every `[output] diagnostics_every`-th step and at the last; a
     /// measured step after an unmeasured one first recomputes `E^{n−1/2}` from `u^n` and `w`,
@@ -228,7 +236,8 @@ impl<B: Body> Scheme<B> {
         let force = self.load.force();
         self.body.rhs_into(&self.u, &self.w, force, &mut self.b);
         let clock = clock.lap(&mut self.timing.rhs_ns);
-        // 2. The bounds of the increment.
+        // 2. The bounds of the increment (moving obstacles first moved to t_{n+1}).
+        self.contact.advance_gaps((n + 1) as f64 * self.body.dt())?;
         self.contact.lower_bounds_into(&self.u, &mut self.lower);
         let measure = (n + 1).is_multiple_of(self.diagnostics_every) || n + 1 == self.last_step;
         if measure && !self.balance.measured {
@@ -260,6 +269,7 @@ impl<B: Body> Scheme<B> {
         let contact = self.contact.measure(state, measure, &mut record.contact);
         if measure {
             let sums = (self.body).energy_sums(&self.u, &self.z, &self.w, self.load.force());
+            record.obstacle_work = self.contact.obstacle_work(&self.reactions);
             self.close_balance(&mut record, sums, contact)?;
         }
         self.balance.measured = measure;
@@ -298,10 +308,22 @@ impl<B: Body> Scheme<B> {
             0.0
         };
         let work = 0.5 * sums.work;
-        let residual = energy - before - work + viscous + contact;
-        let scale = [energy, before, work.abs(), viscous, contact.abs()]
-            .into_iter()
-            .fold(0.0, f64::max);
+        let obstacle = record.obstacle_work;
+        let residual = if obstacle == 0.0 {
+            energy - before - work + viscous + contact
+        } else {
+            energy - before - work - obstacle + viscous + contact
+        };
+        let scale = [
+            energy,
+            before,
+            work.abs(),
+            viscous,
+            contact.abs(),
+            obstacle.abs(),
+        ]
+        .into_iter()
+        .fold(0.0, f64::max);
         if !(energy.is_finite() && residual.is_finite()) {
             return Err(self.failure(record.step, StepFailure::NonFinite));
         }
@@ -338,9 +360,10 @@ impl<B: Body> Scheme<B> {
         &self.contact
     }
 
-    /// Whether the run has a load (an unforced run cannot gain energy).
+    /// Whether something can feed energy in: a load, or a moving obstacle (without either a
+    /// run cannot gain energy).
     pub fn is_forced(&self) -> bool {
-        self.load.force().is_some()
+        self.load.force().is_some() || self.contact.is_moving()
     }
 
     /// The load vector `F^n` on the unknowns (zeros without a load), as the step from `t_n`

@@ -15,6 +15,7 @@ pub mod penalty;
 pub mod report;
 pub mod schur;
 pub mod solver;
+pub mod sparse_penalty;
 
 pub use block_pivot::BlockPivotSolver;
 pub use condensed::CondensedSolver;
@@ -25,3 +26,4 @@ pub use report::{
     AuditReport, OsqpStatus, SettingsError, SetupError, SolveInfo, SolverReport, StepFailure,
 };
 pub use solver::{Constraints, StepSolver};
+pub use sparse_penalty::SparsePenaltySolver;

@@ -100,26 +100,53 @@ pub fn write_talk_figures(out: &Path, overrides: &[String]) -> Result<Vec<PathBu
         runs.push(sample_run(name, scene, sampling).map_err(run_err(name))?);
     }
     register_font()?;
-    std::fs::create_dir_all(out).map_err(|source| FigureError::Write {
-        path: out.to_path_buf(),
-        source,
-    })?;
+    create_folder(out)?;
     let mut written = Vec::new();
     for run in &runs {
-        for ext in ["png", "svg"] {
-            let path = out.join(format!("{}.{ext}", run.name));
-            write_figure(&path, &TalkFigure::Scene(run))?;
-            written.push(path);
-        }
+        written.extend(write_both(out, &run.name, &TalkFigure::Scene(run))?);
     }
     for (k, (stem, caption, _)) in TALK_FIGURES.iter().enumerate() {
         let pair = [&runs[2 * k], &runs[2 * k + 1]];
         let title = format!("Figure {}: {caption}", k + 1);
-        for ext in ["png", "svg"] {
-            let path = out.join(format!("{stem}.{ext}"));
-            write_figure(&path, &TalkFigure::Pair(&title, pair))?;
-            written.push(path);
+        written.extend(write_both(out, stem, &TalkFigure::Pair(&title, pair))?);
+    }
+    Ok(written)
+}
+
+/// Runs one bar scene and writes its figure (the colour map of u(x, t) beside its contact
+/// panel, as [`write_talk_figures`] draws each talk scene) as `<name>.png` and `<name>.svg`
+/// into `out`; returns the files written (`viscobar run SCENE --figure`).
+pub fn write_scene_figure(
+    name: &str,
+    scene: &scene::Scene,
+    out: &Path,
+) -> Result<Vec<PathBuf>, FigureError> {
+    let run = sample_run(name, scene, Sampling::for_figure(scene)).map_err(|source| {
+        FigureError::Run {
+            scene: name.to_string(),
+            source,
         }
+    })?;
+    register_font()?;
+    create_folder(out)?;
+    write_both(out, name, &TalkFigure::Scene(&run))
+}
+
+/// `out` and its parents, made if missing.
+fn create_folder(out: &Path) -> Result<(), FigureError> {
+    std::fs::create_dir_all(out).map_err(|source| FigureError::Write {
+        path: out.to_path_buf(),
+        source,
+    })
+}
+
+/// `<stem>.png` and `<stem>.svg` of `figure` in `out`; returns their paths.
+fn write_both(out: &Path, stem: &str, figure: &TalkFigure) -> Result<Vec<PathBuf>, FigureError> {
+    let mut written = Vec::new();
+    for ext in ["png", "svg"] {
+        let path = out.join(format!("{stem}.{ext}"));
+        write_figure(&path, figure)?;
+        written.push(path);
     }
     Ok(written)
 }

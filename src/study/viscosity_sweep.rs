@@ -27,7 +27,7 @@ fn impact_of(scene: &Scene) -> Option<Impact> {
             .ok()?;
     Some(Impact {
         length: scene.bar.length,
-        gap: scene.left.gap?,
+        gap: scene.left.constant_gap()?,
         speed: -v,
     })
 }

@@ -2,6 +2,7 @@
 //! `plane_contact_cli.rs`, `plane_symmetry.rs`), each beside the measurement of what it guards.
 
 use super::{AGREEMENT_ULPS_PER_STEP, Measured};
+use viscobar::plane::matrices::Integration;
 use viscobar::scheme::RunError;
 
 // ---- tests/plane.rs, tests/plane_contact.rs, tests/plane_cli.rs, tests/plane_contact_cli.rs ----
@@ -26,6 +27,10 @@ pub const PLANE_OSQP_AGREEMENT_TOL: f64 = 1e-7;
 /// twice itself where the wave reflects, and the release delayed by O(ε) can double that again
 /// (the bar's `PENALTY_AGREEMENT_FACTOR`, one contact episode): `|u − u_exact| ≤ 4 ε r_max`.
 pub const PLANE_PENALTY_FACTOR: f64 = 4.0;
+/// The sparse penalty solver against the condensed one, relative to `max |z|` and `max r`:
+/// both backward-stable solves of the same law, of `C + D_A/ε` and of `S_AA + εI`, whose
+/// conditioning grows as `1/ε` (measured 1e-13 at `ε = 1e-6`, 1e-15 at `1e-3`).
+pub const SPARSE_PENALTY_AGREEMENT_TOL: f64 = 1e-11;
 
 // ---- tests/plane_symmetry.rs ------------------------------------------------------------------
 
@@ -228,8 +233,81 @@ pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
             "the reactions from nearly closed gaps times S⁻¹ (every mirror and turn of the tests)",
         ),
     ];
+    let galilean = crate::moving::galilean_plane()?
+        .ratio()
+        .max(crate::moving::galilean_bar()?.ratio());
+    let [patch_full, patch_selective] = crate::locking::patch_worst()?;
+    let table = crate::locking::cantilever_table()?;
+    let selective =
+        |f: fn(f64, f64) -> f64, init: f64| table.iter().map(|r| r.selective).fold(init, f);
+    let (low, high) = (selective(f64::min, f64::INFINITY), selective(f64::max, 0.0));
+    let locked = table.last().map_or(f64::INFINITY, |r| r.full);
+    let identity = crate::locking::identity_ratio(0.4999, Integration::Full)?.max(
+        crate::locking::identity_ratio(0.4999, Integration::Selective)?,
+    );
+    use crate::locking::{LOCKED_BELOW, PATCH_TOL, SELECTIVE_BAND};
+    let locking = [
+        (
+            "locking::PATCH_TOL",
+            "tests/plane_locking.rs",
+            PATCH_TOL,
+            patch_full.max(patch_selective),
+            "both rules, λ = 1.7 and 1e4 on a graded patch: the solve's κ(K_II) ε",
+        ),
+        (
+            "locking::SELECTIVE_BAND.0 / least selective ratio",
+            "tests/plane_locking.rs",
+            1.0,
+            SELECTIVE_BAND.0 / low,
+            "lower end over the least selective ratio (below 1: inside the band)",
+        ),
+        (
+            "locking::SELECTIVE_BAND.1",
+            "tests/plane_locking.rs",
+            SELECTIVE_BAND.1,
+            high,
+            "the largest selective ratio against the band's upper end",
+        ),
+        (
+            "locking::LOCKED_BELOW",
+            "tests/plane_locking.rs",
+            LOCKED_BELOW,
+            locked,
+            "full integration's ratio at ν = 0.4999 (a check that locking is seen)",
+        ),
+        (
+            "identity residual / (PLANE_IDENTITY_TOL + LAMBDA_IDENTITY_ULPS ε λ/μ)",
+            "tests/plane_locking.rs",
+            1.0,
+            identity,
+            "cantilever at ν = 0.4999, both rules, 80 steps",
+        ),
+    ];
+    let sparse = crate::scale::EPSILONS
+        .iter()
+        .map(|&e| crate::scale::sparse_penalty_agreement(e))
+        .collect::<Result<Vec<f64>, RunError>>()?
+        .into_iter()
+        .fold(0.0, f64::max);
+    let locking = locking.into_iter().chain([(
+        "SPARSE_PENALTY_AGREEMENT_TOL",
+        "tests/plane_scale.rs",
+        SPARSE_PENALTY_AGREEMENT_TOL,
+        sparse,
+        "the sparse Newton iteration against the condensed LCP on S + εI, ε = 1e-3 and 1e-6",
+    )]);
+    let moving = [(
+        "moving obstacle: relative |Δu|, |Δr| of the shifted run / (steps · GALILEAN_ULPS_PER_STEP ε)",
+        "tests/moving_obstacles.rs",
+        1.0,
+        galilean,
+        "Galilean invariance, plane and bar: the shift v t rounded and K's translation \
+         round-off, per step, accumulated linearly",
+    )];
     Ok(rows
         .into_iter()
+        .chain(locking)
+        .chain(moving)
         .map(|(name, used_in, tolerance, worst, note)| Measured {
             name: name.into(),
             used_in,

@@ -265,7 +265,7 @@ pub fn builtin_falling_bar() -> Result<FallingBar, RunError> {
         })?;
     let gap = s
         .left
-        .gap
+        .constant_gap()
         .ok_or_else(|| invalid("left.gap", "none".into(), "a Signorini left end"))?;
     FallingBar::new(s.bar.length, gravity, gap).ok_or_else(|| {
         invalid(
