@@ -2,7 +2,7 @@
 //! start-up and every step with the energy balance, through `run::run_in_memory` (no files
 //! written, so disk speed does not enter). Throughput in node-steps.
 //!
-//! Group `setup` (issue 17, set-up and output): `run::run_to_dir` (what `viscobar run` does,
+//! Group `setup` (set-up and output): `run::run_to_dir` (what `viscobar run` does,
 //! files written into a fresh `target/bench-setup/`) of the two-end bar `both-ends` with 16384 elements
 //! for one step (`one-step`) and for 400 steps keeping `t = 0` and the last step
 //! (`400-steps`, `[output] every = 400`), the same 400 steps alone (`400-steps-stepping`: the

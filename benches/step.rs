@@ -138,7 +138,7 @@ fn bench_other_solvers(c: &mut Criterion) {
             }
         }
     }
-    // The stiff worst case of issue 4: J = 1e5, dt = 10 dx.
+    // The stiff worst case: J = 1e5, dt = 10 dx.
     group.throughput(Throughput::Elements(100_001));
     settle_and_bench(
         &mut group,
@@ -164,7 +164,7 @@ fn refined_builtin(name: &str, elements: u64, extra: &[&str]) -> Scene {
     viscobar::scene::load(name, &o).unwrap().1
 }
 
-/// Issue 17's load path: each forced talk scene against its unforced twin (the same bar,
+/// The load path: each forced talk scene against its unforced twin (the same bar,
 /// obstacles and data without the load), and the twin with a load that does not separate
 /// (two transcendental calls per node).
 fn bench_loads(c: &mut Criterion) {

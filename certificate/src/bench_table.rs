@@ -244,7 +244,7 @@ impl Measurements {
         .filter_map(|(j, name, target)| Some((j, name, self.step_ratio(j, name)?, target)))
         .collect();
         if !distributed.is_empty() {
-            let _ = writeln!(out, "\nTargets (issue 17, distributed obstacle):");
+            let _ = writeln!(out, "\nTargets (distributed obstacle):");
             for (j, name, ratio, target) in distributed {
                 let _ = writeln!(
                     out,
@@ -310,7 +310,7 @@ impl Measurements {
         for (j, name) in self.loads.stale.iter().filter(|_| list_stale) {
             let _ = writeln!(out, "| {j} | {name} (stale) | | | |");
         }
-        let _ = writeln!(out, "\nTargets (issue 17, loads):");
+        let _ = writeln!(out, "\nTargets (loads):");
         for ((j, name), t) in loads {
             if let Some(twin) = name.strip_suffix("-forced") {
                 if let Some(b) = loads.get(&(*j, twin.to_string())) {
@@ -353,7 +353,7 @@ impl Measurements {
         for name in self.setup.stale.iter().filter(|_| list_stale) {
             let _ = writeln!(out, "| {name} (stale) | | |");
         }
-        let _ = writeln!(out, "\nTargets (issue 17, set-up and output):");
+        let _ = writeln!(out, "\nTargets (set-up and output):");
         if let Some(t) = setup.get("one-step") {
             let _ = writeln!(
                 out,
@@ -402,7 +402,7 @@ impl Measurements {
         if self.steps.rows.is_empty() {
             return;
         }
-        let _ = writeln!(out, "\nTargets (issue 7):");
+        let _ = writeln!(out, "\nTargets (bar steps):");
         if let Some(bare) = self.step(100_000, "unconstrained-bare") {
             let per_node = bare / 100_001.0;
             let _ = writeln!(

@@ -604,12 +604,12 @@ pub fn low_ratio_notes(results: &[CaseResult]) -> String {
 /// result.
 pub const UNIT_ROUNDOFF: f64 = 0.5 * f64::EPSILON;
 /// Rounding depth of one entry of the computed solve residual `ρ̂ = C z − b̂ − r` and of the
-/// right-hand side `b̂` (`src/time/rhs.rs`): a difference-form row is two differences, three
+/// right-hand side `b̂` (`src/bar/rhs.rs`): a difference-form row is two differences, three
 /// products and two sums (5 roundings in sequence), then two subtractions; `b̂`'s rows are the
 /// same depth (the `R y` and `M w` rows, the scaling by `1/Δt²`, two sums, the load).
 /// `γ_8 = 8u/(1 − 8u)`, 8.0000001u here; the margin to 9 covers the `O(u²)`.
 pub const RESIDUAL_ROUNDINGS: f64 = 9.0;
-/// Rounding depth of one term of the energy sums (`src/time/energy.rs`): a difference, two
+/// Rounding depth of one term of the energy sums (`src/bar/energy.rs`): a difference, two
 /// products and the accumulation into its lane, plus the combination of the sums into the
 /// energy (scaling, two sums) and of the energies into the residual (four sums).
 pub const SUM_TERM_ROUNDINGS: f64 = 10.0;

@@ -111,7 +111,7 @@ impl Profiles {
                 let _ = rounded;
                 return Err(std::io::Error::new(
                     std::io::ErrorKind::Unsupported,
-                    "output.format = \"vtu\" is written by crate::output::vtk, not as a table",
+                    "output.format = \"vtu\" is written as ParaView files, not as a table",
                 ));
             }
             #[cfg(not(feature = "npy"))]
