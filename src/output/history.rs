@@ -2,6 +2,8 @@
 //! terms (empty on steps whose identity was not measured), then per group of constraints its
 //! contact state (a single constraint: `gap_G,reaction_G`; a set: the constraints in contact,
 //! the extent `s` of the contact, the least gap and the total reaction), then the iterations.
+//! A run with friction has three more columns after the identity's residual: the friction
+//! dissipation `D_f` (empty when not measured) and the frictional nodes that stick and slip.
 
 use crate::output::text::{push_time, push_value};
 use crate::scheme::StepRecord;
@@ -12,9 +14,15 @@ use std::io::Write;
 const ENERGY_COLUMNS: &str =
     "step,t,energy,work,viscous_dissipation,contact_dissipation,identity_residual";
 
-/// The header line for a run with the contact `groups`.
-pub fn header(groups: &[Group]) -> String {
+/// The columns of a run with friction, after [`ENERGY_COLUMNS`].
+const FRICTION_COLUMNS: &str = ",friction_dissipation,stick_nodes,slip_nodes";
+
+/// The header line for a run with the contact `groups`, with friction or without.
+pub fn header(groups: &[Group], friction: bool) -> String {
     let mut h = String::from(ENERGY_COLUMNS);
+    if friction {
+        h.push_str(FRICTION_COLUMNS);
+    }
     for g in groups {
         let n = g.name;
         if g.range.len() == 1 {
@@ -29,8 +37,8 @@ pub fn header(groups: &[Group]) -> String {
     h
 }
 
-/// Appends the row of `r` (`row` is cleared first); `groups` as in the header.
-pub fn row(r: &StepRecord, groups: &[Group], row: &mut Vec<u8>) {
+/// Appends the row of `r` (`row` is cleared first); `groups` and `friction` as in the header.
+pub fn row(r: &StepRecord, groups: &[Group], friction: bool, row: &mut Vec<u8>) {
     row.clear();
     write!(row, "{},", r.step).expect("writing to a vector");
     push_time(r.time, row);
@@ -46,6 +54,13 @@ pub fn row(r: &StepRecord, groups: &[Group], row: &mut Vec<u8>) {
         if r.measured {
             push_value(v, row);
         }
+    }
+    if friction {
+        row.push(b',');
+        if r.measured {
+            push_value(r.friction_dissipation, row);
+        }
+        write!(row, ",{},{}", r.stick_nodes, r.slip_nodes).expect("writing to a vector");
     }
     for (g, s) in groups.iter().zip(&r.contact.groups) {
         row.push(b',');

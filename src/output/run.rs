@@ -141,7 +141,8 @@ impl Run<'_> {
         let hist_path = dir.join("history.csv");
         let mut hist = std::io::BufWriter::with_capacity(1 << 16, create(&hist_path)?);
         let groups = prepared.contact().groups().to_vec();
-        hist.write_all(history::header(&groups).as_bytes())
+        let friction = !prepared.contact().friction().is_empty();
+        hist.write_all(history::header(&groups, friction).as_bytes())
             .map_err(io(&hist_path))?;
         // `t = 0` is written before the start-up step moves `u^0` on.
         let disp_path = dir.join(self.sampling.file);
@@ -152,7 +153,7 @@ impl Run<'_> {
         let mut tracker = Tracker::new(&sim, !sim.is_forced());
         let mut row = Vec::new();
         let mut write_row = |hist: &mut std::io::BufWriter<std::fs::File>, r: &StepRecord| {
-            history::row(r, &groups, &mut row);
+            history::row(r, &groups, friction, &mut row);
             hist.write_all(&row)
         };
         write_row(&mut hist, &sim.first_record()).map_err(io(&hist_path))?;

@@ -7,7 +7,7 @@
 //! [`in_contact`]. The constraints form named groups (an end of the bar, an edge of the plane,
 //! the bar's whole obstacle), whose contact episodes the outputs report.
 
-use crate::step::Constraints;
+use crate::step::{Constraints, Friction};
 use std::ops::Range;
 
 /// A constraint is in contact when its gap is at most this: the exact solvers put an active
@@ -68,6 +68,8 @@ pub struct ContactSet {
     directions: Vec<f64>,
     positions: Positions,
     groups: Vec<Group>,
+    /// The frictional nodes (none without friction), [`crate::scheme::friction`].
+    friction: Friction,
 }
 
 /// The sums of one pass over some constraints.
@@ -114,7 +116,24 @@ impl ContactSet {
             directions,
             positions,
             groups,
+            friction: Friction::default(),
         }
+    }
+
+    /// The same constraints with Coulomb friction at the nodes of `friction`.
+    pub fn with_friction(mut self, friction: Friction) -> Self {
+        self.friction = friction;
+        self
+    }
+
+    /// The frictional nodes (empty without friction).
+    pub fn friction(&self) -> &Friction {
+        &self.friction
+    }
+
+    /// Reactions of a step: one per constraint, then one tangential per frictional node.
+    pub fn reaction_len(&self) -> usize {
+        self.len() + self.friction.len()
     }
 
     /// No constraint.

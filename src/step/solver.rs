@@ -50,7 +50,9 @@ pub trait StepSolver {
     fn name(&self) -> &'static str;
 
     /// Given `rhs = b` and `lower = lo` (one entry per constraint, in the order given at
-    /// construction), writes the minimiser into `z` and the multipliers into `reactions`.
+    /// construction), writes the minimiser into `z` and the multipliers into `reactions` (a
+    /// frictional solver writes, after them, the tangential reaction of each frictional node,
+    /// [`crate::step::friction`]).
     fn solve(
         &mut self,
         rhs: &[f64],
@@ -78,6 +80,11 @@ pub trait StepSolver {
         let info = self.solve(rhs, lower, z, reactions)?;
         Ok((info, crate::linalg::update::add_in_place(u, z)))
     }
+
+    /// The previous increment `w = u^n − u^{n−1}`, given before each solve of a step after the
+    /// start-up step: a frictional solver's central slip is `(z + w)` at its tangential
+    /// unknowns. Default: ignored.
+    fn set_previous_increment(&mut self, _w: &[f64]) {}
 
     /// Statistics over all solves so far; `None` for solvers that keep none.
     fn report(&self) -> Option<SolverReport> {
