@@ -35,7 +35,9 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
         /// Plane scenes: also draw the deformed mesh coloured by the von Mises stress at
-        /// 6 times (plane.png, plane.svg in the output folder).
+        /// 6 times (deformed.png, deformed.svg in the output folder); with Signorini edges the
+        /// contact pressure over (s, t) (contact-pressure.png/.svg), with friction the
+        /// stick/slip/open state and the forces (friction-state.png/.svg).
         #[arg(long)]
         figure: bool,
     },
@@ -394,6 +396,9 @@ fn report(summary: &viscobar::Summary, out: &std::path::Path) {
     );
     for (group, episodes) in &summary.contact_episodes {
         println!("  {group}: {}", episode_line(episodes));
+    }
+    if let Some(d) = summary.friction_dissipation {
+        println!("  friction dissipation {d:.3e}");
     }
     if let Some(n) = summary.inaccurate_steps.filter(|n| *n > 0) {
         eprintln!(

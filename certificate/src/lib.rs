@@ -5,8 +5,8 @@
 //! tests against the worst value it guards ([`tolerances`]), the stiff and extreme case matrix
 //! ([`stiff`], [`stiff_runs`]), the step solvers' agreement ([`agreement`]) with the dense
 //! brute-force [`oracle`], the rigid mode's round-off ([`roundoff`]), the mass variants side by
-//! side ([`mass_study`]), the plane body's checks ([`plane_checks`], [`plane_contact`]), the
-//! manufactured viscous contact ([`viscous_contact`]), error against run time ([`timings`]);
+//! side ([`mass_study`]), the plane body's checks ([`plane_checks`], [`plane_contact`]), its
+//! friction ([`friction`], [`friction_rigid`]), the manufactured viscous contact ([`viscous_contact`]), error against run time ([`timings`]);
 //! and the tools that write the measured blocks of the READMEs ([`bench_table`], [`peak_memory`]).
 //!
 //! A member crate of the viscobar workspace, beside the library and not part of its API: it
@@ -16,6 +16,8 @@
 
 pub mod agreement;
 pub mod bench_table;
+pub mod friction;
+pub mod friction_rigid;
 pub mod mass_study;
 pub mod oracle;
 pub mod peak_memory;

@@ -271,3 +271,77 @@ impl<S: SpdSystem> StepSolver for FrictionalSolver<S> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linalg::system::TridiagSystem;
+    use crate::linalg::tridiag::SymTridiag;
+    use crate::step::CondensedSolver;
+    use proptest::prelude::*;
+
+    /// Frictional and frictionless answers of well-conditioned 12-unknown problems (κ(C) below
+    /// 10): two exact methods, round-off apart.
+    const AGREEMENT_TOL: f64 = 1e-12;
+
+    /// Normals at unknowns 0, 4, 9 (directions +, −, +), frictional nodes with tangents 1, 5, 8.
+    fn problem(mu: f64) -> (TridiagSystem, Constraints, Friction) {
+        let n = 12;
+        let c = SymTridiag::new(
+            (0..n).map(|i| 4.0 + 0.1 * i as f64).collect(),
+            vec![-1.0; n - 1],
+        );
+        let constraints = Constraints {
+            unknowns: vec![0, 4, 9],
+            directions: vec![1.0, -1.0, 1.0],
+        };
+        let friction = Friction {
+            normals: vec![0, 1, 2],
+            tangents: vec![1, 5, 8],
+            coefficients: vec![mu; 3],
+        };
+        (TridiagSystem::new(&c).unwrap(), constraints, friction)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(100))]
+        #[test]
+        fn zero_friction_is_the_frictionless_lcp_and_friction_meets_coulombs_law(
+            b in prop::collection::vec(-1.0f64..1.0, 12),
+            lo in prop::collection::vec(-0.3f64..0.3, 3),
+            w in prop::collection::vec(-0.2f64..0.2, 12),
+            mu in 0.05f64..1.5,
+        ) {
+            let (system, constraints, friction) = problem(0.0);
+            let mut plain = CondensedSolver::new(system.clone(), constraints.clone(), 0.0).unwrap();
+            let mut zero = FrictionalSolver::new(system, constraints.clone(), friction).unwrap();
+            zero.set_previous_increment(&w);
+            let (mut z0, mut r0) = (vec![0.0; 12], vec![0.0; 3]);
+            let (mut z1, mut r1) = (vec![0.0; 12], vec![0.0; 6]);
+            plain.solve(&b, &lo, &mut z0, &mut r0).unwrap();
+            zero.solve(&b, &lo, &mut z1, &mut r1).unwrap();
+            for i in 0..12 {
+                prop_assert!((z0[i] - z1[i]).abs() <= AGREEMENT_TOL, "z {i}");
+            }
+            for k in 0..3 {
+                prop_assert!((r0[k] - r1[k]).abs() <= AGREEMENT_TOL, "r {k}");
+                prop_assert_eq!(r1[3 + k], 0.0);
+            }
+            // With friction: the law, recomputed here from (z, r) (the solver's audit passed).
+            let (system, constraints, friction) = problem(mu);
+            let mut f = FrictionalSolver::new(system, constraints.clone(), friction.clone()).unwrap();
+            f.set_previous_increment(&w);
+            f.solve(&b, &lo, &mut z1, &mut r1).unwrap();
+            for k in 0..3 {
+                let gap = constraints.directions[k] * z1[constraints.unknowns[k]] - lo[k];
+                let (rn, rt) = (r1[k], r1[3 + k]);
+                let delta = z1[friction.tangents[k]] + w[friction.tangents[k]];
+                prop_assert!(gap >= -AGREEMENT_TOL && rn >= 0.0 && (gap * rn).abs() <= AGREEMENT_TOL);
+                prop_assert!(rt.abs() <= mu * rn * (1.0 + 1e-15), "cone {k}: {rt} {rn}");
+                if delta.abs() > AGREEMENT_TOL {
+                    prop_assert!((rt + mu * rn * delta.signum()).abs() <= AGREEMENT_TOL, "slip {k}");
+                }
+            }
+        }
+    }
+}

@@ -34,6 +34,9 @@ pub const PIVOT_ULPS: f64 = 65_536.0;
 /// Ratios and lexicographic entries within this many ulps of the least are ties, and so are
 /// basic values within it of 0 (a value that small is 0 in the tableau's round-off).
 pub const LEMKE_ULPS: f64 = 256.0;
+/// Runs of Lemke's method per call beyond the stored basis: a run, and one more from where it
+/// ended should the refined answer of the first be a round-off away from feasible.
+const RUNS: usize = 2;
 
 /// Where a run of Lemke's method starts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -437,57 +440,72 @@ impl Lemke {
         }
         let q_max = q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let mut outcome = LemkeOutcome::default();
-        self.basic_values(q);
-        let feasible = |me: &Self| {
-            let tol = LEMKE_ULPS * f64::EPSILON * me.scale(q_max);
-            me.b.iter().all(|&v| v >= -tol)
-        };
-        if !feasible(self) {
+        // The stored basis as it is; then at most two runs of Lemke's method, each from the
+        // basis the last one ended on (a run can end a round-off away from feasible).
+        for attempt in 0..=RUNS {
+            let tol = self.refined_values(q, q_max);
+            let worst = self.b.iter().copied().fold(f64::INFINITY, f64::min);
+            if worst >= -tol {
+                break;
+            }
+            if !worst.is_finite() {
+                return Err(LemkeError::NonFinite);
+            }
+            if attempt == RUNS {
+                return Err(LemkeError::Infeasible {
+                    value: worst,
+                    tolerance: tol,
+                });
+            }
             let warm = self.basis.iter().enumerate().any(|(r, &v)| v != r);
             let result = if warm {
                 self.run(q, Start::Warm, n as u32 + 10)
             } else {
                 Err(LemkeError::Ray { pivots: 0 })
             };
-            outcome.pivots = match result {
+            outcome.pivots += match result {
                 Ok(p) => p,
                 Err(LemkeError::NonFinite) => return Err(LemkeError::NonFinite),
-                Err(e) => {
-                    outcome.restarted = warm;
-                    let done = match e {
-                        LemkeError::Ray { pivots } | LemkeError::PivotLimit { pivots } => pivots,
-                        _ => 0,
-                    };
-                    done + self.run(q, Start::Cold, 50 * n as u32 + 100)?
+                Err(LemkeError::Ray { pivots } | LemkeError::PivotLimit { pivots }) => {
+                    outcome.restarted |= warm;
+                    pivots + self.run(q, Start::Cold, 50 * n as u32 + 100)?
                 }
+                Err(e) => return Err(e),
             };
             if self.pivots_since_inversion >= n.max(8) && !self.invert() {
                 return Err(LemkeError::NonFinite);
             }
-            let residual = self.basic_values(q);
-            let tol = LEMKE_ULPS * f64::EPSILON * self.scale(q_max);
-            if (residual > tol || residual.is_nan()) && self.invert() {
-                self.basic_values(q);
-            }
         }
-        let tol = LEMKE_ULPS * f64::EPSILON * self.scale(q_max);
         x.fill(0.0);
         for r in 0..n {
-            let (v, value) = (self.basis[r], self.b[r]);
-            if !value.is_finite() {
-                return Err(LemkeError::NonFinite);
-            }
-            if value < -tol {
-                return Err(LemkeError::Infeasible {
-                    value,
-                    tolerance: tol,
-                });
-            }
+            let v = self.basis[r];
             if (n..2 * n).contains(&v) {
-                x[v - n] = value.max(0.0);
+                x[v - n] = self.b[r].max(0.0);
             }
         }
         Ok(outcome)
+    }
+
+    /// The basic values of the stored basis ([`Lemke::basic_values`]; again after a fresh
+    /// inversion when the first residual is beyond round-off), and the tolerance below which
+    /// a negative one is round-off: [`LEMKE_ULPS`] ε times the tableau's scale and the basis'
+    /// condition `‖B⁻¹‖∞ (1 + ‖M‖∞)`.
+    fn refined_values(&mut self, q: &[f64], q_max: f64) -> f64 {
+        let n = self.n;
+        let residual = self.basic_values(q);
+        let round_off = LEMKE_ULPS * f64::EPSILON * self.scale(q_max);
+        if (residual > round_off || residual.is_nan()) && self.invert() {
+            self.basic_values(q);
+        }
+        let inverse = (0..n)
+            .map(|r| {
+                self.binv[r * n..(r + 1) * n]
+                    .iter()
+                    .map(|v| v.abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max);
+        LEMKE_ULPS * f64::EPSILON * self.scale(q_max) * inverse * (1.0 + self.m_norm)
     }
 }
 

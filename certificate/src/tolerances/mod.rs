@@ -6,6 +6,7 @@
 //! tests import them, so test and table share one constant and one measurement. The others are
 //! found by scanning the sources (`scanner.rs`) and listed with the reason they are not measured.
 
+mod friction;
 mod matrices;
 mod plane;
 mod random_problems;
@@ -13,6 +14,7 @@ mod scanner;
 mod scenes;
 mod solvers;
 
+pub use friction::*;
 pub use matrices::*;
 pub use plane::*;
 pub use random_problems::*;
@@ -583,6 +585,7 @@ pub fn registry_markdown(
 ) -> Result<String, RunError> {
     let mut measured = measured()?;
     measured.extend(plane_measured()?);
+    measured.extend(friction_measured()?);
     measured.push(Measured {
         name: "BACKWARD_ULPS (units of ε)".into(),
         used_in: "tests/matrices.rs",
