@@ -115,8 +115,11 @@ impl FrictionAudit {
         let r_norm = max_abs(&r[..m + p]);
         let stationarity = max_abs(&self.residual);
         let tol_f = ulp * (self.c_norm * z_norm + b_norm + r_norm) + law.slack_force;
-        // A backward-stable solve's displacement error, and the rounding of z itself.
-        let floor_z = self.inv_norm * tol_f + ulp * z_norm;
+        // A backward-stable solve's displacement error and the rounding of z itself; the
+        // condensed problem sums every reaction's effect on each gap and slip, so they round to
+        // ulps of `Σ_j |S_kj r_j| <= ‖C⁻¹‖∞ ‖r‖₁`.
+        let r_sum: f64 = r[..m + p].iter().map(|v| v.abs()).sum();
+        let floor_z = self.inv_norm * (tol_f + ulp * r_sum) + ulp * z_norm;
         system.solve_in_place(&mut self.residual);
         let displacement = max_abs(&self.residual);
         let tol_dz = floor_z + law.slack_displacement;
