@@ -1,7 +1,7 @@
 //! `viscobar run` on scenes with friction through the binary: the friction columns of
 //! history.csv and the summary's total against the library's run, the figure of the
-//! stick/slip/open state, and bad friction input refused with exit code 2 naming the key,
-//! nothing written.
+//! stick/slip/open state, bad friction input refused with exit code 2 naming the key and a
+//! failed frictional step with exit code 1 naming the step, nothing written.
 
 mod common;
 use common::viscobar;
@@ -134,4 +134,28 @@ const CASES: &[(&str, &[&str], &str)] = &[
 #[test]
 fn bad_friction_input_exits_2_naming_the_key_and_writes_nothing() {
     common::assert_each_refused("plane-tilted-drop", CASES, &fresh_dir("bad"));
+}
+
+#[test]
+fn a_failed_frictional_step_exits_1_naming_the_step_and_writes_nothing() {
+    // OSQP stopped after one iteration cannot solve the first Tresca problem: the run fails
+    // at that step, through the same path as a Lemke ray or a failed friction audit.
+    let out = fresh_dir("fails");
+    let o = viscobar(&[
+        "run",
+        "plane-friction-tilted-drop",
+        "--solver",
+        "osqp",
+        "--set",
+        "solver.max_iter=1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("step 1 (t = 0.005)") && stderr.contains("maximum iterations reached"),
+        "{stderr}"
+    );
+    assert!(!out.exists(), "wrote {}", out.display());
 }

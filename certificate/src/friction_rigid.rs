@@ -169,9 +169,12 @@ fn stiffened(scene: &PlaneScene, kappa: f64) -> PlaneScene {
     s
 }
 
+/// The mean motion `(t, X, V)` of a run after each step.
+pub type MeanHistory = Vec<(f64, f64, f64)>;
+
 /// Runs `scene` and returns the mean motion `(t, X, V)` after each step (`V` at `t − Δt/2`),
 /// from the start-up step on, with the largest identity residual.
-pub fn mean_history(scene: &PlaneScene) -> Result<(Vec<(f64, f64, f64)>, f64), ConvergeError> {
+pub fn mean_history(scene: &PlaneScene) -> Result<(MeanHistory, f64), ConvergeError> {
     let prepared = PlaneSimulation::prepare(scene).map_err(plane_error)?;
     let (u0, v0) = (prepared.state().u.to_vec(), prepared.state().w.to_vec());
     let mut sim = prepared.start().map_err(plane_error)?;
@@ -235,9 +238,9 @@ pub fn rigid_row(kappa: f64) -> Result<RigidRow, ConvergeError> {
 
 /// The launch scene's initial velocity (uniform, along x).
 fn launch_velocity(scene: &PlaneScene) -> Result<f64, ConvergeError> {
-    Ok(scene.expressions()?.velocity[0]
+    scene.expressions()?.velocity[0]
         .eval_xy(0.0, 0.0, 0.0)
-        .map_err(|e| ConvergeError::BadInput(e.to_string()))?)
+        .map_err(|e| ConvergeError::BadInput(e.to_string()))
 }
 
 /// The rigid-limit table over [`STIFFNESSES`].

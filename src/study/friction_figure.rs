@@ -31,6 +31,9 @@ enum State {
     SlipDown,
 }
 
+/// One time row of an edge: per frictional node its state, pressure and traction.
+type NodeRow = Vec<(State, f64, f64)>;
+
 /// One frictional edge's maps.
 struct EdgeMaps {
     edge: usize,
@@ -38,7 +41,7 @@ struct EdgeMaps {
     nodes: Vec<usize>,
     cells: Vec<(f64, f64)>,
     /// Rows: `t` and, per node, its state, pressure and traction.
-    rows: Vec<(f64, Vec<(State, f64, f64)>)>,
+    rows: Vec<(f64, NodeRow)>,
 }
 
 /// The figure's data.
@@ -99,7 +102,7 @@ impl FrictionFigure {
             sim.gaps_into(&mut gaps);
             let (w, r, rt) = (sim.state().w, sim.reactions(), sim.tangential_reactions());
             for e in &mut edges {
-                let row: Vec<(State, f64, f64)> = (e.nodes.iter())
+                let row: NodeRow = (e.nodes.iter())
                     .map(|&j| {
                         let k = friction.normals[j];
                         let delta = w[friction.tangents[j]] + previous[j];
