@@ -15,40 +15,8 @@ use crate::step::condensed::condensed_matrix;
 use crate::step::friction_audit::{FrictionAudit, FrictionLaw, Thresholds};
 use crate::step::lcp::{DenseLcp, LcpError};
 use crate::step::lemke::Lemke;
-use crate::step::solver::Constraints;
+use crate::step::solver::{Constraints, Friction};
 use crate::step::{SetupError, SolveInfo, SolverReport, StepFailure, StepSolver};
-
-/// The frictional nodes of a step problem: node `j` adds the tangential reaction `r_T,j` along
-/// `+e_{t_j}` to the normal constraint `normals[j]`, with coefficient `μ_j > 0`.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Friction {
-    /// The normal constraint `k_j` of each frictional node.
-    pub normals: Vec<usize>,
-    /// The unknown `t_j` of its tangential component.
-    pub tangents: Vec<usize>,
-    /// `μ_j`.
-    pub coefficients: Vec<f64>,
-}
-
-impl Friction {
-    /// `p`, the frictional nodes.
-    pub fn len(&self) -> usize {
-        self.normals.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.normals.is_empty()
-    }
-
-    /// The normal constraints followed by the tangential rows (direction `+1`), as one set of
-    /// rows `E` for the condensation.
-    pub fn rows(&self, constraints: &Constraints) -> Constraints {
-        let mut all = constraints.clone();
-        all.unknowns.extend(&self.tangents);
-        all.directions.extend(std::iter::repeat_n(1.0, self.len()));
-        all
-    }
-}
 
 /// The Stewart–Trinkle LCP matrix of the condensed `S` (`(m + p)²`, row-major, normals then
 /// tangents), scaled by `1/σ`: rows and columns `r_N` (`m`), `β⁺`, `β⁻`, `λ/σ` (`p` each),

@@ -10,9 +10,8 @@
 
 use crate::linalg::norms::max_abs;
 use crate::linalg::system::{SpdSystem, inverse_norm_estimate};
-use crate::step::friction::Friction;
 use crate::step::report::{AuditReport, StepFailure, Worst};
-use crate::step::solver::Constraints;
+use crate::step::solver::{Constraints, Friction};
 
 /// The thresholds `g_j` of the tangential reactions.
 #[derive(Clone, Copy, Debug)]

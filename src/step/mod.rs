@@ -24,11 +24,11 @@ pub mod tresca;
 pub use block_pivot::BlockPivotSolver;
 pub use condensed::CondensedSolver;
 pub use exact::ExactSolver;
-pub use friction::{Friction, FrictionalSolver};
+pub use friction::FrictionalSolver;
 pub use osqp::{OsqpSettings, OsqpSolver};
 pub use penalty::{PenaltySettings, PenaltySolver};
 pub use report::{
     AuditReport, OsqpStatus, SettingsError, SetupError, SolveInfo, SolverReport, StepFailure,
 };
-pub use solver::{Constraints, StepSolver};
+pub use solver::{Constraints, Friction, StepSolver};
 pub use tresca::TrescaSolver;

@@ -17,10 +17,9 @@ use crate::linalg::norms::max_abs;
 use crate::linalg::system::{Csc, SpdSystem};
 use crate::step::audit::{AUDIT_MARGIN, INACCURATE_FACTOR};
 use crate::step::condensed::condensed_matrix;
-use crate::step::friction::Friction;
 use crate::step::friction_audit::{FrictionAudit, FrictionLaw, Thresholds};
 use crate::step::osqp::{OSQP_INFTY, OsqpSettings, osqp_csc, status_of};
-use crate::step::solver::Constraints;
+use crate::step::solver::{Constraints, Friction};
 use crate::step::{SetupError, SolveInfo, SolverReport, StepFailure, StepSolver};
 use osqp::{Problem, Status};
 
