@@ -35,9 +35,10 @@ enum Command {
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
         /// Also draw the run's figures into the output folder: for a plane scene the deformed
-        /// mesh coloured by the von Mises stress at 6 times (deformed.png, deformed.svg) and,
-        /// with Signorini edges, the contact pressure along them (contact-pressure.png, .svg);
-        /// for a bar scene u(x, t) beside the contact reactions (<scene>.png, <scene>.svg).
+        /// mesh coloured by the von Mises stress at 6 times (deformed.png, deformed.svg), with
+        /// Signorini edges the contact pressure over (s, t) (contact-pressure.png, .svg), with
+        /// friction the stick/slip/open state and the forces (friction-state.png, .svg); for a
+        /// bar scene u(x, t) beside the contact reactions (<scene>.png, <scene>.svg).
         #[arg(long)]
         figure: bool,
     },
@@ -398,6 +399,9 @@ fn report(summary: &viscobar::Summary, out: &std::path::Path) {
     );
     for (group, episodes) in &summary.contact_episodes {
         println!("  {group}: {}", episode_line(episodes));
+    }
+    if let Some(d) = summary.friction_dissipation {
+        println!("  friction dissipation {d:.3e}");
     }
     if let Some(n) = summary.inaccurate_steps.filter(|n| *n > 0) {
         eprintln!(

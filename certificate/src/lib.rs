@@ -6,8 +6,9 @@
 //! ([`stiff`], [`stiff_runs`]), the step solvers' agreement ([`agreement`]) with the dense
 //! brute-force [`oracle`], the rigid mode's round-off ([`roundoff`]), the mass variants side by
 //! side ([`mass_study`]), the plane body's checks ([`plane_checks`], [`plane_contact`],
-//! [`plane_symmetry`]), the manufactured viscous contact ([`viscous_contact`]), error against
-//! run time ([`timings`]); the writers of the READMEs' blocks ([`bench_table`], [`peak_memory`]).
+//! [`plane_symmetry`], [`locking`], [`moving`]), its friction ([`friction`], [`friction_rigid`]),
+//! the manufactured viscous contact ([`viscous_contact`]), error against run time ([`timings`]);
+//! the writers of the READMEs' blocks ([`bench_table`], [`peak_memory`]).
 //!
 //! A member crate of the viscobar workspace, beside the library and not part of its API: it
 //! imports `viscobar`, and the integration tests of `viscobar` import it (a dev-dependency),
@@ -16,6 +17,8 @@
 
 pub mod agreement;
 pub mod bench_table;
+pub mod friction;
+pub mod friction_rigid;
 pub mod locking;
 pub mod mass_study;
 pub mod moving;

@@ -6,6 +6,7 @@
 
 use crate::roundoff::rigid_mode_drift;
 use std::fmt::Write;
+use std::sync::OnceLock;
 use viscobar::bar::closed_form;
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
 use viscobar::linalg::norms::max_abs;
@@ -13,6 +14,7 @@ use viscobar::output::run_in_memory;
 use viscobar::scene;
 use viscobar::scheme::RunError;
 use viscobar::study::accuracy::{error_against, observed_order};
+use viscobar::study::converge::ConvergeError;
 
 /// One generated block of VERIFICATION.md.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,50 +29,129 @@ pub const CONVERGENCE_LEVELS: u32 = 5;
 pub const RIGID_ELEMENTS: u64 = 8193;
 pub const RIGID_STEPS: usize = 26_000;
 
-/// All sections, in document order.
+/// One independent computation of the document: its sections (none for a measurement that
+/// sections assemble later).
+type Job<'a> = Box<dyn FnOnce() -> Result<Vec<Section>, ConvergeError> + Send + 'a>;
+
+/// Wraps one section's computation as a [`Job`].
+fn job<'a>(
+    id: &'static str,
+    markdown: impl FnOnce() -> Result<String, ConvergeError> + Send + 'a,
+) -> Job<'a> {
+    Box::new(move || {
+        Ok(vec![Section {
+            id,
+            markdown: markdown()?,
+        }])
+    })
+}
+
+/// Stores the value of a measurement job for the sections assembled after it.
+fn keep<'a, T: Send + Sync>(
+    cell: &'a OnceLock<T>,
+    value: impl FnOnce() -> Result<T, ConvergeError> + Send + 'a,
+) -> Job<'a> {
+    Box::new(move || {
+        let _ = cell.set(value()?);
+        Ok(Vec::new())
+    })
+}
+
+/// All sections (in the order of their jobs; each replaces its own block). The computations
+/// are independent and deterministic, so they run on the machine's cores side by side and give
+/// the same document in any order; the round-off, stiff and tolerance tables are assembled
+/// afterwards from the measurements they share (the stiff case matrix, the rigid-mode run,
+/// the registry's measurements).
 /// Errors are those of the runs and of the α-sweep (both carry their exit code).
-pub fn sections() -> Result<Vec<Section>, viscobar::study::converge::ConvergeError> {
-    let stiff = crate::stiff_runs::run_all(crate::stiff::Size::Full);
-    // One rigid-mode run for the round-off table and the registry's INCREMENT_DRIFT_TOL.
-    let drift = rigid_drift()?;
-    Ok(vec![
-        matrices_section(),
-        solve_section(),
-        scenes_section()?,
-        Section {
-            id: "solver-agreement",
-            markdown: crate::agreement::markdown()?,
-        },
-        convergence_section()?,
-        falling_bar_section()?,
-        Section {
-            id: "viscous-contact",
-            markdown: crate::viscous_contact::markdown(&crate::viscous_contact::study(
-                CONVERGENCE_LEVELS,
-            )?),
-        },
-        roundoff_section(drift),
-        viscosity_section()?,
-        stiff_section(&stiff),
-        tolerances_section(&stiff, drift.0)?,
-        mass_variants_section()?,
-        Section {
-            id: "plane",
-            markdown: crate::plane_checks::markdown()?,
-        },
-        Section {
-            id: "plane-contact",
-            markdown: crate::plane_contact::markdown()?,
-        },
-        Section {
-            id: "locking",
-            markdown: crate::locking::markdown()?,
-        },
-        Section {
-            id: "moving",
-            markdown: crate::moving::markdown()?,
-        },
-    ])
+pub fn sections() -> Result<Vec<Section>, ConvergeError> {
+    let stiff = OnceLock::new();
+    let drift = OnceLock::new();
+    let registry: [OnceLock<Vec<crate::tolerances::Measured>>; 3] = Default::default();
+    let backward = OnceLock::new();
+    let jobs: Vec<Job> = vec![
+        // The longest first.
+        job("plane-friction", crate::friction::markdown),
+        job("plane", crate::plane_checks::markdown),
+        keep(&stiff, || {
+            Ok(crate::stiff_runs::run_all(crate::stiff::Size::Full))
+        }),
+        keep(&registry[0], || Ok(crate::tolerances::measured()?)),
+        keep(&registry[1], || Ok(crate::tolerances::plane_measured()?)),
+        keep(&registry[2], || Ok(crate::tolerances::friction_measured()?)),
+        job("solver-agreement", || Ok(crate::agreement::markdown()?)),
+        job("plane-contact", crate::plane_contact::markdown),
+        Box::new(|| Ok(vec![convergence_section()?, falling_bar_section()?])),
+        keep(&drift, || Ok(rigid_drift()?)),
+        job("viscous-contact", || {
+            let study = crate::viscous_contact::study(CONVERGENCE_LEVELS)?;
+            Ok(crate::viscous_contact::markdown(&study))
+        }),
+        Box::new(|| Ok(vec![viscosity_section()?])),
+        Box::new(|| Ok(vec![mass_variants_section()?])),
+        keep(&backward, || Ok(backward_ulps())),
+        Box::new(|| Ok(vec![matrices_section(), solve_section(), scenes_section()?])),
+        job("locking", || Ok(crate::locking::markdown()?)),
+        job("moving", || Ok(crate::moving::markdown()?)),
+    ];
+    let mut out = run_jobs(jobs)?;
+    let (stiff, drift) = (stiff.get().expect("kept"), *drift.get().expect("kept"));
+    let measured = registry
+        .into_iter()
+        .flat_map(|m| m.into_inner().expect("kept"))
+        .collect();
+    out.push(roundoff_section(drift));
+    out.push(stiff_section(stiff));
+    out.push(Section {
+        id: "tolerances",
+        markdown: crate::tolerances::registry_markdown_of(
+            measured,
+            stiff,
+            drift.0,
+            *backward.get().expect("kept"),
+        ),
+    });
+    Ok(out)
+}
+
+/// Runs `jobs` on up to `available_parallelism` threads, each taking the next job in turn;
+/// the first error (in job order) is returned.
+fn run_jobs(jobs: Vec<Job<'_>>) -> Result<Vec<Section>, ConvergeError> {
+    let count = jobs.len();
+    let queue = std::sync::Mutex::new(jobs.into_iter().enumerate().collect::<Vec<_>>());
+    let results = std::sync::Mutex::new(Vec::with_capacity(count));
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(count);
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| {
+                loop {
+                    // Take from the front: the list starts with the longest jobs.
+                    let next = {
+                        let mut q = queue.lock().expect("no job panics while holding the queue");
+                        if q.is_empty() {
+                            None
+                        } else {
+                            Some(q.remove(0))
+                        }
+                    };
+                    let Some((index, job)) = next else { break };
+                    let result = job();
+                    results
+                        .lock()
+                        .expect("no job panics while holding the results")
+                        .push((index, result));
+                }
+            });
+        }
+    });
+    let mut results = results.into_inner().expect("the threads have ended");
+    results.sort_by_key(|(index, _)| *index);
+    let mut out = Vec::new();
+    for (_, r) in results {
+        out.extend(r?);
+    }
+    Ok(out)
 }
 
 fn matrices_section() -> Section {
@@ -415,14 +496,18 @@ pub fn tolerances_section(
     results: &[crate::stiff::CaseResult],
     increment_drift: f64,
 ) -> Result<Section, RunError> {
-    let backward_ulps = solve_study(&backward_error_nodes())
-        .iter()
-        .map(|c| c.backward_error)
-        .fold(0.0, f64::max);
     Ok(Section {
         id: "tolerances",
-        markdown: crate::tolerances::registry_markdown(results, increment_drift, backward_ulps)?,
+        markdown: crate::tolerances::registry_markdown(results, increment_drift, backward_ulps())?,
     })
+}
+
+/// The worst backward error of the solve over [`backward_error_nodes`], in units of ε.
+fn backward_ulps() -> f64 {
+    solve_study(&backward_error_nodes())
+        .iter()
+        .map(|c| c.backward_error)
+        .fold(0.0, f64::max)
 }
 
 /// The node counts of `tests/matrices.rs`'s backward-error check (`BACKWARD_ULPS`): every small

@@ -2,8 +2,9 @@
 //! terms (empty on steps whose identity was not measured), then per group of constraints its
 //! contact state (a single constraint: `gap_G,reaction_G`; a set: the constraints in contact,
 //! the extent `s` of the contact, the least gap and the total reaction), then the iterations.
-//! A run whose obstacles move has one more energy column, `obstacle_work`, after
-//! `identity_residual`.
+//! Optional columns follow `identity_residual` ([`OptionalColumns`]): `obstacle_work` when an
+//! obstacle moves; with friction, the friction dissipation `D_f` (empty when not measured) and
+//! the frictional nodes that stick and slip.
 
 use crate::output::text::{push_time, push_value};
 use crate::scheme::StepRecord;
@@ -16,12 +17,26 @@ const ENERGY_COLUMNS: &str =
 
 /// The column of a run whose obstacles move.
 const OBSTACLE_COLUMN: &str = ",obstacle_work";
+/// The columns of a run with friction.
+const FRICTION_COLUMNS: &str = ",friction_dissipation,stick_nodes,slip_nodes";
 
-/// The header line for a run with the contact `groups`, and `obstacle_work` when `moving`.
-pub fn header(groups: &[Group], moving: bool) -> String {
+/// Which optional columns a run writes after [`ENERGY_COLUMNS`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OptionalColumns {
+    /// An obstacle moves: `obstacle_work`.
+    pub moving: bool,
+    /// Some edge has friction: `friction_dissipation`, `stick_nodes`, `slip_nodes`.
+    pub friction: bool,
+}
+
+/// The header line for a run with the contact `groups` and the `optional` columns.
+pub fn header(groups: &[Group], optional: OptionalColumns) -> String {
     let mut h = String::from(ENERGY_COLUMNS);
-    if moving {
+    if optional.moving {
         h.push_str(OBSTACLE_COLUMN);
+    }
+    if optional.friction {
+        h.push_str(FRICTION_COLUMNS);
     }
     for g in groups {
         let n = g.name;
@@ -37,8 +52,8 @@ pub fn header(groups: &[Group], moving: bool) -> String {
     h
 }
 
-/// Appends the row of `r` (`row` is cleared first); `groups` and `moving` as in the header.
-pub fn row(r: &StepRecord, groups: &[Group], moving: bool, row: &mut Vec<u8>) {
+/// Appends the row of `r` (`row` is cleared first); `groups` and `optional` as in the header.
+pub fn row(r: &StepRecord, groups: &[Group], optional: OptionalColumns, row: &mut Vec<u8>) {
     row.clear();
     write!(row, "{},", r.step).expect("writing to a vector");
     push_time(r.time, row);
@@ -55,11 +70,18 @@ pub fn row(r: &StepRecord, groups: &[Group], moving: bool, row: &mut Vec<u8>) {
             push_value(v, row);
         }
     }
-    if moving {
+    if optional.moving {
         row.push(b',');
         if r.measured {
             push_value(r.obstacle_work, row);
         }
+    }
+    if optional.friction {
+        row.push(b',');
+        if r.measured {
+            push_value(r.friction_dissipation, row);
+        }
+        write!(row, ",{},{}", r.stick_nodes, r.slip_nodes).expect("writing to a vector");
     }
     for (g, s) in groups.iter().zip(&r.contact.groups) {
         row.push(b',');

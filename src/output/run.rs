@@ -145,8 +145,11 @@ impl Run<'_> {
         let hist_path = dir.join("history.csv");
         let mut hist = std::io::BufWriter::with_capacity(1 << 16, create(&hist_path)?);
         let groups = prepared.contact().groups().to_vec();
-        let moving = prepared.contact().is_moving();
-        hist.write_all(history::header(&groups, moving).as_bytes())
+        let optional = history::OptionalColumns {
+            moving: prepared.contact().is_moving(),
+            friction: !prepared.contact().friction().is_empty(),
+        };
+        hist.write_all(history::header(&groups, optional).as_bytes())
             .map_err(io(&hist_path))?;
         // `t = 0` is written before the start-up step moves `u^0` on (no reactions yet).
         let (body, contact) = (prepared.body(), prepared.contact());
@@ -157,7 +160,7 @@ impl Run<'_> {
         let mut tracker = Tracker::new(&sim, !sim.is_forced());
         let mut row = Vec::new();
         let mut write_row = |hist: &mut std::io::BufWriter<std::fs::File>, r: &StepRecord| {
-            history::row(r, &groups, moving, &mut row);
+            history::row(r, &groups, optional, &mut row);
             hist.write_all(&row)
         };
         write_row(&mut hist, &sim.first_record()).map_err(io(&hist_path))?;

@@ -92,6 +92,9 @@ pub struct Summary {
     /// The contact episodes per group: each Signorini end or edge, and for the bar's obstacle
     /// one list for the whole contact set (an episode lasts while any node is in contact).
     pub contact_episodes: BTreeMap<String, Vec<ContactEpisode>>,
+    /// With friction: the friction dissipation `Σ D_f` over the measured steps (energy).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction_dissipation: Option<f64>,
     pub solver_iterations: Iterations,
     /// What the profile file holds (written runs only): its name and format, kept steps, node
     /// stride, rows.
@@ -170,6 +173,8 @@ pub struct Tracker {
     iterations_sum: u64,
     iterations_max: u32,
     records: usize,
+    /// `Σ D_f` so far, with friction.
+    friction: Option<f64>,
 }
 
 impl Tracker {
@@ -196,6 +201,7 @@ impl Tracker {
             iterations_sum: 0,
             iterations_max: 0,
             records: 0,
+            friction: (!sim.contact().friction().is_empty()).then_some(0.0),
         };
         t.observe_contact(&first);
         t.last_energy = Some(first.energy);
@@ -211,6 +217,9 @@ impl Tracker {
             self.energy_prev = r.energy;
             self.energy_final = r.energy;
             self.max_residual = self.max_residual.max(r.identity_residual);
+            if let Some(total) = self.friction.as_mut() {
+                *total += r.friction_dissipation;
+            }
         }
         self.iterations_sum += u64::from(r.iterations);
         self.iterations_max = self.iterations_max.max(r.iterations);
@@ -299,6 +308,7 @@ impl Tracker {
                         }),
                 )
                 .collect(),
+            friction_dissipation: self.friction,
             solver_iterations: Iterations {
                 mean: self.iterations_sum as f64 / self.records.max(1) as f64,
                 max: self.iterations_max,

@@ -309,13 +309,20 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
         }
     }
     let normals = normals(&disc.grid, &disc.index, &gaps, &u0_full)?;
-    let contact = contact_set(&normals).with_motion(edge_motion(&gaps, &normals));
+    let mu = scene.edges.frictions()?;
+    let friction = crate::plane::friction::frictional_nodes(&normals, &disc.index, &mu);
+    let contact = contact_set(&normals)
+        .with_motion(edge_motion(&gaps, &normals))
+        .with_friction(friction.clone());
     let restrict = |v: &[f64]| disc.free.iter().map(|&d| v[d]).collect::<Vec<f64>>();
     let (displacement, velocity) = (restrict(&u0_full), restrict(&v0_full));
     let c = disc.step_matrix();
     let system = || SparseSystem::new(&disc.pattern, &c, "C");
     let constraints = contact.constraints();
     let solver: Box<dyn StepSolver> = match scene.solver.method {
+        _ if !friction.is_empty() => {
+            crate::plane::friction::frictional_solver(scene, system()?, constraints, friction)?
+        }
         SolverMethod::Exact => Box::new(CondensedSolver::new(system()?, constraints, 0.0)?),
         SolverMethod::Penalty => {
             let epsilon = scene.solver.penalty_settings().epsilon;

@@ -2,7 +2,8 @@
 //! tensor grid graded in `y` ([`mesh`]), the consistent Q1 mass `M` and stiffness `K`
 //! ([`matrices`]), stepped by the scheme ([`crate::scheme`]) through its kernels ([`body`]);
 //! the step matrix is factorised once per run by a sparse Cholesky (faer, AMD). Edges may be
-//! Signorini: each node of such an edge carries a contact normal ([`normals`]). With `λ = 0`,
+//! Signorini: each node of such an edge carries a contact normal ([`normals`]), with Coulomb
+//! friction where the edge has a coefficient ([`friction`]). With `λ = 0`,
 //! `μ = ½`, `ρ = 1` and data `(f(x), 0)` it reduces to the bar exactly (VERIFICATION.md,
 //! "Plane body").
 //!
@@ -13,6 +14,7 @@
 pub mod body;
 pub mod closed_form;
 pub mod energy;
+pub mod friction;
 pub mod matrices;
 pub mod mesh;
 pub mod normals;

@@ -114,7 +114,8 @@ pub enum EdgeCondition {
 }
 
 /// One edge: its condition and, for `signorini`, the gap (a number or an expression in the
-/// edge's coordinate `s`: `x` along bottom and top, `y` along left and right).
+/// edge's coordinate `s`: `x` along bottom and top, `y` along left and right) and the Coulomb
+/// friction coefficient ([`crate::scene::friction`]).
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EdgeSpec {
@@ -125,6 +126,9 @@ pub struct EdgeSpec {
         skip_serializing_if = "Option::is_none"
     )]
     pub gap: Option<String>,
+    /// `μ >= 0` of a Signorini edge (absent: 0, frictionless).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<f64>,
 }
 
 impl EdgeSpec {
@@ -133,6 +137,7 @@ impl EdgeSpec {
         Self {
             condition,
             gap: None,
+            friction: None,
         }
     }
 
@@ -141,6 +146,7 @@ impl EdgeSpec {
         Self {
             condition: EdgeCondition::Signorini,
             gap: Some(gap.to_string()),
+            friction: None,
         }
     }
 }
@@ -459,6 +465,7 @@ impl PlaneScene {
         self.solver.validate()?;
         self.expressions()?;
         self.edges.gaps()?;
+        self.validate_friction()?;
         let m = self.contact_normals();
         if self.solver.method == SolverMethod::Exact {
             let dense = m

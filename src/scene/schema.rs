@@ -362,6 +362,18 @@ pub const PLANE_BUILTIN: &[(&str, &str)] = &[
         "plane-block-drop",
         include_str!("../../scenes/plane-block-drop.toml"),
     ),
+    (
+        "plane-friction-tilted-drop",
+        include_str!("../../scenes/plane-friction-tilted-drop.toml"),
+    ),
+    (
+        "plane-friction-slope",
+        include_str!("../../scenes/plane-friction-slope.toml"),
+    ),
+    (
+        "plane-friction-launch",
+        include_str!("../../scenes/plane-friction-launch.toml"),
+    ),
 ];
 
 /// The TOML text of a built-in plane scene.

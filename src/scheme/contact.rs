@@ -9,7 +9,7 @@
 //! ([`GapMotion`]): its gaps `g_k(t)` are then set before each step's bounds.
 
 use crate::scene::{Expression, SceneError};
-use crate::step::Constraints;
+use crate::step::{Constraints, Friction};
 use std::ops::Range;
 
 /// A constraint is in contact when its gap is at most this: the exact solvers put an active
@@ -72,6 +72,8 @@ pub struct ContactSet {
     groups: Vec<Group>,
     /// The obstacles that move, if any ([`ContactSet::with_motion`]).
     motion: Option<Box<GapMotion>>,
+    /// The frictional nodes (none without friction), [`crate::scheme::friction`].
+    friction: Friction,
 }
 
 /// One constraint whose obstacle moves: `g_k(t) = min(law(s, t), cap)`.
@@ -168,6 +170,7 @@ impl ContactSet {
             positions,
             groups,
             motion: None,
+            friction: Friction::default(),
         }
     }
 
@@ -227,6 +230,22 @@ impl ContactSet {
             work += -0.5 * r[k] * (self.gaps[k] - motion.earlier[k]);
         }
         work
+    }
+
+    /// The same constraints with Coulomb friction at the nodes of `friction`.
+    pub fn with_friction(mut self, friction: Friction) -> Self {
+        self.friction = friction;
+        self
+    }
+
+    /// The frictional nodes (empty without friction).
+    pub fn friction(&self) -> &Friction {
+        &self.friction
+    }
+
+    /// Reactions of a step: one per constraint, then one tangential per frictional node.
+    pub fn reaction_len(&self) -> usize {
+        self.len() + self.friction.len()
     }
 
     /// No constraint.

@@ -11,11 +11,13 @@ pub mod body;
 pub mod clock;
 pub mod contact;
 pub mod error;
+pub mod friction;
 pub mod load;
 pub mod stepper;
 
 pub use body::{Body, EnergySums};
 pub use contact::{CONTACT_GAP_TOL, ContactSet, ContactState, GroupState, in_contact};
 pub use error::RunError;
+pub use friction::{FrictionState, SLIP_TOL, is_slipping};
 pub use load::Load;
 pub use stepper::{Scheme, Setup, State, StepRecord, Unstarted};

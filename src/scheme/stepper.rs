@@ -28,12 +28,17 @@ pub struct StepRecord {
     pub viscous_dissipation: f64,
     /// `D = −½ Σ_k r_k (s_k (u^{n+1} − u^{n−1})_{i_k} + g_k^{n+1} − g_k^{n−1}) >= 0`.
     pub contact_dissipation: f64,
-    /// `|E^{n+1/2} − E^{n−1/2} − work − obstacle_work + viscous + D|` over the largest of
-    /// those terms.
+    /// `|E^{n+1/2} − E^{n−1/2} − work − obstacle_work + viscous + D + D_f|` over the largest
+    /// of those terms.
     pub identity_residual: f64,
     /// `W = −½ Σ_k r_k (g_k^{n+1} − g_k^{n−1})`, the work of moving obstacles (0 when none
     /// moves; of either sign).
     pub obstacle_work: f64,
+    /// `D_f = −½ Σ_j r_T,j δ_j >= 0`, the friction dissipation (0 without friction).
+    pub friction_dissipation: f64,
+    /// Frictional nodes in contact that stick and that slip ([`crate::scheme::friction`]).
+    pub stick_nodes: usize,
+    pub slip_nodes: usize,
     /// The contact state of `u^{n+1}`.
     pub contact: ContactState,
     /// The step solver's iterations (active sets tried, ADMM iterations…).
@@ -100,7 +105,7 @@ impl<B: Body> Scheme<B> {
     /// The scheme set up, `u^0` held, the start-up step not taken ([`Unstarted::start`]).
     pub fn unstarted(setup: Setup<B>) -> Unstarted<B> {
         let n = setup.body.unknowns();
-        let k = setup.contact.len();
+        let (k, reactions) = (setup.contact.len(), setup.contact.reaction_len());
         let scheme = Self {
             solver: setup.solver,
             contact: setup.contact,
@@ -112,7 +117,7 @@ impl<B: Body> Scheme<B> {
             z: vec![0.0; n],
             b: vec![0.0; n],
             lower: vec![0.0; k],
-            reactions: vec![0.0; k],
+            reactions: vec![0.0; reactions],
             balance: Balance {
                 energy: 0.0,
                 potential: 0.0,
@@ -187,6 +192,8 @@ impl<B: Body> Scheme<B> {
         };
         let state = (&self.u[..], &self.z[..], &self.w[..], &self.reactions[..]);
         self.contact.measure(state, false, &mut record.contact);
+        let friction = self.contact.measure_friction(state, false);
+        (record.stick_nodes, record.slip_nodes) = (friction.stick_nodes, friction.slip_nodes);
         std::mem::swap(&mut self.w, &mut self.z);
         self.n = 1;
         self.first_record = record;
@@ -223,7 +230,9 @@ impl<B: Body> Scheme<B> {
     ///    complementarity and the admissibility of `u^{n−1}`: contact only dissipates. A moving
     ///    obstacle adds its work `W = −½ Σ_k r_k (g_k^{n+1} − g_k^{n−1})` to the right-hand
     ///    side and `g^{n+1} − g^{n−1}` to `D`'s bracket ([`ContactSet::advance_gaps`],
-    ///    [docs/moving-obstacles.md](../../docs/moving-obstacles.md)).
+    ///    [docs/moving-obstacles.md](../../docs/moving-obstacles.md)). With friction the
+    ///    right-hand side also loses `D_f = −½ Σ_j r_T,j δ_{t_j} >= 0`
+    ///    ([`crate::scheme::friction`]); the solver reads `w` for the central slip.
     ///
     /// The identity is measured every `[output] diagnostics_every`-th step and at the last; a
     /// measured step after an unmeasured one first recomputes `E^{n−1/2}` from `u^n` and `w`,
@@ -245,6 +254,7 @@ impl<B: Body> Scheme<B> {
         }
         // 3. The constrained minimisation, and u^{n+1} = u^n + z.
         self.solver.set_state_scale(self.u_scale);
+        self.solver.set_previous_increment(&self.w);
         let (info, u_scale) = self
             .solver
             .solve_and_advance(
@@ -267,10 +277,12 @@ impl<B: Body> Scheme<B> {
         };
         let state = (&self.u[..], &self.z[..], &self.w[..], &self.reactions[..]);
         let contact = self.contact.measure(state, measure, &mut record.contact);
+        let friction = self.contact.measure_friction(state, measure);
+        (record.stick_nodes, record.slip_nodes) = (friction.stick_nodes, friction.slip_nodes);
         if measure {
             let sums = (self.body).energy_sums(&self.u, &self.z, &self.w, self.load.force());
             record.obstacle_work = self.contact.obstacle_work(&self.reactions);
-            self.close_balance(&mut record, sums, contact)?;
+            self.close_balance(&mut record, sums, [contact, friction.dissipation])?;
         }
         self.balance.measured = measure;
         std::mem::swap(&mut self.w, &mut self.z);
@@ -290,13 +302,13 @@ impl<B: Body> Scheme<B> {
             0.5 * self.body.mass_form(&self.w) * (1.0 / (dt * dt)) + 0.25 * (potential + before);
     }
 
-    /// The energy identity of the step just taken from its sums and the contact term `D`,
-    /// into `record`; the balance moves on to `n + 1`.
+    /// The energy identity of the step just taken from its sums, the contact term `D` and the
+    /// friction term `D_f`, into `record`; the balance moves on to `n + 1`.
     fn close_balance(
         &mut self,
         record: &mut StepRecord,
         sums: EnergySums,
-        contact: f64,
+        [contact, friction]: [f64; 2],
     ) -> Result<(), RunError> {
         let (dt, alpha) = (self.body.dt(), self.body.viscosity());
         let before = self.balance.energy;
@@ -310,9 +322,9 @@ impl<B: Body> Scheme<B> {
         let work = 0.5 * sums.work;
         let obstacle = record.obstacle_work;
         let residual = if obstacle == 0.0 {
-            energy - before - work + viscous + contact
+            energy - before - work + viscous + contact + friction
         } else {
-            energy - before - work - obstacle + viscous + contact
+            energy - before - work - obstacle + viscous + contact + friction
         };
         let scale = [
             energy,
@@ -321,6 +333,7 @@ impl<B: Body> Scheme<B> {
             viscous,
             contact.abs(),
             obstacle.abs(),
+            friction.abs(),
         ]
         .into_iter()
         .fold(0.0, f64::max);
@@ -331,6 +344,7 @@ impl<B: Body> Scheme<B> {
         record.work = work;
         record.viscous_dissipation = viscous;
         record.contact_dissipation = contact;
+        record.friction_dissipation = friction;
         record.identity_residual = if scale > 0.0 {
             residual.abs() / scale
         } else {
@@ -450,7 +464,12 @@ impl<B: Body> Scheme<B> {
 
     /// The reactions of the last step, one per constraint.
     pub fn reactions(&self) -> &[f64] {
-        &self.reactions
+        &self.reactions[..self.contact.len()]
+    }
+
+    /// The tangential reactions of the last step, one per frictional node (empty without).
+    pub fn tangential_reactions(&self) -> &[f64] {
+        &self.reactions[self.contact.len()..]
     }
 
     /// The gaps `s_k u^n_{i_k} + g_k` of every constraint.

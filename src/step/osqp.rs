@@ -87,7 +87,7 @@ impl OsqpSettings {
         Ok(())
     }
 
-    fn to_osqp(self) -> Settings {
+    pub(crate) fn to_osqp(self) -> Settings {
         Settings::default()
             .verbose(false)
             .eps_abs(self.eps_abs)
@@ -121,7 +121,7 @@ impl<S: SpdSystem> std::fmt::Debug for OsqpSolver<S> {
     }
 }
 
-fn osqp_csc(m: Csc) -> CscMatrix<'static> {
+pub(crate) fn osqp_csc(m: Csc) -> CscMatrix<'static> {
     CscMatrix {
         nrows: m.nrows,
         ncols: m.ncols,

@@ -93,6 +93,15 @@ pub enum StepFailure {
         value: f64,
         tolerance: f64,
     },
+    /// The frictional step's complementarity problem was not solved (Lemke's method).
+    #[error("solver status: {0}")]
+    Lemke(#[from] crate::step::lemke::LemkeError),
+    /// The fixed point of Tresca problems (OSQP with friction) did not settle.
+    #[error(
+        "solver status: the fixed point of Tresca problems did not converge in {iterations} \
+         iterations (last relative change of the normal reactions {change:e})"
+    )]
+    FixedPoint { iterations: u32, change: f64 },
 }
 
 /// The worst value of one audited quantity over a run, and its worst ratio to its tolerance
@@ -139,6 +148,13 @@ pub struct AuditReport {
     pub stationarity: Worst,
     /// `‖C⁻¹(Cz − b − Σ r_j e_j)‖_∞`, displacement.
     pub stationarity_displacement: Worst,
+    /// Friction: `max_j (|r_T,j| − μ_j r_N,j)⁺`, force (the Coulomb cone).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction_cone: Option<Worst>,
+    /// Friction: `max_j |μ_j r_N,j |δ_j| + r_T,j δ_j|` (`δ` the central slip), force ×
+    /// displacement: 0 when `r_T = −μ r_N sign δ` wherever `δ ≠ 0`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slip_law: Option<Worst>,
 }
 
 /// Why a step solver could not be set up: bad input, as opposed to a [`StepFailure`] during a

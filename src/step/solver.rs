@@ -43,6 +43,38 @@ impl Constraints {
     }
 }
 
+/// The frictional nodes of a step problem: node `j` adds the tangential reaction `r_T,j` along
+/// `+e_{t_j}` to the normal constraint `normals[j]`, with coefficient `μ_j > 0`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Friction {
+    /// The normal constraint `k_j` of each frictional node.
+    pub normals: Vec<usize>,
+    /// The unknown `t_j` of its tangential component.
+    pub tangents: Vec<usize>,
+    /// `μ_j`.
+    pub coefficients: Vec<f64>,
+}
+
+impl Friction {
+    /// `p`, the frictional nodes.
+    pub fn len(&self) -> usize {
+        self.normals.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.normals.is_empty()
+    }
+
+    /// The normal constraints followed by the tangential rows (direction `+1`), as one set of
+    /// rows `E` for the condensation.
+    pub fn rows(&self, constraints: &Constraints) -> Constraints {
+        let mut all = constraints.clone();
+        all.unknowns.extend(&self.tangents);
+        all.directions.extend(std::iter::repeat_n(1.0, self.len()));
+        all
+    }
+}
+
 /// A solver for the step problem. Built once per run for a fixed `C` and fixed
 /// [`Constraints`]; `solve` is called every step and must not allocate.
 pub trait StepSolver {
@@ -50,7 +82,9 @@ pub trait StepSolver {
     fn name(&self) -> &'static str;
 
     /// Given `rhs = b` and `lower = lo` (one entry per constraint, in the order given at
-    /// construction), writes the minimiser into `z` and the multipliers into `reactions`.
+    /// construction), writes the minimiser into `z` and the multipliers into `reactions` (a
+    /// frictional solver writes, after them, the tangential reaction of each frictional node,
+    /// [`crate::step::friction`]).
     fn solve(
         &mut self,
         rhs: &[f64],
@@ -78,6 +112,11 @@ pub trait StepSolver {
         let info = self.solve(rhs, lower, z, reactions)?;
         Ok((info, crate::linalg::update::add_in_place(u, z)))
     }
+
+    /// The previous increment `w = u^n − u^{n−1}`, given before each solve of a step after the
+    /// start-up step: a frictional solver's central slip is `(z + w)` at its tangential
+    /// unknowns. Default: ignored.
+    fn set_previous_increment(&mut self, _w: &[f64]) {}
 
     /// Statistics over all solves so far; `None` for solvers that keep none.
     fn report(&self) -> Option<SolverReport> {

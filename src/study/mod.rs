@@ -11,6 +11,7 @@ pub mod converge;
 pub mod convergence_table;
 pub mod figure_writer;
 pub mod figures;
+pub mod friction_figure;
 pub mod mass_figure;
 pub mod mass_variants;
 pub mod plane_contact_figure;

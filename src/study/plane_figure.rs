@@ -269,8 +269,9 @@ impl Drawing for PlaneFigure {
     }
 }
 
-/// Runs `scene` and writes `deformed.png` and `deformed.svg` into `out`, and with Signorini
-/// edges `contact-pressure.png`/`.svg` ([`crate::study::plane_contact_figure`]); returns their
+/// Runs `scene` and writes `deformed.png` and `deformed.svg` into `out`, with Signorini
+/// edges `contact-pressure.png`/`.svg` ([`crate::study::plane_contact_figure`]) and with
+/// friction `friction-state.png`/`.svg` ([`crate::study::friction_figure`]); returns their
 /// paths.
 pub fn write(name: &str, scene: &PlaneScene, out: &Path) -> Result<Vec<PathBuf>, PlaneFigureError> {
     register_font()?;
@@ -289,6 +290,9 @@ pub fn write(name: &str, scene: &PlaneScene, out: &Path) -> Result<Vec<PathBuf>,
         crate::study::plane_contact_figure::ContactPressureFigure::run(name, scene)?
     {
         files.extend(contact.write(out)?);
+    }
+    if let Some(friction) = crate::study::friction_figure::FrictionFigure::run(name, scene)? {
+        files.extend(friction.write(out)?);
     }
     Ok(files)
 }

@@ -6,6 +6,7 @@
 //! tests import them, so test and table share one constant and one measurement. The others are
 //! found by scanning the sources (`scanner.rs`) and listed with the reason they are not measured.
 
+mod friction;
 mod matrices;
 mod plane;
 mod random_problems;
@@ -13,6 +14,7 @@ mod scanner;
 mod scenes;
 mod solvers;
 
+pub use friction::*;
 pub use matrices::*;
 pub use plane::*;
 pub use random_problems::*;
@@ -583,6 +585,23 @@ pub fn registry_markdown(
 ) -> Result<String, RunError> {
     let mut measured = measured()?;
     measured.extend(plane_measured()?);
+    measured.extend(friction_measured()?);
+    Ok(registry_markdown_of(
+        measured,
+        results,
+        increment_drift,
+        backward_ulps,
+    ))
+}
+
+/// [`registry_markdown`] from the measurements `measured` (those of [`measured`],
+/// [`plane_measured`] and [`friction_measured`], in that order) taken apart.
+pub fn registry_markdown_of(
+    mut measured: Vec<Measured>,
+    results: &[CaseResult],
+    increment_drift: f64,
+    backward_ulps: f64,
+) -> String {
     measured.push(Measured {
         name: "BACKWARD_ULPS (units of ε)".into(),
         used_in: "tests/matrices.rs",
@@ -602,11 +621,11 @@ pub fn registry_markdown(
         ("OSQP_AGREEMENT_REL", "certificate/src/stiff.rs"),
         ("OSQP_STEP_ABS", "certificate/src/stiff.rs"),
     ];
-    Ok(markdown(
+    markdown(
         &measured,
         &stiff_checks(results),
         &scanner::uncovered(&covered),
-    ))
+    )
 }
 
 /// The error of a built-in scene whose data the registry cannot use (not a panic).

@@ -103,13 +103,15 @@ pub fn plane_worst() -> Result<PlaneWorst, RunError> {
     for (name, scene) in identity_scenes() {
         let (records, summary, checks) = checked_run(&name, &scene).map_err(plane_run_error)?;
         let sim_has_contact = !scene.edges.gaps()?.iter().all(Option::is_none);
+        // The friction scenes' gaps are held by their audit (tests/friction.rs), as in the test.
+        let frictional = scene.edges.frictions()?.iter().any(|mu| *mu > 0.0);
         for r in records.iter().skip(1) {
             w.identity = w.identity.max(r.identity_residual);
         }
         if let Some(rise) = summary.max_energy_rise {
             w.energy_rise = w.energy_rise.max(rise);
         }
-        for (r, c) in records.iter().zip(&checks) {
+        for (r, c) in records.iter().zip(&checks).filter(|_| !frictional) {
             if sim_has_contact && r.energy > 0.0 {
                 w.gap = w.gap.max(-r.contact_dissipation / r.energy);
             }

@@ -1,0 +1,102 @@
+//! Snapshot regression of `plane-friction-tilted-drop`: statistics of the run at 11 steps
+//! (`n = 1`, the start-up step, and `N/10, …, N`), rounded, in the reviewed YAML file
+//! `snapshots/plane/plane-friction-tilted-drop.snap` (never raw matrices or fields). A change
+//! that moves the frictional drop's numbers fails this test; the README ("Snapshots") says how
+//! to review and accept it.
+//!
+//! Rounding: each quantity to [`SIGNIFICANT_DIGITS`] digits of its largest magnitude over the
+//! run, as `tests/plane_contact_snapshot.rs`: far above the run's round-off, far below its
+//! discretisation error.
+
+use insta::with_settings;
+use serde::Serialize;
+use viscobar::plane::PlaneSimulation;
+use viscobar_certificate::plane_contact::plane_scene;
+
+/// Significant digits kept, relative to the largest magnitude of each quantity.
+const SIGNIFICANT_DIGITS: i32 = 7;
+/// Rows of the snapshot (10 intervals).
+const T_POINTS: usize = 11;
+
+fn round_sig(x: f64, scale: f64) -> f64 {
+    if x == 0.0 || scale == 0.0 {
+        return x;
+    }
+    let exponent = scale.abs().log10().floor() as i32 - (SIGNIFICANT_DIGITS - 1);
+    let q = 10f64.powi(exponent);
+    let digits = (-exponent).max(0) as usize;
+    let r: f64 = format!("{:.*}", digits, (x / q).round() * q)
+        .parse()
+        .unwrap();
+    r + 0.0
+}
+
+#[derive(Serialize)]
+struct Row {
+    step: usize,
+    t: f64,
+    energy: f64,
+    /// `Σ D_f` up to this step.
+    friction_dissipation: f64,
+    /// Frictional nodes in contact that stick, and that slip.
+    stick: usize,
+    slip: usize,
+    /// `Σ r_N` and `Σ r_T`.
+    normal_force: f64,
+    tangential_force: f64,
+    /// The mean displacement of the nodes (x, y).
+    mean_u: [f64; 2],
+}
+
+#[test]
+fn the_frictional_tilted_drop_matches_its_reviewed_snapshot() {
+    let scene = plane_scene("plane-friction-tilted-drop", &[]).unwrap();
+    let steps = scene.steps();
+    let mut sim = PlaneSimulation::new(&scene).unwrap();
+    let mut rows = Vec::new();
+    let mut record = sim.first_record();
+    let mut dissipated = 0.0;
+    for n in 1..=steps {
+        if n > 1 {
+            record = sim.step().unwrap();
+            dissipated += record.friction_dissipation;
+        }
+        if n > 1 && !(n * (T_POINTS - 1)).is_multiple_of(steps) {
+            continue;
+        }
+        let u = sim.displacement_dofs();
+        let nodes = sim.discretisation().grid.nodes() as f64;
+        let mean_u = [0, 1].map(|k| u.iter().skip(k).step_by(2).sum::<f64>() / nodes);
+        rows.push(Row {
+            step: n,
+            t: n as f64 * scene.time.step,
+            energy: record.energy,
+            friction_dissipation: dissipated,
+            stick: record.stick_nodes,
+            slip: record.slip_nodes,
+            normal_force: sim.reactions().iter().sum::<f64>() + 0.0,
+            tangential_force: sim.tangential_reactions().iter().sum::<f64>() + 0.0,
+            mean_u,
+        });
+    }
+    let scale = |f: &dyn Fn(&Row) -> f64| rows.iter().map(|r| f(r).abs()).fold(0.0, f64::max);
+    let (se, sd, sn, st) = (
+        scale(&|r| r.energy),
+        scale(&|r| r.friction_dissipation),
+        scale(&|r| r.normal_force),
+        scale(&|r| r.tangential_force),
+    );
+    let su = scale(&|r| r.mean_u[0].abs().max(r.mean_u[1].abs()));
+    for r in &mut rows {
+        r.t = round_sig(r.t, 1.0);
+        r.energy = round_sig(r.energy, se);
+        r.friction_dissipation = round_sig(r.friction_dissipation, sd);
+        r.normal_force = round_sig(r.normal_force, sn);
+        r.tangential_force = round_sig(r.tangential_force, st);
+        r.mean_u = r.mean_u.map(|v| round_sig(v, su));
+    }
+    assert_eq!(rows.len(), T_POINTS);
+    with_settings!({snapshot_path => "../snapshots/plane", prepend_module_to_snapshot => false}, {
+        insta::assert_yaml_snapshot!("plane-friction-tilted-drop", &rows);
+    });
+}
