@@ -1,6 +1,4 @@
-//! # viscobar-certificate
-//!
-//! The certificate of [`viscobar`]: the studies that recompute the generated tables of
+//! # viscobar-certificate: the certificate of [`viscobar`]: the studies that recompute the generated tables of
 //! VERIFICATION.md ([`verify`]), the tolerance registry that measures every tolerance of the
 //! tests against the worst value it guards ([`tolerances`]), the stiff and extreme case matrix
 //! ([`stiff`], [`stiff_runs`]), the step solvers' agreement ([`agreement`]) with the dense

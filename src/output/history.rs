@@ -20,7 +20,7 @@ const OBSTACLE_COLUMN: &str = ",obstacle_work";
 /// The columns of a run with friction.
 const FRICTION_COLUMNS: &str = ",friction_dissipation,stick_nodes,slip_nodes";
 
-/// Which optional columns a run writes after [`ENERGY_COLUMNS`].
+/// Which optional columns a run writes after `identity_residual`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct OptionalColumns {
     /// An obstacle moves: `obstacle_work`.
