@@ -7,7 +7,7 @@
 //! brute-force [`oracle`], the rigid mode's round-off ([`roundoff`]), the mass variants side by
 //! side ([`mass_study`]), the plane body's checks ([`plane_checks`], [`plane_contact`]), the
 //! manufactured viscous contact ([`viscous_contact`]), error against run time ([`timings`]);
-//! and the tools that write the measured blocks of the READMEs ([`bench_table`], [`peak_memory`]).
+//! the measured blocks of the READMEs ([`bench_table`], [`bench_compare`], [`peak_memory`]).
 //!
 //! A member crate of the viscobar workspace, beside the library and not part of its API: it
 //! imports `viscobar`, and the integration tests of `viscobar` import it (a dev-dependency),
@@ -15,6 +15,7 @@
 //! `cargo run --release -p viscobar-certificate -- --help`.
 
 pub mod agreement;
+pub mod bench_compare;
 pub mod bench_table;
 pub mod mass_study;
 pub mod oracle;

@@ -12,6 +12,7 @@ pub mod exact;
 pub mod lcp;
 pub mod osqp;
 pub mod penalty;
+mod pivot_sweeps;
 pub mod report;
 pub mod schur;
 pub mod solver;
