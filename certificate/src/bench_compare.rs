@@ -212,13 +212,11 @@ pub fn markdown(o: &Options) -> Result<String, String> {
     );
     writeln!(
         out,
-        "Commands, for K = 1, 2, … in turn (`$BASE` a worktree of {} with its own `target/`):\n",
+        "Commands, for K = 1, 2, … in turn (`$BASE` a worktree of {} with its own `target/`): \
+         `(cd $BASE && {bench})`, then the same here.",
         o.base_commit
     )
     .unwrap();
-    writeln!(out, "    git worktree add $BASE {}", o.base_commit).unwrap();
-    writeln!(out, "    (cd $BASE && {bench})").unwrap();
-    writeln!(out, "    {bench}").unwrap();
     Ok(out)
 }
 

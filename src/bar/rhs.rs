@@ -8,7 +8,7 @@ use crate::linalg::tridiag::SymTridiag;
 /// x_i)` (`s_i` the row sum), in the order of [`SymTridiag::mul_into`]: for the stiffness
 /// matrix (`s = 0`) the round-off is relative to the differences of `x`, so a rigid offset of
 /// the bar adds none.
-pub(crate) fn row_of(a: &SymTridiag, x: impl Fn(usize) -> f64, i: usize, n: usize) -> f64 {
+pub fn row_of(a: &SymTridiag, x: impl Fn(usize) -> f64, i: usize, n: usize) -> f64 {
     let mut r = a.row_sums()[i] * x(i);
     if i > 0 {
         r += a.off[i - 1] * (x(i - 1) - x(i));
@@ -22,7 +22,7 @@ pub(crate) fn row_of(a: &SymTridiag, x: impl Fn(usize) -> f64, i: usize, n: usiz
 /// `b = F + M w/Δt² + R y` with `y = c_w w − u`, `c_w = ½ − α/(2Δt)`, `inv_dt2 = 1/Δt²`: row
 /// `i` is `(R y)_i + (M w)_i/Δt² + F_i`, each product by [`row_of`] (no force without a load).
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn rhs_into(
+pub fn rhs_into(
     mass: &SymTridiag,
     stiffness: &SymTridiag,
     c_w: f64,

@@ -11,7 +11,7 @@ use crate::linalg::tridiag::{SymTridiag, Uniform};
 /// of `M` and `R`; `LOAD = false` skips the force.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-pub(crate) fn rhs_into_uniform<const LOAD: bool>(
+pub fn rhs_into_uniform<const LOAD: bool>(
     mass: &SymTridiag,
     stiffness: &SymTridiag,
     (mi, ri): (Uniform, Uniform),
