@@ -6,7 +6,7 @@
 //! side ([`mass_study`]), the plane body's checks ([`plane_checks`], [`plane_contact`],
 //! [`plane_symmetry`], [`locking`], [`moving`]), its friction ([`friction`], [`friction_rigid`]),
 //! the manufactured viscous contact ([`viscous_contact`]), error against run time ([`timings`]);
-//! the writers of the READMEs' blocks ([`bench_table`], [`peak_memory`]).
+//! the measured blocks of the READMEs ([`bench_table`], [`bench_compare`], [`peak_memory`]).
 //!
 //! A member crate of the viscobar workspace, beside the library and not part of its API: it
 //! imports `viscobar`, and the integration tests of `viscobar` import it (a dev-dependency),
@@ -14,6 +14,7 @@
 //! `cargo run --release -p viscobar-certificate -- --help`.
 
 pub mod agreement;
+pub mod bench_compare;
 pub mod bench_table;
 pub mod friction;
 pub mod friction_rigid;

@@ -1,12 +1,13 @@
 //! The certificate's commands: `verify` regenerates the measured tables of VERIFICATION.md,
 //! `solver-agreement` prints one of them, `bench-table` writes the criterion timings into
-//! README.md and benches/README.md, `peak-memory` measures a long run's resident memory.
+//! README.md and benches/README.md, `bench-compare` the bar's steps beside another commit's,
+//! `peak-memory` measures a long run's resident memory.
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use viscobar_certificate::peak_memory::Ends;
 use viscobar_certificate::{
-    agreement, bench_table, peak_memory, stiff, stiff_runs, timings, verify,
+    agreement, bench_compare, bench_table, peak_memory, stiff, stiff_runs, timings, verify,
 };
 
 #[derive(Parser)]
@@ -51,6 +52,26 @@ enum Command {
         #[arg(long, value_name = "FILE", num_args = 1..)]
         update: Option<Vec<PathBuf>>,
     },
+    /// Print criterion's medians of the bar's step benches beside a base commit's (another
+    /// worktree's `target/criterion`), with the ratio and the 1.15x limit, as Markdown.
+    BenchCompare {
+        /// The base commit's `target/criterion`.
+        #[arg(long, value_name = "DIR", required_unless_present = "twins")]
+        base: Option<PathBuf>,
+        /// The base commit, as the block names it.
+        #[arg(long, value_name = "REV", required_unless_present = "twins")]
+        base_commit: Option<String>,
+        /// Instead, each optimised twin's factor on a step, from `cargo bench --bench twins`
+        /// (the block `bench-twins`).
+        #[arg(long)]
+        twins: bool,
+        /// The criterion baselines of the runs on both sides (`--save-baseline`), comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "new")]
+        runs: Vec<String>,
+        /// Rewrite the block (`bench-compare` or `bench-twins`) of this file instead of printing.
+        #[arg(long, value_name = "FILE")]
+        update: Option<PathBuf>,
+    },
     /// Run a long viscoelastic bar to files and print its timings and the peak resident memory
     /// of this process (target: 1e6 elements, 1e4 steps under 200 MB).
     PeakMemory {
@@ -86,6 +107,19 @@ fn main() {
             }
         },
         Command::BenchTable { update } => bench_table::run(update.as_deref()),
+        Command::BenchCompare {
+            base,
+            base_commit,
+            twins,
+            runs,
+            update,
+        } => bench_compare::run(&bench_compare::Options {
+            base: base.unwrap_or_default(),
+            base_commit: base_commit.unwrap_or_default(),
+            twins,
+            runs,
+            update,
+        }),
         Command::PeakMemory {
             elements,
             steps,

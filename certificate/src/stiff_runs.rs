@@ -56,11 +56,6 @@ impl StepSolver for Traced {
         self.inner.name()
     }
 
-    // Forwarded, so that the matrix audits the solver as runs use it.
-    fn set_state_scale(&mut self, max_abs_u: f64) {
-        self.inner.set_state_scale(max_abs_u);
-    }
-
     fn solve(
         &mut self,
         rhs: &[f64],

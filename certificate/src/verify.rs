@@ -203,7 +203,8 @@ pub struct SolveCase {
     pub alpha: f64,
     pub dt_over_dx: f64,
     pub nodes: usize,
-    /// Normwise backward error of `Ldlt::solve_in_place`, in units of ε.
+    /// Normwise backward error of the per-step solve `TwistedLdlt::solve_in_place`, in units
+    /// of ε.
     pub backward_error: f64,
     /// Whether `solve_into` gave the same bits.
     pub into_same_bits: bool,
@@ -228,7 +229,7 @@ pub fn solve_study(nodes: &[usize]) -> Vec<SolveCase> {
                 &r,
             );
             let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() + 0.1).collect();
-            let Ok(factor) = viscobar::linalg::ldlt::Ldlt::factor(&c) else {
+            let Ok(factor) = viscobar::linalg::ldlt_fast::TwistedLdlt::factor(&c) else {
                 continue;
             };
             let mut x = b.clone();

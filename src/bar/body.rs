@@ -4,10 +4,13 @@
 //! penalty, OSQP). A run of a bar scene is a [`Simulation`], the scheme stepping this body.
 
 use crate::bar::discretisation::{Discretisation, InitialData};
-use crate::bar::energy::{measure, potential_of_difference};
+use crate::bar::energy::{energy_sums, potential_of_difference};
+use crate::bar::energy_fast::energy_sums_uniform;
 use crate::bar::matrices;
 use crate::bar::rhs::rhs_into;
-use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite};
+use crate::bar::rhs_fast::rhs_into_uniform;
+use crate::linalg::ldlt::NotPositiveDefinite;
+use crate::linalg::ldlt_fast::TwistedLdlt;
 use crate::linalg::tridiag::Uniform;
 use crate::scene::expr::Expression;
 use crate::scene::{Condition, Scene, SceneError, SolverMethod};
@@ -19,36 +22,47 @@ use crate::step::{BlockPivotSolver, ExactSolver, OsqpSolver, PenaltySolver, Step
 /// A run of a bar scene: the scheme stepping the bar.
 pub type Simulation = Scheme<BarBody>;
 
-/// Calls `$body` with `$load` as a `const bool` and the interior coefficients of `M` and `R`
-/// as numbers (uniform mesh) or as rows: the four monomorphised kernels of a step.
-macro_rules! monomorphise {
-    ($load:expr, $uniform:expr, $mass:expr, $stiffness:expr, |$l:ident, $k:ident| $body:expr) => {
-        match ($load, $uniform) {
-            (true, Some($k)) => {
-                const $l: bool = true;
-                $body
-            }
-            (false, Some($k)) => {
-                const $l: bool = false;
-                $body
-            }
-            (true, None) => {
-                const $l: bool = true;
-                let $k = ($mass.rows(), $stiffness.rows());
-                $body
-            }
-            (false, None) => {
-                const $l: bool = false;
-                let $k = ($mass.rows(), $stiffness.rows());
-                $body
-            }
-        }
+/// Which version of each of the bar's per-step kernels a run uses: the optimised twins (the
+/// default, [`Kernels::TWINS`]) or the plain kernels they are tested against
+/// ([`Kernels::PLAIN`]). The results agree to round-off; `benches/twins.rs` measures what each
+/// twin buys on a step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Kernels {
+    /// The exact end solver's solves by `ldlt_fast::TwistedLdlt`, else by the plain `Ldlt`.
+    pub twisted_solve: bool,
+    /// The exact end solver tries the previous step's active set first.
+    pub warm_start: bool,
+    /// On a uniform mesh, the right-hand side by [`rhs_into_uniform`].
+    pub uniform_rhs: bool,
+    /// On a uniform mesh, the energy sums by [`energy_sums_uniform`].
+    pub uniform_energy: bool,
+}
+
+impl Kernels {
+    pub const TWINS: Kernels = Kernels {
+        twisted_solve: true,
+        warm_start: true,
+        uniform_rhs: true,
+        uniform_energy: true,
     };
+    pub const PLAIN: Kernels = Kernels {
+        twisted_solve: false,
+        warm_start: false,
+        uniform_rhs: false,
+        uniform_energy: false,
+    };
+}
+
+impl Default for Kernels {
+    fn default() -> Self {
+        Self::TWINS
+    }
 }
 
 /// The bar on its unknowns: the discretisation and the coefficients its kernels stream.
 pub struct BarBody {
     disc: Discretisation,
+    kernels: Kernels,
     /// Interior coefficients of `M` and `R` as numbers, when the mesh is uniform.
     uniform: Option<(Uniform, Uniform)>,
     /// `1/Δt²` and `½ − α/(2Δt)`.
@@ -86,20 +100,31 @@ impl Body for BarBody {
         self.disc.alpha
     }
 
+    /// The optimised twins on a uniform mesh ([`rhs_into_uniform`], [`energy_sums_uniform`]),
+    /// else the plain kernels.
     fn rhs_into(&self, u: &[f64], w: &[f64], force: Option<&[f64]>, b: &mut [f64]) {
         let (mass, stiffness) = (&self.disc.mass, &self.disc.stiffness);
-        let (inv_dt2, c_w, f) = (self.inv_dt2, self.c_w, force.unwrap_or(&[]));
-        monomorphise!(force.is_some(), self.uniform, mass, stiffness, |LOAD, k| {
-            rhs_into::<LOAD, _>(mass, stiffness, k, c_w, inv_dt2, u, w, f, b)
-        });
+        let (inv_dt2, c_w) = (self.inv_dt2, self.c_w);
+        let uniform = self.uniform.filter(|_| self.kernels.uniform_rhs);
+        match (uniform, force) {
+            (Some(k), Some(f)) => {
+                rhs_into_uniform::<true>(mass, stiffness, k, c_w, inv_dt2, u, w, f, b)
+            }
+            (Some(k), None) => {
+                rhs_into_uniform::<false>(mass, stiffness, k, c_w, inv_dt2, u, w, &[], b)
+            }
+            (None, _) => rhs_into(mass, stiffness, c_w, inv_dt2, u, w, force, b),
+        }
     }
 
     fn energy_sums(&self, u: &[f64], z: &[f64], w: &[f64], force: Option<&[f64]>) -> EnergySums {
         let (mass, stiffness) = (&self.disc.mass, &self.disc.stiffness);
-        let f = force.unwrap_or(&[]);
-        monomorphise!(force.is_some(), self.uniform, mass, stiffness, |LOAD, k| {
-            measure::<LOAD, _>(mass, stiffness, k, u, z, w, f)
-        })
+        let uniform = self.uniform.filter(|_| self.kernels.uniform_energy);
+        match (uniform, force) {
+            (Some(k), Some(f)) => energy_sums_uniform::<true>(mass, stiffness, k, u, z, w, f),
+            (Some(k), None) => energy_sums_uniform::<false>(mass, stiffness, k, u, z, w, &[]),
+            (None, _) => energy_sums(mass, stiffness, u, z, w, force),
+        }
     }
 
     fn stiffness_form(&self, x: &[f64]) -> f64 {
@@ -127,7 +152,7 @@ impl Body for BarBody {
     }
 
     /// On the unknowns that carry mass (a contiguous block: the massless ones are end nodes,
-    /// [`Discretisation::massless`]).
+    /// [`Discretisation::massless`]), by the factorisation the step solves with.
     fn solve_mass(&self, acc: &mut [f64]) -> Result<(), RunError> {
         let n = acc.len();
         let disc = &self.disc;
@@ -140,9 +165,10 @@ impl Body for BarBody {
             return Ok(());
         }
         let solved: Result<(), NotPositiveDefinite> = if lo == 0 && hi == n {
-            Ldlt::factor(&disc.mass).map(|f| f.solve_in_place(acc))
+            TwistedLdlt::factor(&disc.mass).map(|f| f.solve_in_place(acc))
         } else {
-            Ldlt::factor(&disc.mass.sub(lo, hi - 1)).map(|f| f.solve_in_place(&mut acc[lo..hi]))
+            let sub = disc.mass.sub(lo, hi - 1);
+            TwistedLdlt::factor(&sub).map(|f| f.solve_in_place(&mut acc[lo..hi]))
         };
         Ok(solved?)
     }
@@ -196,11 +222,23 @@ impl Body for BarBody {
 
 /// Builds the step solver a scene asks for, for `disc`'s step matrix and constrained nodes.
 pub fn make_solver(scene: &Scene, disc: &Discretisation) -> Result<Box<dyn StepSolver>, RunError> {
+    make_solver_with(scene, disc, Kernels::TWINS)
+}
+
+/// [`make_solver`] with the exact end solver's kernels as `kernels` says.
+fn make_solver_with(
+    scene: &Scene,
+    disc: &Discretisation,
+    kernels: Kernels,
+) -> Result<Box<dyn StepSolver>, RunError> {
     let nodes = disc.constrained_locals();
     match scene.solver.method {
-        SolverMethod::Exact if disc.ends_only() => {
-            Ok(Box::new(ExactSolver::new(&disc.step_matrix, &nodes)?))
-        }
+        SolverMethod::Exact if disc.ends_only() => Ok(Box::new(ExactSolver::with_options(
+            &disc.step_matrix,
+            &nodes,
+            kernels.twisted_solve,
+            kernels.warm_start,
+        )?)),
         SolverMethod::Exact => Ok(Box::new(BlockPivotSolver::new(&disc.step_matrix, &nodes)?)),
         SolverMethod::Osqp => Ok(Box::new(OsqpSolver::new(
             &disc.step_matrix,
@@ -252,6 +290,7 @@ fn setup(
     scene: &Scene,
     disc: Discretisation,
     solver: Box<dyn StepSolver>,
+    kernels: Kernels,
 ) -> Result<Setup<BarBody>, RunError> {
     scene.validate()?;
     let (nodes, n, dt, alpha) = (disc.nodes, disc.unknowns(), disc.dt, disc.alpha);
@@ -292,6 +331,7 @@ fn setup(
     let (displacement, velocity) = (restrict(u0_full), restrict(v0_full));
     let contact = contact_set(&disc).with_motion(disc.motion.clone());
     let body = BarBody {
+        kernels,
         uniform: disc.mass.uniform().zip(disc.stiffness.uniform()),
         inv_dt2: 1.0 / (dt * dt),
         c_w: 0.5 - alpha / (2.0 * dt),
@@ -328,7 +368,19 @@ impl Scheme<BarBody> {
     pub fn prepare(scene: &Scene) -> Result<Unstarted<BarBody>, RunError> {
         let disc = Discretisation::new(scene)?;
         let solver = make_solver(scene, &disc)?;
-        Ok(Scheme::unstarted(setup(scene, disc, solver)?))
+        Ok(Scheme::unstarted(setup(
+            scene,
+            disc,
+            solver,
+            Kernels::TWINS,
+        )?))
+    }
+
+    /// [`Simulation::new`] with the kernels `kernels` names (the same answers to round-off).
+    pub fn with_kernels(scene: &Scene, kernels: Kernels) -> Result<Self, RunError> {
+        let disc = Discretisation::new(scene)?;
+        let solver = make_solver_with(scene, &disc, kernels)?;
+        Scheme::from_setup(setup(scene, disc, solver, kernels)?)
     }
 
     /// Sets up a run with a given step solver (built for `disc.step_matrix` and
@@ -338,7 +390,7 @@ impl Scheme<BarBody> {
         disc: Discretisation,
         solver: Box<dyn StepSolver>,
     ) -> Result<Self, RunError> {
-        Scheme::from_setup(setup(scene, disc, solver)?)
+        Scheme::from_setup(setup(scene, disc, solver, Kernels::TWINS)?)
     }
 
     pub fn discretisation(&self) -> &Discretisation {

@@ -1,17 +1,12 @@
-//! The instruction set of the per-step streaming kernels, chosen at run time.
+//! The instruction set of the optimised twins' streaming loops, chosen at run time.
 //!
 //! The build targets baseline x86-64 (SSE2, two doubles per vector) and uses no target-cpu
-//! flags. The right-hand side, the energy sums and the update `z += r c; u += z` are
-//! throughput bound, so on a CPU with AVX (four doubles per vector) they run as AVX code:
-//! the right-hand side through `run` (the compiler vectorises it), the other two as AVX
-//! intrinsics behind [`has_avx`] (the compiler does not vectorise them). The tridiagonal
-//! solve (`Ldlt`) also goes through `run`: its chains stay scalar, but the three-operand AVX
-//! encoding needs fewer instructions. The bits do not
-//! change: AVX without FMA performs the same IEEE operations in the same order (Rust never
-//! contracts `a * b + c` into a fused multiply-add), and every sum has its lane order fixed
-//! in the source, so the vector width cannot reorder it.
-//! `simulation::tests::kernels_give_the_same_bits_with_and_without_avx` and
-//! `tridiag::tests::updates_give_the_same_bits_with_and_without_avx` check this.
+//! flags. On a CPU with AVX (four doubles per vector) the uniform right-hand side
+//! (`bar::rhs_fast`) runs through `run` (the compiler vectorises it) and the uniform energy
+//! sums (`bar::energy_fast`) as AVX intrinsics behind [`has_avx`]. The bits do not change: AVX
+//! without FMA performs the same IEEE operations in the same order (Rust never contracts
+//! `a * b + c` into a fused multiply-add), and every sum has its lane order fixed in the
+//! source. The twins' tests compare the AVX and the portable paths bit for bit.
 
 /// A streaming kernel with its arguments. `call` must be `#[inline(always)]`: it is then
 /// compiled into each caller, including the AVX one (a closure would be compiled once, for
@@ -30,13 +25,6 @@ pub(crate) fn run<K: Kernel>(kernel: K) -> K::Output {
         // SAFETY: the CPU supports AVX, the only feature `with_avx` enables.
         return unsafe { with_avx(kernel) };
     }
-    kernel.call()
-}
-
-/// Runs `kernel` as built (baseline instruction set): for tests comparing the two paths.
-#[cfg(test)]
-#[inline(never)]
-pub(crate) fn baseline<K: Kernel>(kernel: K) -> K::Output {
     kernel.call()
 }
 

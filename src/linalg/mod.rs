@@ -1,21 +1,21 @@
 //! Linear algebra of the bodies: symmetric tridiagonal matrices ([`tridiag`]) and their
-//! factorisation ([`ldlt`]), sparse matrices on a CSR pattern ([`sparse`]) and their sparse
-//! Cholesky factorisation ([`cholesky`], faer); the step matrix with its factorisation as the
-//! solvers see it ([`system`]); the O(n) update kernel ([`update`]) and the CPU dispatch that
-//! runs kernels compiled for AVX ([`dispatch`]); ∞-norms ([`norms`]) and the spectrum of `C`
-//! ([`spectrum`]).
+//! factorisation ([`ldlt`], with its optimised twin for the per-step solve, [`ldlt_fast`]),
+//! sparse matrices on a CSR pattern ([`sparse`]) and their sparse Cholesky factorisation
+//! ([`cholesky`], faer); the step matrix with its factorisation as the solvers see it
+//! ([`system`]); the CPU dispatch that runs kernels compiled for AVX ([`dispatch`]); ∞-norms
+//! ([`norms`]) and the spectrum of `C` ([`spectrum`]).
 //!
 //! Bottom layer: imports nothing from the crate.
 
 pub mod cholesky;
 pub mod dispatch;
 pub mod ldlt;
+pub mod ldlt_fast;
 pub mod norms;
 pub mod sparse;
 pub mod spectrum;
 pub mod system;
 pub mod tridiag;
-pub mod update;
 
 pub use ldlt::{Ldlt, NotPositiveDefinite};
 pub use norms::{max_abs, max_distance};

@@ -4,7 +4,8 @@
 //! tridiagonal [`TridiagSystem`], the plane body the sparse [`SparseSystem`].
 
 use crate::linalg::cholesky::{FactorError, SparseCholesky};
-use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite};
+use crate::linalg::ldlt::NotPositiveDefinite;
+use crate::linalg::ldlt_fast::TwistedLdlt;
 use crate::linalg::sparse::Pattern;
 use crate::linalg::tridiag::SymTridiag;
 
@@ -87,17 +88,18 @@ pub fn inverse_norm_estimate(system: &mut impl SpdSystem) -> f64 {
     estimate
 }
 
-/// The bar's step matrix: tridiagonal, with its `LDLᵀ` factorisation.
+/// The bar's step matrix: tridiagonal, with the factorisation the bar's step solves with
+/// (the twin [`TwistedLdlt`], so that every solver of a bar solves with the same bits).
 #[derive(Clone, Debug)]
 pub struct TridiagSystem {
     pub matrix: SymTridiag,
-    pub factor: Ldlt,
+    pub factor: TwistedLdlt,
 }
 
 impl TridiagSystem {
     pub fn new(matrix: &SymTridiag) -> Result<Self, NotPositiveDefinite> {
         Ok(Self {
-            factor: Ldlt::factor(matrix)?,
+            factor: TwistedLdlt::factor(matrix)?,
             matrix: matrix.clone(),
         })
     }

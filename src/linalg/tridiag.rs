@@ -1,6 +1,6 @@
 //! Symmetric tridiagonal matrices: the matrix type, its products and quadratic forms (in
-//! difference form, exact for rigid motions), and the interior coefficients the per-step
-//! kernels stream. nalgebra has no banded solver; the factorisation is in [`super::ldlt`].
+//! difference form, exact for rigid motions), and the interior coefficients of a uniform mesh.
+//! nalgebra has no banded solver; the factorisation is in [`super::ldlt`].
 
 /// A symmetric tridiagonal matrix: `diag[i] = A[i][i]`, `off[i] = A[i][i+1] = A[i+1][i]`.
 #[derive(Clone, Debug, PartialEq)]
@@ -191,104 +191,16 @@ impl SymTridiag {
     }
 }
 
-/// The interior rows (`1..n−1`) of a symmetric tridiagonal matrix as the per-step kernels read
-/// them: the row sum `s_i` and the off-diagonals `e_{i−1}`, `e_i`. [`Rows`] reads them from the
-/// matrix; [`Uniform`] holds the two numbers of a uniform mesh, so the kernels stream no
-/// coefficient vectors. The right-hand side gets the same bits either way; the energy sums
-/// do not (the uniform kernel sums in four lanes and scales once), and agree to round-off
-/// (`simulation::tests::uniform_and_row_energy_sums_agree`).
-///
-/// Quadratic forms over the interior are accumulated as `Σ ws_i x_i²` and `Σ we_i (Δx_i)²` and
-/// scaled at the end: per row (`ws = s`, `we = e`, scales 1) or, on a uniform mesh, as plain
-/// sums scaled once by `s` and `e` (half the multiplications).
-pub trait Interior: Copy {
-    /// Whether every row has the same coefficients (the kernels may then factor them out).
-    const UNIFORM: bool;
-    fn s(self, i: usize) -> f64;
-    /// `A_{i,i+1}`.
-    fn e(self, i: usize) -> f64;
-    /// Weights inside the sums, and the factors applied to the finished sums.
-    fn ws(self, i: usize) -> f64;
-    fn we(self, i: usize) -> f64;
-    fn scale_s(self) -> f64;
-    fn scale_e(self) -> f64;
-}
-
-/// Interior coefficients read row by row.
-#[derive(Clone, Copy, Debug)]
-pub struct Rows<'a> {
-    s: &'a [f64],
-    e: &'a [f64],
-}
-
-/// Interior coefficients that are the same on every interior row.
+/// The interior coefficients of a symmetric tridiagonal matrix whose interior rows (`1..n−1`)
+/// are all alike (the uniform mesh): the row sum `s` and the off-diagonal `e`, read by the
+/// optimised twins of the bar's kernels as two numbers instead of two streams.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Uniform {
-    s: f64,
-    e: f64,
-}
-
-impl Interior for Rows<'_> {
-    const UNIFORM: bool = false;
-    #[inline(always)]
-    fn s(self, i: usize) -> f64 {
-        self.s[i]
-    }
-    #[inline(always)]
-    fn e(self, i: usize) -> f64 {
-        self.e[i]
-    }
-    #[inline(always)]
-    fn ws(self, i: usize) -> f64 {
-        self.s[i]
-    }
-    #[inline(always)]
-    fn we(self, i: usize) -> f64 {
-        self.e[i]
-    }
-    fn scale_s(self) -> f64 {
-        1.0
-    }
-    fn scale_e(self) -> f64 {
-        1.0
-    }
-}
-
-impl Interior for Uniform {
-    const UNIFORM: bool = true;
-    #[inline(always)]
-    fn s(self, _: usize) -> f64 {
-        self.s
-    }
-    #[inline(always)]
-    fn e(self, _: usize) -> f64 {
-        self.e
-    }
-    #[inline(always)]
-    fn ws(self, _: usize) -> f64 {
-        1.0
-    }
-    #[inline(always)]
-    fn we(self, _: usize) -> f64 {
-        1.0
-    }
-    fn scale_s(self) -> f64 {
-        self.s
-    }
-    fn scale_e(self) -> f64 {
-        self.e
-    }
+    pub s: f64,
+    pub e: f64,
 }
 
 impl SymTridiag {
-    /// The interior coefficients, row by row.
-    pub fn rows(&self) -> Rows<'_> {
-        Rows {
-            s: &self.row_sums,
-            e: &self.off,
-        }
-    }
-
     /// The interior coefficients as two numbers, when every interior row sum and every
     /// off-diagonal entry are bitwise equal (the uniform mesh).
     pub fn uniform(&self) -> Option<Uniform> {

@@ -1,8 +1,6 @@
 //! The scheme's state, its start-up step and its step, for any [`Body`]: see [`Scheme::step`].
 
-use crate::linalg::norms::max_abs;
 use crate::linalg::tridiag::dot;
-use crate::linalg::update::add_in_place;
 use crate::scheme::body::{Body, EnergySums};
 use crate::scheme::clock::{PhaseClock, PhaseTimes};
 use crate::scheme::contact::{ContactSet, ContactState};
@@ -79,8 +77,6 @@ pub struct Scheme<B: Body> {
     /// `n`: the state held is `u^n`.
     n: usize,
     u: Vec<f64>,
-    /// `max_i |u^n_i|`, handed to the step solver ([`StepSolver::set_state_scale`]).
-    u_scale: f64,
     w: Vec<f64>,
     z: Vec<f64>,
     b: Vec<f64>,
@@ -112,7 +108,6 @@ impl<B: Body> Scheme<B> {
             load: setup.load,
             n: 0,
             u: setup.displacement,
-            u_scale: 0.0,
             w: vec![0.0; n],
             z: vec![0.0; n],
             b: vec![0.0; n],
@@ -164,12 +159,11 @@ impl<B: Body> Scheme<B> {
         self.body.step_matrix_mul(&self.w, &mut self.b);
         self.contact.advance_gaps(dt)?;
         self.contact.lower_bounds_into(&self.u, &mut self.lower);
-        self.solver.set_state_scale(max_abs(&self.u));
         let info = (self.solver)
             .solve(&self.b, &self.lower, &mut self.z, &mut self.reactions)
             .map_err(|failure| self.failure(1, failure))?;
         let potential0 = self.body.stiffness_form(&self.u);
-        self.u_scale = add_in_place(&mut self.u, &self.z);
+        add_in_place(&mut self.u, &self.z);
         self.body.mass_mul(&self.z, &mut self.b);
         let potential = self.body.stiffness_form(&self.u);
         let energy =
@@ -253,19 +247,11 @@ impl<B: Body> Scheme<B> {
             self.restart_balance();
         }
         // 3. The constrained minimisation, and u^{n+1} = u^n + z.
-        self.solver.set_state_scale(self.u_scale);
         self.solver.set_previous_increment(&self.w);
-        let (info, u_scale) = self
-            .solver
-            .solve_and_advance(
-                &self.b,
-                &self.lower,
-                &mut self.u,
-                &mut self.z,
-                &mut self.reactions,
-            )
+        let info = (self.solver)
+            .solve(&self.b, &self.lower, &mut self.z, &mut self.reactions)
             .map_err(|failure| self.failure(n + 1, failure))?;
-        self.u_scale = u_scale;
+        add_in_place(&mut self.u, &self.z);
         let clock = clock.lap(&mut self.timing.solve_ns);
         // 4. The contact state and the energy identity.
         let mut record = StepRecord {
@@ -475,6 +461,13 @@ impl<B: Body> Scheme<B> {
     /// The gaps `s_k u^n_{i_k} + g_k` of every constraint.
     pub fn gaps_into(&self, out: &mut [f64]) {
         self.contact.gaps_into(&self.u, out);
+    }
+}
+
+/// `u += z`.
+fn add_in_place(u: &mut [f64], z: &[f64]) {
+    for (ui, zi) in u.iter_mut().zip(z) {
+        *ui += zi;
     }
 }
 

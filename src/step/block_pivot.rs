@@ -1,53 +1,27 @@
-//! Exact solver for the step QP with a bound at many nodes (distributed Signorini: an obstacle
-//! under every node):
+//! Exact solver for the step QP with a bound at many nodes (an obstacle under every node):
+//! minimise `½ zᵀCz − bᵀz` subject to `z_i >= lo_i` for `i` in `B`, `C` symmetric positive
+//! definite tridiagonal. With `y = z − lo` this is an LCP with a P-matrix: one solution.
 //!
-//! ```text
-//!   minimise ½ zᵀ C z − bᵀ z   subject to   z_i >= lo_i  for i in B,
-//! ```
-//!
-//! `C` symmetric positive definite tridiagonal. With `y = z − lo` this is the linear
-//! complementarity problem `λ = C y − (b − C lo)`, `y ≥ 0`, `λ ≥ 0`, `yᵀλ = 0` restricted to `B`;
-//! `C` is a P-matrix, so the solution is unique.
-//!
-//! Method: block principal pivoting (Júdice & Pires, Comput. Oper. Res. 21, 1994) safeguarded
-//! by Murty's single pivoting rule. It terminates after finitely many iterations: a block
-//! iteration (flip every infeasible index) is taken only while the number of infeasible
-//! indices has reached a new minimum within the last [`BLOCK_PATIENCE`] iterations, and that
-//! minimum can fall at most `|B|` times, so after finitely many block iterations only Murty's
-//! rule is applied (flip the infeasible index of largest node number), which visits no
-//! active set twice and ends on every P-matrix LCP (Murty 1974)
-//! ([docs/step-solvers.md](../docs/step-solvers.md#block-principal-pivoting)). Should round-off
-//! defeat that argument, the iteration stops at a hard limit with an error, never with an
-//! unverified point.
-//!
-//! Each iteration solves `C_FF z_F = b_F − C_FA lo_A` on the free set `F` with `z_A = lo_A`:
-//! the tridiagonal matrix with the active rows and columns replaced by identity ones, by the
-//! plain `L D Lᵀ` sweep (pivots `d_j`, multipliers `l_j`), a forward chain `t_j` and a backward
-//! chain `z_j`. An active node cuts the sweep into independent runs of free nodes.
-//!
-//! *Incremental re-solves.* The right-hand side changes every step, so the first iteration of a
-//! step sweeps the whole bar; its factor is the one kept from the previous step's final active
-//! set (a contact set that persists costs no factorisation). A later iteration of the same step
-//! changes only a few rows (the flipped indices), and recomputes each of the three recurrences
-//! (pivots, forward chain, backward chain) only from the first changed row until its carried
-//! value is bitwise the one stored from the previous iteration, past the last changed row:
-//! from there on every later value is the same function of the same bits. The answer of every
-//! iteration is therefore bitwise the full sweep's ([`BlockPivotSolver::with_full_solves`] is
-//! that reference, and the tests compare the two bit for bit). The recurrences forget their
-//! start geometrically (the pivots at the rate `(e/d)²`, the chains at `|e/d|` per node, where
-//! columns of `C⁻¹` decay), so a flip costs a few hundred to a few thousand nodes instead of
-//! the whole bar; the pivots of a uniform mesh provably meet (the rounded pivot map is monotone:
-//! two orbits from above end at the same largest fixed point), the chains in practice, and a
-//! recurrence that never meets ends at its run's end, still exact. The margins of the indices
-//! (`λ_i = (C z − b)_i` if active, `z_i − lo_i` if free) are re-evaluated only where `z`
-//! changed and next to it; the round-off thresholds, which scale with `max|z|` (kept per block
-//! of nodes), are applied to the negative margins only.
-//!
-//! When no index is active, the factorisation of `C` computed once per run is used.
+//! Method: block principal pivoting (Júdice & Pires 1994) safeguarded by Murty's single
+//! pivoting rule after [`BLOCK_PATIENCE`] block iterations without a new minimum of infeasible
+//! indices, so it terminates; a hard iteration limit ends in an error, never an unverified point.
+//! Each iteration solves `C_FF z_F = b_F − C_FA lo_A` (`z_A = lo_A`) by the plain `L D Lᵀ` sweep
+//! of `C` with the active rows replaced by identity ones; an iteration after the step's first
+//! recomputes each recurrence (pivots, forward chain, backward chain) only from the first
+//! changed row until its carried value meets the stored bits, so every answer is bitwise the
+//! whole-bar sweep's ([`BlockPivotSolver::with_full_solves`], compared in the tests). The
+//! margins are re-evaluated only where `z` changed. Termination, tie thresholds, how far a flip
+//! reaches and what the code does for speed:
+//! [docs/step-solvers.md](../docs/step-solvers.md#block-principal-pivoting).
 
-use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite};
+use crate::linalg::ldlt::NotPositiveDefinite;
+use crate::linalg::ldlt_fast::TwistedLdlt;
 use crate::linalg::norms::max_abs;
 use crate::linalg::tridiag::SymTridiag;
+use crate::step::pivot_sweeps::{
+    backward_chain, forward_chain, margins_interior, max_abs_4, max_of, push_merged, row_product,
+    run_end, run_start, sweep_down, sweep_up,
+};
 use crate::step::{SolveInfo, StepFailure, StepSolver};
 
 /// Block iterations allowed without a decrease of the number of infeasible indices before the
@@ -90,7 +64,7 @@ pub struct BlockPivotSolver {
     c: SymTridiag,
     /// `max_i Σ_j |C_ij|`, for the round-off threshold of the multipliers.
     c_norm: f64,
-    factor: Ldlt,
+    factor: TwistedLdlt,
     /// Constrained nodes (strictly increasing) and, per node, its constraint index or `NONE`;
     /// both empty when every node is constrained.
     nodes: Vec<usize>,
@@ -136,7 +110,7 @@ impl BlockPivotSolver {
     pub fn new(c: &SymTridiag, nodes: &[usize]) -> Result<Self, NotPositiveDefinite> {
         let n = c.dim();
         assert!(nodes.windows(2).all(|w| w[0] < w[1]) && nodes.iter().all(|&i| i < n));
-        let factor = Ldlt::factor(c)?;
+        let factor = TwistedLdlt::factor(c)?;
         let all_constrained = nodes.len() == n;
         // Only a subset of the nodes needs the map (and the list of nodes, and its bounds).
         let mut slot = if all_constrained {
@@ -549,227 +523,6 @@ impl BlockPivotSolver {
     }
 }
 
-/// The forward chain `t_j = b_j − l_{j−1} t_{j−1}` over rows with free neighbours (`l` holds
-/// `l_{j−1}` for each row, `t` is the value before the first), with the running maxima of
-/// `|b|` and `|lo|`; returns the last `t` and the maxima.
-#[inline(never)]
-fn forward_chain(
-    rhs: &[f64],
-    lo: &[f64],
-    l: &[f64],
-    ts: &mut [f64],
-    mut t: f64,
-    mut b_max: f64,
-    mut lo_max: f64,
-) -> (f64, f64, f64) {
-    for (((tj, &b), &lo), &l) in ts.iter_mut().zip(rhs).zip(lo).zip(l) {
-        b_max = max_of(b_max, b.abs());
-        lo_max = max_of(lo_max, lo.abs());
-        t = b - l * t;
-        *tj = t;
-    }
-    (t, b_max, lo_max)
-}
-
-/// The backward chain `z_j = t_j / d_j − l_j z_{j+1}` downwards over the rows of `t`, from
-/// `z`'s last entry (one more than `t`), which is given.
-#[inline(never)]
-fn backward_chain(t: &[f64], inv_d: &[f64], l: &[f64], z: &mut [f64]) {
-    let k = t.len();
-    let mut z_next = z[k];
-    for (((zj, &t), &inv_d), &l) in z[..k].iter_mut().zip(t).zip(inv_d).zip(l).rev() {
-        z_next = t * inv_d - l * z_next;
-        *zj = z_next;
-    }
-}
-
-/// The margins of the interior nodes `1..n − 1` (all constrained), as `margin_at` (the
-/// interior branch of [`row_product`]), negative ones appended to `negative`. A loop of its
-/// own: as a closure called per node it was not inlined.
-#[inline(never)]
-fn margins_interior(
-    active: &[bool],
-    lo: &[f64],
-    rhs: &[f64],
-    c: &SymTridiag,
-    z: &[f64],
-    margin: &mut [f64],
-    negative: &mut Vec<usize>,
-) {
-    let n = z.len();
-    let (s, e) = (&c.row_sums()[..n], &c.off[..n - 1]);
-    let (active, lo, rhs, margin) = (&active[..n], &lo[..n], &rhs[..n], &mut margin[..n]);
-    for i in 1..n - 1 {
-        let zi = z[i];
-        let m = if active[i] {
-            s[i] * zi + e[i - 1] * (z[i - 1] - zi) + e[i] * (z[i + 1] - zi) - rhs[i]
-        } else {
-            zi - lo[i]
-        };
-        margin[i] = m;
-        if m < 0.0 {
-            negative.push(i);
-        }
-    }
-}
-
-/// `(C z)_i`, with the bits of [`SymTridiag::mul_into`] (difference form).
-#[inline(always)]
-fn row_product(c: &SymTridiag, i: usize, z: &[f64]) -> f64 {
-    let n = z.len();
-    let (s, e) = (c.row_sums(), &c.off);
-    if n == 1 {
-        c.diag[0] * z[0]
-    } else if i == 0 {
-        s[0] * z[0] + e[0] * (z[1] - z[0])
-    } else if i + 1 == n {
-        s[i] * z[i] + e[i - 1] * (z[i - 1] - z[i])
-    } else {
-        s[i] * z[i] + e[i - 1] * (z[i - 1] - z[i]) + e[i] * (z[i + 1] - z[i])
-    }
-}
-
-/// Runs the recurrence `step` upwards over the rows of the sorted, disjoint ranges `dirty`
-/// (rows whose inputs changed), continuing past a range until `step` reports the carried value
-/// unchanged; the recomputed rows go to `out` (sorted, disjoint), their count to `rows`.
-fn sweep_up(
-    n: usize,
-    dirty: &[(usize, usize)],
-    out: &mut Vec<(usize, usize)>,
-    rows: &mut usize,
-    mut step: impl FnMut(usize) -> bool,
-) {
-    out.clear();
-    let mut next = 0;
-    while next < dirty.len() {
-        let (start, mut must) = dirty[next];
-        let mut j = start;
-        loop {
-            while next < dirty.len() && dirty[next].0 <= j {
-                must = must.max(dirty[next].1);
-                next += 1;
-            }
-            let same = step(j);
-            *rows += 1;
-            if j + 1 == n || (same && j >= must) {
-                break;
-            }
-            j += 1;
-        }
-        push_merged(out, (start, j));
-    }
-}
-
-/// [`sweep_up`] downwards: the recurrence carries from row `j + 1` to row `j`.
-fn sweep_down(
-    n: usize,
-    dirty: &[(usize, usize)],
-    out: &mut Vec<(usize, usize)>,
-    rows: &mut usize,
-    mut step: impl FnMut(usize) -> bool,
-) {
-    debug_assert!(dirty.iter().all(|r| r.1 < n));
-    out.clear();
-    let mut next = dirty.len();
-    while next > 0 {
-        let (mut must, start) = dirty[next - 1];
-        let mut j = start;
-        loop {
-            while next > 0 && dirty[next - 1].1 >= j {
-                must = must.min(dirty[next - 1].0);
-                next -= 1;
-            }
-            let same = step(j);
-            *rows += 1;
-            if j == 0 || (same && j <= must) {
-                break;
-            }
-            j -= 1;
-        }
-        out.push((j, start));
-    }
-    out.reverse();
-    // Adjacent ranges found downwards are merged after the reversal.
-    let mut w = 0;
-    for r in 0..out.len() {
-        let cur = out[r];
-        if w > 0 && cur.0 <= out[w - 1].1 + 1 {
-            out[w - 1].1 = out[w - 1].1.max(cur.1);
-        } else {
-            out[w] = cur;
-            w += 1;
-        }
-    }
-    out.truncate(w);
-}
-
-/// Flags compared a word at a time by [`run_end`] and [`run_start`].
-const SCAN: usize = 32;
-
-/// The first index at or after `from` whose flag is not `flag` (`flags.len()` if none).
-#[inline]
-fn run_end(flags: &[bool], from: usize, flag: bool) -> usize {
-    let mut i = from;
-    while i + SCAN <= flags.len()
-        && flags[i..i + SCAN]
-            .iter()
-            .fold(true, |a, &f| a & (f == flag))
-    {
-        i += SCAN;
-    }
-    flags[i..]
-        .iter()
-        .position(|&f| f != flag)
-        .map_or(flags.len(), |k| i + k)
-}
-
-/// The least `s <= top` with every flag of `s..=top` equal to `flag` (that of `top`).
-#[inline]
-fn run_start(flags: &[bool], top: usize, flag: bool) -> usize {
-    let mut s = top;
-    while s >= SCAN
-        && flags[s - SCAN..s]
-            .iter()
-            .fold(true, |a, &f| a & (f == flag))
-    {
-        s -= SCAN;
-    }
-    flags[..s]
-        .iter()
-        .rposition(|&f| f != flag)
-        .map_or(0, |k| k + 1)
-}
-
-/// `m.max(x)` for a running maximum `m` that is not NaN (it starts at 0): the same value (a
-/// NaN `x` is ignored either way) in one `maxsd`, without `f64::max`'s NaN blend on the
-/// dependency chain.
-#[inline(always)]
-fn max_of(m: f64, x: f64) -> f64 {
-    if x > m { x } else { m }
-}
-
-/// [`max_abs`] with four accumulators (the same value: a maximum does not depend on the order;
-/// NaNs are ignored either way), off the single chain of dependent comparisons.
-fn max_abs_4(v: &[f64]) -> f64 {
-    let mut m = [0.0f64; 4];
-    let chunks = v.chunks_exact(4);
-    let rest = max_abs(chunks.remainder());
-    for c in chunks {
-        for k in 0..4 {
-            m[k] = max_of(m[k], c[k].abs());
-        }
-    }
-    max_of(max_of(max_of(m[0], m[1]), max_of(m[2], m[3])), rest)
-}
-
-/// Appends `r` to sorted ranges, merging it with the last one when they overlap or touch.
-fn push_merged(out: &mut Vec<(usize, usize)>, r: (usize, usize)) {
-    match out.last_mut() {
-        Some(last) if r.0 <= last.1 + 1 => last.1 = last.1.max(r.1),
-        _ => out.push(r),
-    }
-}
-
 impl StepSolver for BlockPivotSolver {
     fn name(&self) -> &'static str {
         "exact"
@@ -920,7 +673,7 @@ mod tests {
     /// The whole-bar solve's run loops, kernels and margin pass against the row-by-row
     /// recurrences (`pivot_at`, `forward_at`, `backward_at`, `margin_at`) that the incremental
     /// re-solves use: the same bits of `t`, `z`, the block maxima and the negative margins, on
-    /// random SPD matrices and active patterns with runs of every length around [`SCAN`].
+    /// random SPD matrices and active patterns with runs of every length around `pivot_sweeps::SCAN`.
     fn whole_bar_equals_rows(diag: Vec<f64>, off: Vec<f64>, runs: Vec<(bool, usize)>, all: bool) {
         let n = diag.len();
         let c = SymTridiag::new(diag, off);

@@ -16,6 +16,7 @@ pub mod lcp;
 pub mod lemke;
 pub mod osqp;
 pub mod penalty;
+mod pivot_sweeps;
 pub mod report;
 pub mod schur;
 pub mod solver;

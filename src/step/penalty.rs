@@ -1,21 +1,25 @@
 //! The penalty step solver: the talk's penalised problem (PP) (Petrov & Schatzman 2009), normal
 //! compliance. The unilateral constraint at each Signorini node is replaced by the force
 //! `(u + a)⁻/ε`, taken implicitly at `t^{n+1}`; in the increment `z` the step reads
-//! `C z = b + Σ_j r_j e_j`, `ε r_j = max(0, lo_j − z_j)`, the optimality condition of the
-//! strictly convex problem `min ½ zᵀCz − bᵀz + Σ_j ((lo_j − z_j)⁺)²/(2ε)`, so it has exactly
-//! one solution. The gap `z_j − lo_j = −ε r_j` is negative in contact: penetration ≈ ε ×
+//!
+//! ```text
+//!   C z = b + Σ_j r_j e_j,   ε r_j = max(0, lo_j − z_j),
+//! ```
+//!
+//! the optimality condition of `min ½ zᵀCz − bᵀz + Σ_j ((lo_j − z_j)⁺)²/(2ε)`, strictly convex
+//! (one solution). The gap `z_j − lo_j = −ε r_j` is negative in contact: penetration ≈ ε ×
 //! reaction, and complementarity holds only in the limit ε → 0.
 //!
 //! Each step solves the LCP in the reactions by enumerating the at most four supports, then
 //! computes the answer by a direct solve on the chosen one; why this is exact and backward
 //! stable: [docs/step-solvers.md](../docs/step-solvers.md#penalty-solver).
 
-use crate::linalg::ldlt::{Ldlt, RowChange};
+use crate::linalg::ldlt::RowChange;
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::audit::{KktAudit, Law, reaction_from_gap};
 use crate::step::schur::{
-    Column, constraint_rows, factor_each_subset, inverse_columns, least_violating, masked_solve,
-    row_product, schur_complement,
+    StepFactor, constraint_rows, factor_each_subset, least_violating, masked_solve, row_product,
+    schur_complement,
 };
 use crate::step::{SettingsError, SetupError, SolveInfo, SolverReport, StepFailure, StepSolver};
 
@@ -56,8 +60,9 @@ impl PenaltySettings {
 #[derive(Clone, Debug)]
 pub struct PenaltySolver {
     epsilon: f64,
-    factor: Ldlt,
-    columns: Vec<Column>,
+    factor: StepFactor,
+    /// The constrained nodes (at most two).
+    nodes: Vec<usize>,
     /// `S + εI` on the constrained nodes.
     matrix: [[f64; 2]; 2],
     /// `1/ε`, the contact spring.
@@ -69,14 +74,15 @@ pub struct PenaltySolver {
     /// [`PenaltySolver::solve_on_support`]).
     from_gap: [bool; 2],
     /// The factorisation of `C + Σ_{j∈A} e_j e_jᵀ/ε` for support `A = mask`, at `mask − 1`.
-    springs: Vec<Ldlt>,
+    springs: Vec<StepFactor>,
     /// The support of the last answer, tried first.
     previous: u8,
     audit: KktAudit,
 }
 
 impl PenaltySolver {
-    /// Factorises `C`, precomputes `C⁻¹ e_j` for each constrained node (at most two).
+    /// Factorises `C` and `C` with a spring at each subset of the constrained nodes (at most
+    /// two; `TwistedLdlt`), and computes `S + εI`.
     pub fn new(
         c: &SymTridiag,
         nodes: &[usize],
@@ -90,19 +96,18 @@ impl PenaltySolver {
         }
         settings.validate()?;
         let epsilon = settings.epsilon;
-        let factor = Ldlt::factor(c)?;
-        let columns = inverse_columns(&factor, nodes);
-        let mut matrix = schur_complement(&columns);
-        for (a, row) in matrix.iter_mut().enumerate().take(columns.len()) {
+        let factor = StepFactor::new(c, &[], RowChange::Identity, true)?;
+        let mut matrix = schur_complement(&factor, nodes);
+        for (a, row) in matrix.iter_mut().enumerate().take(nodes.len()) {
             row[a] += epsilon;
         }
         let stiffness = 1.0 / epsilon;
-        let springs = factor_each_subset(c, nodes, RowChange::AddToDiagonal(stiffness), &factor)?;
+        let springs = factor_each_subset(c, nodes, RowChange::AddToDiagonal(stiffness), true)?;
         let audit = KktAudit::new(c, nodes, true)?;
         Ok(Self {
             epsilon,
             factor,
-            columns,
+            nodes: nodes.to_vec(),
             matrix,
             stiffness,
             rows: constraint_rows(c, nodes),
@@ -123,7 +128,7 @@ impl PenaltySolver {
 
     /// Reactions and LCP violation (in displacement) of support `mask`, given `d = lo − z⁰`.
     fn candidate(&self, mask: u8, d: &[f64; 2]) -> ([f64; 2], f64) {
-        let k = self.columns.len();
+        let k = self.nodes.len();
         let m = &self.matrix;
         let r = masked_solve(m, d, mask);
         let mut violation: f64 = 0.0;
@@ -159,15 +164,14 @@ impl PenaltySolver {
         reactions: &mut [f64],
     ) -> bool {
         z.copy_from_slice(rhs);
-        for (j, col) in self.columns.iter().enumerate() {
+        for (j, &i) in self.nodes.iter().enumerate() {
             if mask & (1 << j) != 0 {
-                z[col.node] += self.stiffness * lower[j];
+                z[i] += self.stiffness * lower[j];
             }
         }
         self.springs[mask as usize - 1].solve_in_place(z);
         let mut met = true;
-        for (j, col) in self.columns.iter().enumerate() {
-            let i = col.node;
+        for (j, &i) in self.nodes.iter().enumerate() {
             let gap = lower[j] - z[i];
             if mask & (1 << j) != 0 {
                 met &= gap >= 0.0;
@@ -199,13 +203,13 @@ impl StepSolver for PenaltySolver {
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
         let mut tried = 1;
-        let k = self.columns.len();
+        let k = self.nodes.len();
         let warm = self.previous != 0;
         if !(warm && self.solve_on_support(self.previous, rhs, lower, z, reactions)) {
             self.factor.solve_into(rhs, z);
             let mut d = [0.0; 2];
-            for (j, col) in self.columns.iter().enumerate() {
-                d[j] = lower[j] - z[col.node];
+            for (j, &i) in self.nodes.iter().enumerate() {
+                d[j] = lower[j] - z[i];
             }
             if !d[..k].iter().all(|v| v.is_finite()) {
                 return Err(StepFailure::NonFinite);

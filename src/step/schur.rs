@@ -1,53 +1,67 @@
-//! What the exact and penalty solvers share: the columns `c_j = C⁻¹ e_j` of the constrained
-//! nodes, their Schur complement `S_jk = (C⁻¹)_jk`, the 2 × 2 masked solve of an active set,
-//! the ranking of candidate sets by KKT violation, and the factorisations of `C` with the rows
-//! of each subset of constrained nodes changed (for the direct solves).
+//! What the exact and penalty solvers share: their factorisations of `C` (the plain `Ldlt` or
+//! its twin `TwistedLdlt`), with the rows of each subset of constrained nodes changed for the
+//! direct solves; the Schur complement `S_jk = (C⁻¹)_jk` on the constrained nodes, the 2 × 2
+//! masked solve of an active set and the ranking of candidate sets by KKT violation.
 
 use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite, RowChange};
-use crate::linalg::norms::max_abs;
+use crate::linalg::ldlt_fast::TwistedLdlt;
 use crate::linalg::tridiag::SymTridiag;
-use crate::linalg::update::max4;
 
-/// Column `C⁻¹ e_j`, truncated to where it is a normal floating-point number. Shared with the
-/// penalty solver, which uses the same Schur complement.
+/// A factorisation the end solvers solve with every step: the optimised twin (their default)
+/// or the plain one (to measure what the twin buys, `benches/twins.rs`).
 #[derive(Clone, Debug)]
-pub(crate) struct Column {
-    pub(crate) node: usize,
-    /// The entries in `support` only (the column decays geometrically away from `node`).
-    pub(crate) values: Vec<f64>,
-    /// Entries outside `support` are below `f64::MIN_POSITIVE` in magnitude and are dropped:
-    /// adding `r · c` with such `c` cannot change a displacement that is not itself subnormal.
-    pub(crate) support: std::ops::Range<usize>,
-    /// `max_i |c_i|`.
-    pub(crate) max_abs: f64,
+pub(crate) enum StepFactor {
+    Plain(Ldlt),
+    Twisted(TwistedLdlt),
+}
+
+impl StepFactor {
+    /// `C` with the rows of `nodes` changed by `change` (none: `C` itself).
+    pub(crate) fn new(
+        c: &SymTridiag,
+        nodes: &[usize],
+        change: RowChange,
+        twisted: bool,
+    ) -> Result<Self, NotPositiveDefinite> {
+        Ok(if twisted {
+            Self::Twisted(TwistedLdlt::factor_with_rows_changed(c, nodes, change)?)
+        } else {
+            Self::Plain(Ldlt::factor_with_rows_changed(c, nodes, change)?)
+        })
+    }
+
+    pub(crate) fn solve_in_place(&self, x: &mut [f64]) {
+        match self {
+            Self::Plain(f) => f.solve_in_place(x),
+            Self::Twisted(f) => f.solve_in_place(x),
+        }
+    }
+
+    pub(crate) fn solve_into(&self, b: &[f64], x: &mut [f64]) {
+        match self {
+            Self::Plain(f) => f.solve_into(b, x),
+            Self::Twisted(f) => f.solve_into(b, x),
+        }
+    }
 }
 
 /// The factorisations of `C` with the rows of each non-empty subset `mask` of `nodes` changed
-/// by `change`, at index `mask − 1`; shared with the penalty solver. End nodes change one half
-/// only: the other is taken from `factor` (of `C`) or a factorisation made before, neither
-/// computed nor stored twice.
+/// by `change`, at index `mask − 1`, each from scratch.
 pub(crate) fn factor_each_subset(
     c: &SymTridiag,
     nodes: &[usize],
     change: RowChange,
-    factor: &Ldlt,
-) -> Result<Vec<Ldlt>, NotPositiveDefinite> {
-    let subsets: Vec<Vec<usize>> = (1u8..(1 << nodes.len()))
+    twisted: bool,
+) -> Result<Vec<StepFactor>, NotPositiveDefinite> {
+    (1u8..(1 << nodes.len()))
         .map(|mask| {
-            (nodes.iter().enumerate())
+            let subset: Vec<usize> = (nodes.iter().enumerate())
                 .filter(|&(j, _)| mask & (1 << j) != 0)
                 .map(|(_, &node)| node)
-                .collect()
+                .collect();
+            StepFactor::new(c, &subset, change, twisted)
         })
-        .collect();
-    let mut made: Vec<Ldlt> = Vec::new();
-    for subset in &subsets {
-        let known: Vec<(&[usize], &Ldlt)> = std::iter::once((&[][..], factor))
-            .chain(subsets.iter().map(Vec::as_slice).zip(&made))
-            .collect();
-        made.push(Ldlt::factor_with_rows_changed(c, subset, change, &known)?);
-    }
-    Ok(made)
+        .collect()
 }
 
 /// Row `i` of `C` at each constrained node `i`: `C_i,i−1`, `C_i,i+1` (0 where absent) and the
@@ -115,114 +129,27 @@ pub(crate) fn least_violating(
     (tried, best.0, best.1)
 }
 
-/// `C⁻¹ e_j` for each node, computed with `factor` (set-up only).
-pub(crate) fn inverse_columns(factor: &Ldlt, nodes: &[usize]) -> Vec<Column> {
-    nodes
-        .iter()
-        .map(|&node| {
-            let mut values = factor.column_of_inverse(node);
-            for v in values.iter_mut() {
-                if v.abs() < f64::MIN_POSITIVE {
-                    *v = 0.0;
-                }
-            }
-            let start = values.iter().position(|v| *v != 0.0).unwrap_or(0);
-            let end = values.iter().rposition(|v| *v != 0.0).map_or(0, |e| e + 1);
-            let max_abs = max_abs(&values);
-            // The support kept in the column's own storage (no second J-sized copy).
-            values.truncate(end);
-            values.drain(..start.min(end));
-            Column {
-                node,
-                max_abs,
-                values,
-                support: start..end,
-            }
-        })
-        .collect()
-}
-
-/// `S_jk = (C⁻¹)_{jk}` on the (at most two) nodes, made bitwise symmetric so that no choice
-/// made from it depends on the order of the nodes.
-pub(crate) fn schur_complement(columns: &[Column]) -> [[f64; 2]; 2] {
+/// `S_jk = (C⁻¹)_{jk}` on the (at most two) nodes, from the columns `C⁻¹ e_j` (set-up only),
+/// made bitwise symmetric so that no choice made from it depends on the order of the nodes.
+pub(crate) fn schur_complement(factor: &StepFactor, nodes: &[usize]) -> [[f64; 2]; 2] {
     let mut schur = [[0.0; 2]; 2];
-    for (a, ca) in columns.iter().enumerate() {
-        for (b, cb) in columns.iter().enumerate() {
-            schur[a][b] = ca.value(cb.node);
+    let n = match factor {
+        StepFactor::Plain(f) => f.dim(),
+        StepFactor::Twisted(f) => f.dim(),
+    };
+    let mut column = vec![0.0; n];
+    for (a, &i) in nodes.iter().enumerate() {
+        column.fill(0.0);
+        column[i] = 1.0;
+        factor.solve_in_place(&mut column);
+        for (b, &k) in nodes.iter().enumerate() {
+            schur[a][b] = column[k];
         }
     }
-    if columns.len() == 2 {
+    if nodes.len() == 2 {
         let s = 0.5 * (schur[0][1] + schur[1][0]);
         schur[0][1] = s;
         schur[1][0] = s;
     }
     schur
-}
-
-impl Column {
-    /// `(C⁻¹)_{i, node}` (0 outside the support).
-    fn value(&self, i: usize) -> f64 {
-        if self.support.contains(&i) {
-            self.values[i - self.support.start]
-        } else {
-            0.0
-        }
-    }
-
-    /// `z += r · c + r2 · c2` (evaluated as `(z + r·c) + r2·c2`, the bits of two
-    /// [`Column::add_scaled`] passes) for two columns with the same support, in one pass;
-    /// returns `max|z|` over the support before and after.
-    pub(crate) fn add_scaled_pair(
-        &self,
-        r: f64,
-        other: &Column,
-        r2: f64,
-        z: &mut [f64],
-    ) -> (f64, f64) {
-        debug_assert_eq!(self.support, other.support);
-        let (mut before, mut after) = ([0.0f64; 4], [0.0f64; 4]);
-        let zs = &mut z[self.support.clone()];
-        let mut zc = zs.chunks_exact_mut(4);
-        let (mut ac, mut bc) = (self.values.chunks_exact(4), other.values.chunks_exact(4));
-        for ((z4, a4), b4) in (&mut zc).zip(&mut ac).zip(&mut bc) {
-            for k in 0..4 {
-                before[k] = before[k].max(z4[k].abs());
-                z4[k] = (z4[k] + r * a4[k]) + r2 * b4[k];
-                after[k] = after[k].max(z4[k].abs());
-            }
-        }
-        let rest = zc.into_remainder();
-        for ((zi, ai), bi) in rest.iter_mut().zip(ac.remainder()).zip(bc.remainder()) {
-            before[0] = before[0].max(zi.abs());
-            *zi = (*zi + r * ai) + r2 * bi;
-            after[0] = after[0].max(zi.abs());
-        }
-        (max4(before), max4(after))
-    }
-
-    /// `z += r · C⁻¹ e_j` over the column's numerical support; returns `max|z|` over the
-    /// support before and after.
-    pub(crate) fn add_scaled(&self, r: f64, z: &mut [f64]) -> (f64, f64) {
-        // Four running maxima each: one chain of dependent `max`es would be latency-bound
-        // (the column spans the whole bar when C is stiff); the maxima are exact, so the
-        // order does not change the result.
-        let (mut before, mut after) = ([0.0f64; 4], [0.0f64; 4]);
-        let (mut zc, mut cc) = (
-            z[self.support.clone()].chunks_exact_mut(4),
-            self.values.chunks_exact(4),
-        );
-        for (z4, c4) in (&mut zc).zip(&mut cc) {
-            for k in 0..4 {
-                before[k] = before[k].max(z4[k].abs());
-                z4[k] += r * c4[k];
-                after[k] = after[k].max(z4[k].abs());
-            }
-        }
-        for (zi, ci) in zc.into_remainder().iter_mut().zip(cc.remainder()) {
-            before[0] = before[0].max(zi.abs());
-            *zi += r * ci;
-            after[0] = after[0].max(zi.abs());
-        }
-        (max4(before), max4(after))
-    }
 }

@@ -93,26 +93,6 @@ pub trait StepSolver {
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure>;
 
-    /// `max_i |u^n_i|`, the state the next answer `z` is added to, given before each solve
-    /// (the exact end solver weighs its cancellation error against it). Default: ignored.
-    fn set_state_scale(&mut self, _max_abs_u: f64) {}
-
-    /// [`StepSolver::solve`], then `u += z`; returns `max_i |u_i|` afterwards, the next
-    /// step's state scale, or 0 from a solver that never reads it. The default makes the two
-    /// passes; the exact solver merges its superposition `z⁰ + Σ r_j c_j` with the addition
-    /// when it may, and without constrained nodes adds inside the solve (and returns 0).
-    fn solve_and_advance(
-        &mut self,
-        rhs: &[f64],
-        lower: &[f64],
-        u: &mut [f64],
-        z: &mut [f64],
-        reactions: &mut [f64],
-    ) -> Result<(SolveInfo, f64), StepFailure> {
-        let info = self.solve(rhs, lower, z, reactions)?;
-        Ok((info, crate::linalg::update::add_in_place(u, z)))
-    }
-
     /// The previous increment `w = u^n − u^{n−1}`, given before each solve of a step after the
     /// start-up step: a frictional solver's central slip is `(z + w)` at its tangential
     /// unknowns. Default: ignored.

@@ -79,11 +79,13 @@ pub fn mass_sum_worst() -> (f64, f64) {
 /// `b = A x` adds `γ₃ |A||x|`, and `‖|A|‖₂ ≤ ‖A‖∞`: `7u = 3.5ε`, rounded up.
 pub const SOLVE_ULPS: f64 = 4.0;
 
-/// `Ldlt` on the family of `tests/matrices.rs` (n = 1 … 39, two shifts, off-diagonals of both
-/// signs, not all diagonally dominant), `b = A x`: the worst `|x̂ − x|∞` over its own bound
-/// `SOLVE_ULPS ε ‖A‖∞ ‖x‖₂ / λ_min(A)` (λ_min by bisection), and the worst `|x̂ − x|∞`.
+/// The plain `Ldlt` and its twin `TwistedLdlt` on the family of `tests/matrices.rs` (n = 1 …
+/// 39, two shifts, off-diagonals of both signs, not all diagonally dominant), `b = A x`: the
+/// worst `|x̂ − x|∞` of either over its own bound `SOLVE_ULPS ε ‖A‖∞ ‖x‖₂ / λ_min(A)` (λ_min by
+/// bisection), and the worst `|x̂ − x|∞`.
 pub fn ldlt_family_worst() -> (f64, f64) {
     use viscobar::linalg::ldlt::Ldlt;
+    use viscobar::linalg::ldlt_fast::TwistedLdlt;
     use viscobar::linalg::spectrum::smallest_eigenvalue_spd;
     let (mut ratio, mut worst) = (0.0f64, 0.0f64);
     for n in 1..40usize {
@@ -96,21 +98,27 @@ pub fn ldlt_family_worst() -> (f64, f64) {
                 .collect();
             let a = SymTridiag::new(diag, off);
             let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).cos()).collect();
-            let mut b = a.mul(&x);
-            match Ldlt::factor(&a) {
-                Ok(f) => f.solve_in_place(&mut b),
-                Err(_) => return (f64::INFINITY, f64::INFINITY), // SPD: a refusal fails
+            let b = a.mul(&x);
+            let (mut plain, mut twin) = (b.clone(), b);
+            match (Ldlt::factor(&a), TwistedLdlt::factor(&a)) {
+                (Ok(f), Ok(g)) => {
+                    f.solve_in_place(&mut plain);
+                    g.solve_in_place(&mut twin);
+                }
+                _ => return (f64::INFINITY, f64::INFINITY), // SPD: a refusal fails
             }
             let lambda_min = smallest_eigenvalue_spd(&a);
             let x_norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
             let bound = SOLVE_ULPS * f64::EPSILON * a.inf_norm() * x_norm / lambda_min;
-            let error = (0..n).map(|i| (b[i] - x[i]).abs()).fold(0.0, f64::max);
-            worst = worst.max(error);
-            ratio = ratio.max(if bound > 0.0 {
-                error / bound
-            } else {
-                f64::INFINITY
-            });
+            for solved in [&plain, &twin] {
+                let error = (0..n).map(|i| (solved[i] - x[i]).abs()).fold(0.0, f64::max);
+                worst = worst.max(error);
+                ratio = ratio.max(if bound > 0.0 {
+                    error / bound
+                } else {
+                    f64::INFINITY
+                });
+            }
         }
     }
     (ratio, worst)
