@@ -64,6 +64,7 @@ pub mod scene;
 pub mod scheme;
 pub mod step;
 pub mod study;
+pub mod thermal;
 
 pub use bar::Simulation;
 pub use output::{ContactEpisode, Summary, run_in_memory, run_to_dir};

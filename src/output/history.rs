@@ -2,6 +2,7 @@
 //! terms (empty on steps whose identity was not measured), then per group of constraints its
 //! contact state (a single constraint: `gap_G,reaction_G`; a set: the constraints in contact,
 //! the extent `s` of the contact, the least gap and the total reaction), then the iterations.
+//! A bar with a temperature adds the identity's thermal terms after its residual.
 
 use crate::output::text::{push_time, push_value};
 use crate::scheme::StepRecord;
@@ -12,9 +13,15 @@ use std::io::Write;
 const ENERGY_COLUMNS: &str =
     "step,t,energy,work,viscous_dissipation,contact_dissipation,identity_residual";
 
-/// The header line for a run with the contact `groups`.
-pub fn header(groups: &[Group]) -> String {
+/// The thermal terms of a bar with a temperature, after the identity's residual.
+const THERMAL_COLUMNS: &str = ",thermal_energy,thermal_dissipation,exchange,heat_supply";
+
+/// The header line for a run with the contact `groups` (`thermal`: a body with a temperature).
+pub fn header(groups: &[Group], thermal: bool) -> String {
     let mut h = String::from(ENERGY_COLUMNS);
+    if thermal {
+        h.push_str(THERMAL_COLUMNS);
+    }
     for g in groups {
         let n = g.name;
         if g.range.len() == 1 {
@@ -29,8 +36,8 @@ pub fn header(groups: &[Group]) -> String {
     h
 }
 
-/// Appends the row of `r` (`row` is cleared first); `groups` as in the header.
-pub fn row(r: &StepRecord, groups: &[Group], row: &mut Vec<u8>) {
+/// Appends the row of `r` (`row` is cleared first); `groups` and `thermal` as in the header.
+pub fn row(r: &StepRecord, groups: &[Group], thermal: bool, row: &mut Vec<u8>) {
     row.clear();
     write!(row, "{},", r.step).expect("writing to a vector");
     push_time(r.time, row);
@@ -45,6 +52,15 @@ pub fn row(r: &StepRecord, groups: &[Group], row: &mut Vec<u8>) {
         // Not measured ([output] diagnostics_every): empty cells, not zeros.
         if r.measured {
             push_value(v, row);
+        }
+    }
+    if thermal {
+        let h = r.heat.unwrap_or_default();
+        for v in [h.energy, h.dissipation, h.exchange, h.supply] {
+            row.push(b',');
+            if r.measured {
+                push_value(v, row);
+            }
         }
     }
     for (g, s) in groups.iter().zip(&r.contact.groups) {

@@ -6,6 +6,7 @@
 
 pub mod error;
 pub mod expr;
+pub mod heat;
 pub mod nodal;
 pub mod output;
 pub mod parser;

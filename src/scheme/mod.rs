@@ -14,7 +14,7 @@ pub mod error;
 pub mod load;
 pub mod stepper;
 
-pub use body::{Body, EnergySums};
+pub use body::{Body, EnergySums, HeatTerms};
 pub use contact::{CONTACT_GAP_TOL, ContactSet, ContactState, GroupState, in_contact};
 pub use error::RunError;
 pub use load::Load;
