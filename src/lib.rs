@@ -32,6 +32,7 @@
 //!     initial: Initial { displacement: "0".into(), velocity: "-1".into() },
 //!     load: Default::default(),
 //!     obstacle: None,
+//!     heat: None,
 //!     mesh: Mesh { elements: 100 },
 //!     time: Time { step: 0.01, end: 3.0 },
 //!     solver: Default::default(),

@@ -25,6 +25,7 @@ pub mod plane_symmetry;
 pub mod roundoff;
 pub mod stiff;
 pub mod stiff_runs;
+pub mod thermal;
 pub mod timings;
 pub mod tolerances;
 pub mod verify;

@@ -422,7 +422,7 @@ pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(String, Scene),
 
 impl Scene {
     /// Parses TOML text, applies `key=value` overrides and validates. An override's key is
-    /// `section.field`; its value is read as a TOML value (`0.1`, `"x*(1 - x)"`, `true`), and a
+    /// `section.field` (or `section.table.field`, as `heat.left.coefficient`); its value is read as a TOML value (`0.1`, `"x*(1 - x)"`, `true`), and a
     /// value that is not valid TOML (a bare word such as `osqp`) is taken as a string. A number
     /// is accepted wherever an expression is (`initial.displacement = 0.1`, in the file or
     /// through `--set`), kept as its text ([`number_text`]).
@@ -755,15 +755,20 @@ pub(crate) fn apply_override(table: &mut toml::Table, assignment: &str) -> Resul
         Err(_) => toml::Value::String(raw.to_string()),
     };
     let parts: Vec<&str> = key.split('.').collect();
-    if parts.len() != 2 || parts.iter().any(|p| p.is_empty()) {
-        return Err(fail("the key must be section.field, e.g. bar.viscosity"));
+    // section.field, or section.table.field inside a table of a section (`heat.left.…`).
+    if !(2..=3).contains(&parts.len()) || parts.iter().any(|p| p.is_empty()) {
+        return Err(fail(
+            "the key must be section.field (e.g. bar.viscosity) or section.table.field",
+        ));
     }
-    let section = table
-        .entry(parts[0].to_string())
-        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-    let section = section
-        .as_table_mut()
-        .ok_or_else(|| fail("that section is not a table"))?;
-    section.insert(parts[1].to_string(), value);
+    let mut section = &mut *table;
+    for part in &parts[..parts.len() - 1] {
+        section = section
+            .entry(part.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+            .as_table_mut()
+            .ok_or_else(|| fail("that section is not a table"))?;
+    }
+    section.insert(parts[parts.len() - 1].to_string(), value);
     Ok(())
 }

@@ -322,6 +322,7 @@ impl Body for ThermalBody {
     fn rhs_into(&self, u: &[f64], w: &[f64], force: Option<&[f64]>, b: &mut [f64]) {
         let n_u = self.m.n_u;
         let (bu, bt) = b.split_at_mut(n_u);
+        let force = force.map(|f| &f[..n_u]);
         self.bar.rhs_into(&u[..n_u], &w[..n_u], force, bu);
         let gamma = self.m.gamma;
         if gamma != 0.0 {
@@ -334,6 +335,7 @@ impl Body for ThermalBody {
 
     fn energy_sums(&self, u: &[f64], z: &[f64], w: &[f64], force: Option<&[f64]>) -> EnergySums {
         let n = self.m.n_u;
+        let force = force.map(|f| &f[..n]);
         self.bar.energy_sums(&u[..n], &z[..n], &w[..n], force)
     }
 

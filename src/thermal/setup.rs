@@ -3,8 +3,9 @@
 //! (one factorisation per exchange state, formed once).
 
 use crate::bar::Simulation;
+use crate::scene::Expression;
 use crate::scene::{Scene, SceneError, SolverMethod};
-use crate::scheme::{Body, RunError, Scheme, Setup, Unstarted};
+use crate::scheme::{Body, Load, RunError, Scheme, Setup, Unstarted};
 use crate::step::{CondensedSolver, Constraints, StepSolver};
 use crate::thermal::body::ThermalBody;
 use crate::thermal::solver::{CoupledSolver, DecoupledSolver};
@@ -94,11 +95,19 @@ impl Scheme<ThermalBody> {
             Box::new(CoupledSolver::new(variants, exchange))
         };
         debug_assert_eq!(displacement.len(), body.unknowns());
+        // The load on the whole state (zero on the temperature's rows).
+        let load = match &scene.load.density {
+            None => Load::none(),
+            Some(text) => Load::new(
+                vec![Some(Expression::parse("load.density", text, true)?)],
+                &body,
+            )?,
+        };
         Ok(Scheme::unstarted(Setup {
             body,
             solver,
             contact: bar.contact,
-            load: bar.load,
+            load,
             displacement,
             velocity,
             steps: bar.steps,
