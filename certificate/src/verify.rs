@@ -62,6 +62,10 @@ pub fn sections() -> Result<Vec<Section>, viscobar::study::converge::ConvergeErr
             id: "plane-contact",
             markdown: crate::plane_contact::markdown()?,
         },
+        Section {
+            id: "thermal",
+            markdown: crate::thermal::markdown()?,
+        },
     ])
 }
 

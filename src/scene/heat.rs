@@ -6,8 +6,7 @@
 
 use crate::scene::SceneError;
 use crate::scene::error::invalid;
-use crate::scene::expr::Expression;
-use crate::scene::schema::{Condition, EndSpec, number_or_expression};
+use crate::scene::expr::{Expression, number_or_expression};
 use serde::{Deserialize, Serialize};
 
 /// `[heat]`: coupling, diffusivity, initial temperature, source and the ends' conditions.
@@ -121,10 +120,11 @@ const THERMAL_END_KEYS: [&str; 3] = ["value", "coefficient", "obstacle"];
 
 impl Heat {
     /// Checks every key against its range and against the bar's ends (`mechanical`: left,
-    /// right); the error names the key.
+    /// right, each its `condition` name and whether it is a Signorini end); the error names
+    /// the key.
     pub fn validate(
         &self,
-        mechanical: [&EndSpec; 2],
+        mechanical: [(&str, bool); 2],
         obstacle: bool,
     ) -> Result<HeatExpressions, SceneError> {
         if !(self.coupling.is_finite() && self.coupling >= 0.0) {
@@ -166,7 +166,7 @@ impl Heat {
 }
 
 impl ThermalEnd {
-    fn validate(&self, side: &str, mechanical: &EndSpec) -> Result<EndHeat, SceneError> {
+    fn validate(&self, side: &str, mechanical: (&str, bool)) -> Result<EndHeat, SceneError> {
         let key = |k: &str| format!("heat.{side}.{k}");
         let only = |k: &str, condition: &str| SceneError::Invalid {
             field: key(k),
@@ -202,14 +202,14 @@ impl ThermalEnd {
                 )?))
             }
             ThermalCondition::Exchange => {
-                if mechanical.condition != Condition::Signorini {
+                if !mechanical.1 {
                     return Err(SceneError::Invalid {
                         field: key("condition"),
                         value: "\"exchange\"".into(),
                         allowed: format!(
                             "an exchange with the obstacle needs a signorini end (`{side}.condition` \
                              is \"{}\")",
-                            condition_name(mechanical.condition)
+                            mechanical.0
                         ),
                     });
                 }
@@ -232,14 +232,6 @@ impl ThermalEnd {
                 })
             }
         }
-    }
-}
-
-fn condition_name(c: Condition) -> &'static str {
-    match c {
-        Condition::Signorini => "signorini",
-        Condition::Free => "free",
-        Condition::Clamped => "clamped",
     }
 }
 

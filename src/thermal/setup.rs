@@ -38,7 +38,7 @@ impl Scheme<ThermalBody> {
             }
             .into());
         }
-        let expressions = heat.validate([&scene.left, &scene.right], scene.obstacle.is_some())?;
+        let expressions = heat.validate(scene.thermal_view(), scene.obstacle.is_some())?;
         let bar = Simulation::prepare_mechanics(scene)?.into_setup();
         let disc = bar.body.discretisation().clone();
         let constraints: Vec<(usize, f64)> =

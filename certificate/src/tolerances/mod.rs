@@ -12,12 +12,14 @@ mod random_problems;
 mod scanner;
 mod scenes;
 mod solvers;
+mod thermal;
 
 pub use matrices::*;
 pub use plane::*;
 pub use random_problems::*;
 pub use scenes::*;
 pub use solvers::*;
+pub use thermal::*;
 
 use crate::stiff::{CaseResult, checks};
 use crate::viscous_contact;
@@ -583,6 +585,7 @@ pub fn registry_markdown(
 ) -> Result<String, RunError> {
     let mut measured = measured()?;
     measured.extend(plane_measured()?);
+    measured.extend(thermal_measured()?);
     measured.push(Measured {
         name: "BACKWARD_ULPS (units of ε)".into(),
         used_in: "tests/matrices.rs",
