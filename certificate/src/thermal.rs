@@ -1,7 +1,7 @@
 //! The thermal bar's certificate: the heat equation's Fourier mode (`γ = 0`) under refinement,
-//! the exact total-energy identity on every thermal scene, the steady state with contact and
-//! the coupled thermoelastic modes (the cubic's roots against the run's, extracted by Prony's
-//! method). Closed forms and derivations: `docs/thermal.md`. Fast enough for `cargo test`.
+//! the exact total-energy identity on every thermal scene, the steady state with contact, the
+//! coupled thermoelastic modes (the cubic's roots against the run's, extracted by Prony's
+//! method) and a manufactured solution with contact. Closed forms and derivations: `docs/thermal.md`. Fast enough for `cargo test`.
 
 use nalgebra::{Complex, Matrix3, Vector3};
 use std::fmt::Write;
@@ -352,6 +352,102 @@ pub fn markdown() -> Result<String, RunError> {
             r.elements, r.complex_error, r.real_error
         );
     }
-    let _ = writeln!(md, "\nobserved orders {pc:.3} (complex), {pr:.3} (real)");
+    let _ = writeln!(md, "\nobserved orders {pc:.3} (complex), {pr:.3} (real)\n");
+    let (rows, pu, pt) = manufactured_study()?;
+    md.push_str("Manufactured solution with contact (Δt = 1/J, t = 2.5):\n\n");
+    md.push_str("| J | steps in contact | max error of u | max error of θ |\n|---|---|---|---|\n");
+    for (j, eu, et, contact) in &rows {
+        let _ = writeln!(md, "| {j} | {contact} | {eu:.3e} | {et:.3e} |");
+    }
+    let _ = writeln!(md, "\nobserved orders {pu:.3} (u), {pt:.3} (θ)");
     Ok(md)
+}
+
+/// The manufactured solution with contact (`docs/thermal.md`): `u = g(t) + h(t) sin(kx)/k`,
+/// `θ = φ(t) cos(kx)`, `k = π/2`, L = 1, Signorini at x = 0 (gap 1/4, on the obstacle exactly
+/// on `[1/2, 3/2]`, reaction `sin⁴(π(t − 1/2))`), free and at temperature 0 at x = 1,
+/// insulated at x = 0; `α = 0.1`, `γ = 0.5`, `κ = 0.2`.
+pub const MANUFACTURED: &str = r#"
+[bar]
+length = 1.0
+viscosity = 0.1
+[left]
+condition = "signorini"
+gap = 0.25
+[right]
+condition = "free"
+[initial]
+displacement = "-0.4/pi*sin(pi*x/2)"
+velocity = "-2"
+[load]
+density = "48*(max(0, 0.5 - t)^2 + max(0, t - 1.5)^2) + (0.2*cos(t) - pi^2/4*if(t < 0.5, 0, if(t <= 1.5, sin(pi*(t - 0.5))^4, 0)))*2/pi*sin(pi*x/2)"
+[heat]
+coupling = 0.5
+diffusivity = 0.2
+temperature = "-0.4*cos(pi*x/2)"
+source = "(2*(0.2*sin(t) + 0.02*cos(t) + if(t < 0.5, 0, if(t <= 1.5, 4*pi*sin(pi*(t - 0.5))^3*cos(pi*(t - 0.5)), 0))) + 0.05*pi^2*2*(-0.2*cos(t) + 0.02*sin(t) + if(t < 0.5, 0, if(t <= 1.5, sin(pi*(t - 0.5))^4, 0))) + 0.1*sin(t))*cos(pi*x/2)"
+left = { condition = "insulated" }
+right = { condition = "temperature", value = "0" }
+[mesh]
+elements = 8
+[time]
+step = 0.1
+end = 2.5
+"#;
+
+/// The manufactured solution's `(u, θ)` at `(x, t)`.
+pub fn manufactured_exact(x: f64, t: f64) -> (f64, f64) {
+    let pi = std::f64::consts::PI;
+    let s = if (0.5..=1.5).contains(&t) {
+        (pi * (t - 0.5)).sin().powi(4)
+    } else {
+        0.0
+    };
+    let g = -0.25 + 4.0 * ((0.5 - t).max(0.0).powi(4) + (t - 1.5).max(0.0).powi(4));
+    let h = -0.2 * t.cos();
+    let phi = 2.0 * (-0.2 * t.cos() + 0.02 * t.sin() + s);
+    let k = pi / 2.0;
+    (g + h * (k * x).sin() / k, phi * (k * x).cos())
+}
+
+/// The manufactured study's levels (`J`, `Δt = 1/J`) to `t = 2.5`.
+pub const MANUFACTURED_ELEMENTS: [u64; 4] = [16, 32, 64, 128];
+
+/// Per level: `J`, the max nodal errors of `u^N` and of `θ^{N−1/2}`, the steps in contact; and
+/// the observed orders of both.
+pub fn manufactured_study() -> Result<(Vec<(u64, f64, f64, usize)>, f64, f64), RunError> {
+    manufactured_study_to(2.5)
+}
+
+/// [`manufactured_study`] to `t = end`.
+pub fn manufactured_study_to(
+    end: f64,
+) -> Result<(Vec<(u64, f64, f64, usize)>, f64, f64), RunError> {
+    let mut rows = Vec::new();
+    for elements in MANUFACTURED_ELEMENTS {
+        let dt = 1.0 / elements as f64;
+        let scene = sized(MANUFACTURED, elements, dt, end)?;
+        let (records, _, sim) = run_thermal_in_memory("manufactured", &scene)?;
+        let contact = records
+            .iter()
+            .filter(|r| r.contact.contact_nodes > 0)
+            .count();
+        let (t, dx) = (sim.time(), 1.0 / elements as f64);
+        let (mut eu, mut et) = (0.0f64, 0.0f64);
+        for (i, (u, th)) in sim
+            .displacement_dofs()
+            .iter()
+            .zip(temperatures(&sim))
+            .enumerate()
+        {
+            let x = i as f64 * dx;
+            eu = eu.max((u - manufactured_exact(x, t).0).abs());
+            et = et.max((th - manufactured_exact(x, t - 0.5 * dt).1).abs());
+        }
+        rows.push((elements, eu, et, contact));
+    }
+    let h: Vec<f64> = rows.iter().map(|r| 1.0 / r.0 as f64).collect();
+    let eu: Vec<f64> = rows.iter().map(|r| r.1).collect();
+    let et: Vec<f64> = rows.iter().map(|r| r.2).collect();
+    Ok((rows, observed_order(&h, &eu), observed_order(&h, &et)))
 }

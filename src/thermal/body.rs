@@ -470,18 +470,32 @@ impl Body for ThermalBody {
         Ok(())
     }
 
-    /// `θ^{1/2} − θ^0` by a Crank–Nicolson half step with the displacement's Taylor increment
-    /// in the coupling: `(M + Δt/4 (κK + hχ)) Δθ = Δt/2 (Q − κKφ − hχ(θ^0 − θ_obs)) − γ/2 Gᵀ z_u`.
+    /// The Taylor increment's thermal stress `Δt²/2 M⁻¹ γ G θ^0`, then `θ^{1/2} − θ^0` by a
+    /// Crank–Nicolson half step with the displacement's Taylor increment in the coupling: `(M + Δt/4 (κK + hχ)) Δθ = Δt/2 (Q − κKφ − hχ(θ^0 − θ_obs)) − γ/2 Gᵀ z_u`.
     fn complete_start_up(
         &self,
         u0: &[f64],
         _v0: &[f64],
         increment: &mut [f64],
     ) -> Result<(), RunError> {
-        let n_u = self.m.n_u;
+        let (n_u, gamma, dt) = (self.m.n_u, self.m.gamma, self.dt());
         let (zu, zt) = increment.split_at_mut(n_u);
-        self.heat_rhs(u0, zu, 0.5 * self.dt(), 1.0, zt);
-        let h = self.m.heat_matrix(0.25 * self.dt(), self.mask);
+        if gamma != 0.0 {
+            // The thermal stress in the Taylor step's acceleration: Δt²/2 M⁻¹ γ G θ^0.
+            let theta0 = |k: usize| match self.m.theta_unknown(k) {
+                Some(j) => u0[j],
+                None => self.fixed_at(k).map_or(0.0, |f| f.old),
+            };
+            let mut a: Vec<f64> = (0..n_u)
+                .map(|i| gamma * self.g_row(self.m.u_first + i, theta0))
+                .collect();
+            self.bar.solve_mass(&mut a)?;
+            for (z, ai) in zu.iter_mut().zip(&a) {
+                *z += 0.5 * dt * dt * ai;
+            }
+        }
+        self.heat_rhs(u0, zu, 0.5 * dt, 1.0, zt);
+        let h = self.m.heat_matrix(0.25 * dt, self.mask);
         if !zt.is_empty() {
             Ldlt::factor(&h)
                 .map_err(|e| {
