@@ -97,6 +97,9 @@ pub struct ZeroPivot {
 pub struct BandedLdlt<const P: usize> {
     /// `l[i][s − 1] = L_{i, i−s}`.
     l: Vec<[f64; P]>,
+    /// The columns of `L` below the diagonal, row by row for the backward solve:
+    /// `lt[i][s − 1] = L_{i+s, i}` (0 past the end).
+    lt: Vec<[f64; P]>,
     d: Vec<f64>,
     inv_d: Vec<f64>,
 }
@@ -128,7 +131,15 @@ impl<const P: usize> BandedLdlt<P> {
             d[i] = di;
         }
         let inv_d = d.iter().map(|v| 1.0 / v).collect();
-        Ok(Self { l, d, inv_d })
+        let mut lt = vec![[0.0; P]; n];
+        for (i, row) in lt.iter_mut().enumerate() {
+            for (s, v) in row.iter_mut().enumerate() {
+                if i + s + 1 < n {
+                    *v = l[i + s + 1][s];
+                }
+            }
+        }
+        Ok(Self { l, lt, d, inv_d })
     }
 
     pub fn dim(&self) -> usize {
@@ -146,26 +157,30 @@ impl<const P: usize> BandedLdlt<P> {
         (positive, self.d.len() - positive)
     }
 
-    /// `x ← A⁻¹ x`: `L y = x`, `y ← D⁻¹ y`, `Lᵀ x = y`. Allocates nothing.
+    /// `x ← A⁻¹ x`: `L y = x`, `y ← D⁻¹ y`, `Lᵀ x = y`, each sweep carrying the last `P`
+    /// values (the band of `L` is 0 where it leaves the matrix). Allocates nothing.
     pub fn solve_in_place(&self, x: &mut [f64]) {
         let n = self.dim();
         let x = &mut x[..n];
-        for i in 0..n {
-            let mut s = x[i];
-            for d in 1..=P.min(i) {
-                s -= self.l[i][d - 1] * x[i - d];
+        let mut w = [0.0; P];
+        for (xi, li) in x.iter_mut().zip(&self.l) {
+            // The term of the value just computed last: the sweep's dependency chain is one
+            // multiply and one subtraction per row.
+            let mut s = *xi;
+            for d in (0..P).rev() {
+                s -= li[d] * w[d];
             }
-            x[i] = s;
+            w = std::array::from_fn(|d| if d == 0 { s } else { w[d - 1] });
+            *xi = s;
         }
-        for (xi, inv) in x.iter_mut().zip(&self.inv_d) {
-            *xi *= inv;
-        }
-        for i in (0..n).rev() {
-            let mut s = x[i];
-            for d in 1..=P.min(n - 1 - i) {
-                s -= self.l[i + d][d - 1] * x[i + d];
+        let mut w = [0.0; P];
+        for ((xi, li), inv) in x.iter_mut().zip(&self.lt).zip(&self.inv_d).rev() {
+            let mut s = *xi * inv;
+            for d in (0..P).rev() {
+                s -= li[d] * w[d];
             }
-            x[i] = s;
+            w = std::array::from_fn(|d| if d == 0 { s } else { w[d - 1] });
+            *xi = s;
         }
     }
 }
