@@ -38,6 +38,11 @@ pub fn temperatures(sim: &ThermalSimulation) -> Vec<f64> {
         .collect()
 }
 
+/// Rows of a refinement study and its observed order.
+pub type Study<R> = (Vec<R>, f64);
+/// Rows of a refinement study and the observed orders of its two fields.
+pub type Study2<R> = (Vec<R>, f64, f64);
+
 /// The Fourier mode's data: `κ`, wave number `k = 2π` (L = 1), end time.
 pub const FOURIER: (f64, f64, f64) = (0.1, 2.0 * std::f64::consts::PI, 0.25);
 /// The refinement levels of the Fourier study (`J`, `Δt = 0.4/J`).
@@ -46,7 +51,7 @@ pub const FOURIER_ELEMENTS: [u64; 4] = [16, 32, 64, 128];
 /// The heat equation's Fourier mode `θ = exp(−κk²t) cos(kx)` on a free bar with insulated ends
 /// and `γ = 0`: the max nodal error of `θ^{N−1/2}` at `t_N − Δt/2` per level, and the observed
 /// order (least squares over the levels).
-pub fn fourier_study() -> Result<(Vec<(u64, f64, f64)>, f64), RunError> {
+pub fn fourier_study() -> Result<Study<(u64, f64, f64)>, RunError> {
     let (kappa, k, end) = FOURIER;
     let text = scene_text(
         "length = 1.0\nviscosity = 0.0",
@@ -281,7 +286,7 @@ pub struct ModeRow {
 }
 
 /// The mode study over [`MODE_ELEMENTS`] and the observed orders (complex root, real root).
-pub fn mode_study() -> Result<(Vec<ModeRow>, f64, f64), RunError> {
+pub fn mode_study() -> Result<Study2<ModeRow>, RunError> {
     let (real, complex) = cubic_roots();
     let mut rows = Vec::new();
     for elements in MODE_ELEMENTS {
@@ -415,14 +420,12 @@ pub const MANUFACTURED_ELEMENTS: [u64; 4] = [16, 32, 64, 128];
 
 /// Per level: `J`, the max nodal errors of `u^N` and of `θ^{N−1/2}`, the steps in contact; and
 /// the observed orders of both.
-pub fn manufactured_study() -> Result<(Vec<(u64, f64, f64, usize)>, f64, f64), RunError> {
+pub fn manufactured_study() -> Result<Study2<(u64, f64, f64, usize)>, RunError> {
     manufactured_study_to(2.5)
 }
 
 /// [`manufactured_study`] to `t = end`.
-pub fn manufactured_study_to(
-    end: f64,
-) -> Result<(Vec<(u64, f64, f64, usize)>, f64, f64), RunError> {
+pub fn manufactured_study_to(end: f64) -> Result<Study2<(u64, f64, f64, usize)>, RunError> {
     let mut rows = Vec::new();
     for elements in MANUFACTURED_ELEMENTS {
         let dt = 1.0 / elements as f64;
