@@ -337,7 +337,7 @@ pub fn markdown() -> Result<String, RunError> {
         let (u0, r) = steady_closed_form(theta);
         let _ = writeln!(
             md,
-            "| {theta} | {u0} | {r:.4} | {:.2e} |",
+            "| {theta} | {u0:.4} | {r:.4} | {:.2e} |",
             steady_deviation(theta)?
         );
     }

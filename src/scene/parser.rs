@@ -2,7 +2,7 @@
 //! from text to the expression tree. The grammar (numbers, `x`, `y`, `t`, constants, `+ - * /`
 //! left-associative, `^` right-associative and tighter than unary minus, comparisons loosest,
 //! `if`, `step`, the one- and several-argument functions) is README.md's "Expressions" table.
-//! Spaces are ignored; nesting is bounded by [`MAX_DEPTH`]. A parse error names the field, the
+//! Spaces are ignored; nesting is bounded by `MAX_DEPTH`. A parse error names the field, the
 //! text and the column (counted in characters from 1), e.g.
 //! ``` `initial.displacement` = "max(0,min(1,2-x)": unclosed parenthesis opened at column 4```.
 
