@@ -32,6 +32,7 @@
 //!     initial: Initial { displacement: "0".into(), velocity: "-1".into() },
 //!     load: Default::default(),
 //!     obstacle: None,
+//!     heat: None,
 //!     mesh: Mesh { elements: 100 },
 //!     time: Time { step: 0.01, end: 3.0 },
 //!     solver: Default::default(),
@@ -64,6 +65,7 @@ pub mod scene;
 pub mod scheme;
 pub mod step;
 pub mod study;
+pub mod thermal;
 
 pub use bar::Simulation;
 pub use output::{ContactEpisode, Summary, run_in_memory, run_to_dir};

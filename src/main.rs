@@ -254,7 +254,11 @@ const LIST_GAP: usize = 2;
 /// The `scenes` listing: each built-in name, in a column as wide as the longest, beside the
 /// first sentence of its description, wrapped onto indented continuation lines.
 fn scene_list() -> String {
-    let all = || scene::BUILTIN.iter().chain(scene::plane::PLANE_BUILTIN);
+    let all = || {
+        (scene::BUILTIN.iter())
+            .chain(scene::THERMAL_BUILTIN)
+            .chain(scene::plane::PLANE_BUILTIN)
+    };
     let width = all()
         .map(|(name, _)| name.chars().count())
         .max()
@@ -315,6 +319,7 @@ fn first_sentence(text: &str) -> String {
 /// The names of the built-in scenes, bar and plane.
 fn all_builtin_names() -> Vec<&'static str> {
     let mut names = scene::builtin_names();
+    names.extend(scene::thermal_builtin_names());
     names.extend(scene::plane::PLANE_BUILTIN.iter().map(|(n, _)| *n));
     names
 }

@@ -10,8 +10,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 /// The layers, bottom first.
-const LAYERS: [&str; 8] = [
-    "linalg", "step", "scene", "scheme", "bar", "plane", "output", "study",
+const LAYERS: [&str; 9] = [
+    "linalg", "step", "scene", "scheme", "bar", "thermal", "plane", "output", "study",
 ];
 
 /// A source file: its layer, its module name inside the layer (`mod` for `mod.rs`) and its text.

@@ -108,3 +108,46 @@ fn plane_steps_do_not_allocate() {
         );
     }
 }
+
+/// The thermal bar's steps (coupled, with contact and the exchange switching on; uncoupled;
+/// a source, a fixed temperature varying in time and a load) allocate nothing either.
+#[test]
+fn thermal_steps_do_not_allocate() {
+    let mut scenes: Vec<(String, viscobar::Scene)> = Vec::new();
+    for name in viscobar::scene::thermal_builtin_names() {
+        let (_, scene) = viscobar::scene::load(name, &[]).unwrap();
+        scenes.push((name.to_string(), scene));
+    }
+    for (name, sets) in [
+        ("thermal-impact", &["heat.coupling=0"][..]),
+        (
+            "heated-expansion",
+            &[
+                "heat.source=\"x*sin(t)\"",
+                "heat.right.value=\"1 + t\"",
+                "load.density=\"cos(t)\"",
+                "left.gap=0.0005",
+            ][..],
+        ),
+    ] {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let (_, scene) = viscobar::scene::load(name, &sets).unwrap();
+        scenes.push((format!("{name} {sets:?}"), scene));
+    }
+    for (name, scene) in scenes {
+        let mut sim = viscobar::thermal::ThermalSimulation::new(&scene).unwrap();
+        // Warm-up outside the count, up to the first contact.
+        while sim.step().unwrap().contact.contact_nodes == 0 && sim.step_index() < 1000 {}
+        let before = allocations();
+        let mut touched = 0;
+        for _ in 0..100 {
+            touched += sim.step().unwrap().contact.contact_nodes;
+        }
+        let allocations = allocations() - before;
+        assert!(touched > 0, "{name}: the counted steps have contact");
+        assert_eq!(
+            allocations, 0,
+            "{name}: {allocations} allocations in 100 thermal steps"
+        );
+    }
+}

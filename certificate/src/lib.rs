@@ -30,6 +30,7 @@ pub mod roundoff;
 pub mod scale;
 pub mod stiff;
 pub mod stiff_runs;
+pub mod thermal;
 pub mod timings;
 pub mod tolerances;
 pub mod verify;

@@ -66,7 +66,7 @@ fn keep<'a, T: Send + Sync>(
 pub fn sections() -> Result<Vec<Section>, ConvergeError> {
     let stiff = OnceLock::new();
     let drift = OnceLock::new();
-    let registry: [OnceLock<Vec<crate::tolerances::Measured>>; 3] = Default::default();
+    let registry: [OnceLock<Vec<crate::tolerances::Measured>>; 4] = Default::default();
     let backward = OnceLock::new();
     let jobs: Vec<Job> = vec![
         // The longest first.
@@ -78,6 +78,7 @@ pub fn sections() -> Result<Vec<Section>, ConvergeError> {
         keep(&registry[0], || Ok(crate::tolerances::measured()?)),
         keep(&registry[1], || Ok(crate::tolerances::plane_measured()?)),
         keep(&registry[2], || Ok(crate::tolerances::friction_measured()?)),
+        keep(&registry[3], || Ok(crate::tolerances::thermal_measured()?)),
         job("solver-agreement", || Ok(crate::agreement::markdown()?)),
         job("plane-contact", crate::plane_contact::markdown),
         Box::new(|| Ok(vec![convergence_section()?, falling_bar_section()?])),
@@ -92,6 +93,7 @@ pub fn sections() -> Result<Vec<Section>, ConvergeError> {
         Box::new(|| Ok(vec![matrices_section(), solve_section(), scenes_section()?])),
         job("locking", || Ok(crate::locking::markdown()?)),
         job("moving", || Ok(crate::moving::markdown()?)),
+        job("thermal", || Ok(crate::thermal::markdown()?)),
     ];
     let mut out = run_jobs(jobs)?;
     let (stiff, drift) = (stiff.get().expect("kept"), *drift.get().expect("kept"));

@@ -357,6 +357,21 @@ fn setup(
     })
 }
 
+/// A scene with `[heat]` refused where the bar without a temperature is set up (it runs as
+/// the thermal bar, `crate::thermal`).
+fn without_heat(scene: &Scene) -> Result<(), SceneError> {
+    match scene.heat {
+        None => Ok(()),
+        Some(_) => Err(SceneError::Invalid {
+            field: "heat".into(),
+            value: "(set)".into(),
+            allowed: "a scene with a temperature runs as the thermal bar (`viscobar run`); \
+                      this takes bar scenes without [heat]"
+                .into(),
+        }),
+    }
+}
+
 impl Scheme<BarBody> {
     /// Sets up a run of `scene` with the solver it names and takes the start-up step.
     pub fn new(scene: &Scene) -> Result<Self, RunError> {
@@ -366,6 +381,13 @@ impl Scheme<BarBody> {
     /// Sets `scene` up as [`Simulation::new`] does, short of the start-up step: for a run
     /// that writes `u^0` and `u_1` first and starts afterwards (without a copy of `u^0`).
     pub fn prepare(scene: &Scene) -> Result<Unstarted<BarBody>, RunError> {
+        without_heat(scene)?;
+        Self::prepare_mechanics(scene)
+    }
+
+    /// The bar of `scene` set up as [`Simulation::prepare`] does, its `[heat]` table (if any)
+    /// left to the caller: the displacement of the thermal bar.
+    pub fn prepare_mechanics(scene: &Scene) -> Result<Unstarted<BarBody>, RunError> {
         let disc = Discretisation::new(scene)?;
         let solver = make_solver(scene, &disc)?;
         Ok(Scheme::unstarted(setup(
@@ -390,6 +412,7 @@ impl Scheme<BarBody> {
         disc: Discretisation,
         solver: Box<dyn StepSolver>,
     ) -> Result<Self, RunError> {
+        without_heat(scene)?;
         Scheme::from_setup(setup(scene, disc, solver, Kernels::TWINS)?)
     }
 

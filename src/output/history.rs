@@ -4,7 +4,8 @@
 //! the extent `s` of the contact, the least gap and the total reaction), then the iterations.
 //! Optional columns follow `identity_residual` ([`OptionalColumns`]): `obstacle_work` when an
 //! obstacle moves; with friction, the friction dissipation `D_f` (empty when not measured) and
-//! the frictional nodes that stick and slip.
+//! the frictional nodes that stick and slip; for a bar with a temperature, the identity's
+//! thermal terms.
 
 use crate::output::text::{push_time, push_value};
 use crate::scheme::StepRecord;
@@ -19,6 +20,8 @@ const ENERGY_COLUMNS: &str =
 const OBSTACLE_COLUMN: &str = ",obstacle_work";
 /// The columns of a run with friction.
 const FRICTION_COLUMNS: &str = ",friction_dissipation,stick_nodes,slip_nodes";
+/// The thermal terms of a bar with a temperature.
+const THERMAL_COLUMNS: &str = ",thermal_energy,thermal_dissipation,exchange,heat_supply";
 
 /// Which optional columns a run writes after `identity_residual`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -27,6 +30,9 @@ pub struct OptionalColumns {
     pub moving: bool,
     /// Some edge has friction: `friction_dissipation`, `stick_nodes`, `slip_nodes`.
     pub friction: bool,
+    /// The body has a temperature: `thermal_energy`, `thermal_dissipation`, `exchange`,
+    /// `heat_supply`.
+    pub thermal: bool,
 }
 
 /// The header line for a run with the contact `groups` and the `optional` columns.
@@ -37,6 +43,9 @@ pub fn header(groups: &[Group], optional: OptionalColumns) -> String {
     }
     if optional.friction {
         h.push_str(FRICTION_COLUMNS);
+    }
+    if optional.thermal {
+        h.push_str(THERMAL_COLUMNS);
     }
     for g in groups {
         let n = g.name;
@@ -82,6 +91,15 @@ pub fn row(r: &StepRecord, groups: &[Group], optional: OptionalColumns, row: &mu
             push_value(r.friction_dissipation, row);
         }
         write!(row, ",{},{}", r.stick_nodes, r.slip_nodes).expect("writing to a vector");
+    }
+    if optional.thermal {
+        let h = r.heat.unwrap_or_default();
+        for v in [h.energy, h.dissipation, h.exchange, h.supply] {
+            row.push(b',');
+            if r.measured {
+                push_value(v, row);
+            }
+        }
     }
     for (g, s) in groups.iter().zip(&r.contact.groups) {
         row.push(b',');

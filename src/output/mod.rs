@@ -15,5 +15,7 @@ pub mod summary;
 pub mod text;
 pub mod vtk;
 
-pub use run::{run_in_memory, run_plane_in_memory, run_plane_to_dir, run_to_dir};
+pub use run::{
+    run_in_memory, run_plane_in_memory, run_plane_to_dir, run_thermal_in_memory, run_to_dir,
+};
 pub use summary::{ContactEpisode, Summary, Tracker};

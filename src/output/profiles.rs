@@ -1,7 +1,8 @@
 //! The profile file of a run, for either body: at each kept step, one row per written node,
 //! its time, coordinates, displacement and velocity (`t,x,u,v` on the bar's line,
 //! `t,x,y,ux,uy,vx,vy` on the plane; 0 at clamped degrees of freedom; the velocity is the
-//! scheme's `(u^n − u^{n−1})/Δt` at `t_{n−1/2}`). `displacement.csv` in text, or
+//! scheme's `(u^n − u^{n−1})/Δt` at `t_{n−1/2}`; a bar with a temperature adds `theta`, the
+//! scheme's `θ^{n−1/2}`). `displacement.csv` in text, or
 //! `displacement.npy` (cargo feature `npy`), sampled as [`OutputSampling`] says.
 
 use crate::output::text::{output_time, push_time, push_value};
@@ -25,9 +26,12 @@ pub fn written_nodes(lattice: [usize; 2], stride: usize) -> Vec<usize> {
         .collect()
 }
 
-/// The columns of a body with `components` degrees of freedom per node.
-pub fn columns(components: usize) -> &'static [&'static str] {
-    if components == 1 {
+/// The columns of a body with `components` degrees of freedom per node (`theta`: with a
+/// temperature).
+pub fn columns(components: usize, theta: bool) -> &'static [&'static str] {
+    if components == 1 && theta {
+        &["t", "x", "u", "v", "theta"]
+    } else if components == 1 {
         &["t", "x", "u", "v"]
     } else {
         &["t", "x", "y", "ux", "uy", "vx", "vy"]
@@ -44,6 +48,8 @@ enum Writer {
     #[cfg(feature = "npy")]
     Line(crate::output::npy::ProfileNpy<4>, Vec<[f64; 2]>),
     #[cfg(feature = "npy")]
+    LineTheta(crate::output::npy::ProfileNpy<5>, Vec<[f64; 2]>),
+    #[cfg(feature = "npy")]
     Plane(crate::output::npy::ProfileNpy<7>, Vec<[f64; 2]>),
 }
 
@@ -54,16 +60,19 @@ pub struct Profiles {
     components: usize,
     /// The unknown of each written degree of freedom (`None`: clamped, written as 0).
     unknowns: Vec<Option<usize>>,
+    /// Whether a column `theta` follows.
+    theta: bool,
 }
 
 impl Profiles {
     /// Writes the header into `file` (an `npy` scene in a build without the feature is
     /// refused before a run creates anything; `Unsupported` here all the same).
-    pub fn new(
+    pub fn new<B: Body>(
         file: std::fs::File,
-        body: &impl Body,
+        body: &B,
         sampling: &OutputSampling,
     ) -> std::io::Result<Self> {
+        let theta = B::TEMPERATURE;
         let stride = usize::try_from(sampling.node_stride).unwrap_or(usize::MAX);
         let nodes = written_nodes(body.lattice(), stride);
         let components = body.components();
@@ -78,7 +87,7 @@ impl Profiles {
         let writer = match sampling.format {
             OutputFormat::Csv => {
                 let mut file = std::io::BufWriter::with_capacity(1 << 17, file);
-                writeln!(file, "{}", columns(components).join(","))?;
+                writeln!(file, "{}", columns(components, theta).join(","))?;
                 let points = (nodes.iter())
                     .map(|&i| {
                         let (x, y) = body.point(i);
@@ -100,8 +109,10 @@ impl Profiles {
             OutputFormat::Npy => {
                 use crate::output::npy::ProfileNpy;
                 let points = nodes.iter().map(|&i| rounded(i)).collect();
-                let cols = columns(components);
-                if components == 1 {
+                let cols = columns(components, theta);
+                if theta {
+                    Writer::LineTheta(ProfileNpy::new(file, cols, sampling.rows)?, points)
+                } else if components == 1 {
                     Writer::Line(ProfileNpy::new(file, cols, sampling.rows)?, points)
                 } else {
                     Writer::Plane(ProfileNpy::new(file, cols, sampling.rows)?, points)
@@ -128,11 +139,13 @@ impl Profiles {
             nodes,
             components,
             unknowns,
+            theta,
         })
     }
 
-    /// The rows of one kept step at time `t`.
-    pub fn write(&mut self, t: f64, state: State<'_>) -> std::io::Result<()> {
+    /// The rows of one kept step at time `t` of `body`.
+    pub fn write<B: Body>(&mut self, t: f64, state: State<'_>, body: &B) -> std::io::Result<()> {
+        let theta = |j: usize| body.temperature(state.u, self.nodes[j]).unwrap_or(0.0);
         let k = self.components;
         let value = |dof: usize| match self.unknowns[dof] {
             Some(i) => (state.u[i], state.w[i] * state.scale),
@@ -153,7 +166,15 @@ impl Profiles {
                     }
                     for c in 0..k {
                         push_value(value(k * j + c).1, row);
-                        row.push(if c + 1 == k { b'\n' } else { b',' });
+                        row.push(if c + 1 == k && !self.theta {
+                            b'\n'
+                        } else {
+                            b','
+                        });
+                    }
+                    if self.theta {
+                        push_value(theta(j), row);
+                        row.push(b'\n');
                     }
                     file.write_all(row)?;
                 }
@@ -164,6 +185,14 @@ impl Profiles {
                 for (j, p) in points.iter().enumerate() {
                     let (u, v) = value(j);
                     npy.push([t, p[0], u, v])?;
+                }
+            }
+            #[cfg(feature = "npy")]
+            Writer::LineTheta(npy, points) => {
+                let t = output_time(t);
+                for (j, p) in points.iter().enumerate() {
+                    let (u, v) = value(j);
+                    npy.push([t, p[0], u, v, theta(j)])?;
                 }
             }
             #[cfg(feature = "npy")]
@@ -184,6 +213,8 @@ impl Profiles {
             Writer::Csv { mut file, .. } => file.flush(),
             #[cfg(feature = "npy")]
             Writer::Line(npy, _) => npy.finish(),
+            #[cfg(feature = "npy")]
+            Writer::LineTheta(npy, _) => npy.finish(),
             #[cfg(feature = "npy")]
             Writer::Plane(npy, _) => npy.finish(),
         }

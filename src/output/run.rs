@@ -11,6 +11,7 @@ use crate::plane::PlaneSimulation;
 use crate::scene::plane::PlaneScene;
 use crate::scene::{OutputFormat, OutputSampling, OutputSpec, Scene};
 use crate::scheme::{Body, RunError, Scheme, StepRecord, Unstarted};
+use crate::thermal::ThermalSimulation;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -42,6 +43,14 @@ pub fn run_in_memory(
     run_scheme_in_memory(name, Simulation::new(scene)?, scene.steps())
 }
 
+/// Runs a bar scene with a temperature (`[heat]`) in memory.
+pub fn run_thermal_in_memory(
+    name: &str,
+    scene: &Scene,
+) -> Result<(Vec<StepRecord>, Summary, ThermalSimulation), RunError> {
+    run_scheme_in_memory(name, ThermalSimulation::new(scene)?, scene.steps())
+}
+
 /// Runs a plane scene in memory.
 pub fn run_plane_in_memory(
     name: &str,
@@ -50,7 +59,7 @@ pub fn run_plane_in_memory(
     run_scheme_in_memory(name, PlaneSimulation::new(scene)?, scene.steps())
 }
 
-/// Runs a bar scene and writes `summary.json`, `history.csv` and the profiles
+/// Runs a bar scene (with or without a temperature) and writes `summary.json`, `history.csv` and the profiles
 /// (`displacement.csv`, or `displacement.npy` with `[output] format = "npy"`) into `out`. The
 /// scene is set up (discretised, its initial data evaluated) before anything is created, so
 /// a refused scene leaves no trace on disk; the files are moved into place only when the run
@@ -66,7 +75,6 @@ pub fn run_to_dir(
     let start = Instant::now();
     // Again here: a scene's fields are public, so this one may not have been validated.
     scene.output.format.check_available()?;
-    let prepared = Simulation::prepare(scene)?;
     let run = Run {
         name,
         steps: scene.steps(),
@@ -74,7 +82,10 @@ pub fn run_to_dir(
         sampling: scene.output_sampling(),
         progress,
     };
-    run.write(prepared, start, out)
+    if scene.heat.is_some() {
+        return run.write(ThermalSimulation::prepare(scene)?, start, out);
+    }
+    run.write(Simulation::prepare(scene)?, start, out)
 }
 
 /// Runs a plane scene and writes its files into `out`, as [`run_to_dir`] does for the bar.
@@ -148,6 +159,7 @@ impl Run<'_> {
         let optional = history::OptionalColumns {
             moving: prepared.contact().is_moving(),
             friction: !prepared.contact().friction().is_empty(),
+            thermal: B::TEMPERATURE,
         };
         hist.write_all(history::header(&groups, optional).as_bytes())
             .map_err(io(&hist_path))?;

@@ -340,3 +340,41 @@ impl Expression {
         }
     }
 }
+
+/// The text of a number given where an expression may be: `{:?}` of the `f64`, which reads back
+/// to the same bits (`0.1` stays `0.1`, `1e-7` stays `1e-7`); shared by every expression field
+/// so that `displacement = 0.1`, `--set initial.displacement=0.1` and `gap = 0.1` agree.
+pub fn number_text(v: f64) -> String {
+    format!("{v:?}")
+}
+
+/// Serde: an expression field given as a string (the expression) or as a number (TOML integer
+/// or float, kept as [`number_text`]). A non-finite float is kept as `inf`/`NaN`, which the
+/// expression parser then refuses with the field's name.
+pub(crate) fn number_or_expression<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<String, D::Error> {
+    struct Visitor;
+    impl serde::de::Visitor<'_> for Visitor {
+        type Value = String;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a number or an expression in quotes, e.g. 0.1 or \"0.3*cos(2*x)\"")
+        }
+        fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<String, E> {
+            Ok(v.to_string())
+        }
+        fn visit_string<E: serde::de::Error>(self, v: String) -> Result<String, E> {
+            Ok(v)
+        }
+        fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<String, E> {
+            Ok(number_text(v as f64))
+        }
+        fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<String, E> {
+            Ok(number_text(v as f64))
+        }
+        fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<String, E> {
+            Ok(number_text(v))
+        }
+    }
+    d.deserialize_any(Visitor)
+}

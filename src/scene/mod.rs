@@ -7,6 +7,7 @@
 pub mod error;
 pub mod expr;
 pub mod friction;
+pub mod heat;
 pub mod nodal;
 pub mod output;
 pub mod parser;

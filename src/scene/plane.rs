@@ -335,6 +335,7 @@ pub fn load_any(
     let path = Path::new(name_or_path);
     if !path.is_file() {
         let mut names = builtin_names();
+        names.extend(crate::scene::thermal_builtin_names());
         names.extend(PLANE_BUILTIN.iter().map(|(n, _)| *n));
         return Err(SceneError::UnknownScene {
             name: name_or_path.to_string(),
@@ -374,7 +375,15 @@ impl PlaneScene {
     /// Parses TOML text, applies `key=value` overrides (as for the bar) and validates.
     pub fn from_toml(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
         let table: toml::Table = toml::from_str(text).map_err(toml_syntax)?;
-        let scene: PlaneScene = with_overrides(table, overrides)?;
+        let table = crate::scene::schema::overridden(table, overrides)?;
+        if table.contains_key("heat") {
+            return Err(SceneError::Invalid {
+                field: "heat".into(),
+                value: "(set)".into(),
+                allowed: "the plane body has no temperature: [heat] belongs to bar scenes".into(),
+            });
+        }
+        let scene: PlaneScene = with_overrides(table, &[])?;
         scene.validate()?;
         Ok(scene)
     }

@@ -6,6 +6,8 @@
 use crate::scene::SceneError;
 use crate::scene::error::invalid;
 use crate::scene::expr::Expression;
+pub(crate) use crate::scene::expr::number_or_expression;
+pub use crate::scene::expr::number_text;
 use crate::scene::output::{OutputSampling, OutputSpec};
 use crate::scene::solver::SolverSpec;
 use serde::{Deserialize, Serialize};
@@ -85,6 +87,9 @@ pub struct Scene {
     /// Distributed Signorini: an obstacle `u(x) >= -g(x)` under every node.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub obstacle: Option<Obstacle>,
+    /// The temperature (`[heat]`, [`crate::scene::heat`]); absent: the bar has none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heat: Option<crate::scene::heat::Heat>,
     pub mesh: Mesh,
     pub time: Time,
     #[serde(default)]
@@ -228,44 +233,6 @@ impl GapValue {
     }
 }
 
-/// The text of a number given where an expression may be: `{:?}` of the `f64`, which reads back
-/// to the same bits (`0.1` stays `0.1`, `1e-7` stays `1e-7`); shared by every expression field
-/// so that `displacement = 0.1`, `--set initial.displacement=0.1` and `gap = 0.1` agree.
-pub fn number_text(v: f64) -> String {
-    format!("{v:?}")
-}
-
-/// Serde: an expression field given as a string (the expression) or as a number (TOML integer
-/// or float, kept as [`number_text`]). A non-finite float is kept as `inf`/`NaN`, which the
-/// expression parser then refuses with the field's name.
-pub(crate) fn number_or_expression<'de, D: serde::Deserializer<'de>>(
-    d: D,
-) -> Result<String, D::Error> {
-    struct Visitor;
-    impl serde::de::Visitor<'_> for Visitor {
-        type Value = String;
-        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-            f.write_str("a number or an expression in quotes, e.g. 0.1 or \"0.3*cos(2*x)\"")
-        }
-        fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<String, E> {
-            Ok(v.to_string())
-        }
-        fn visit_string<E: serde::de::Error>(self, v: String) -> Result<String, E> {
-            Ok(v)
-        }
-        fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<String, E> {
-            Ok(number_text(v as f64))
-        }
-        fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<String, E> {
-            Ok(number_text(v as f64))
-        }
-        fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<String, E> {
-            Ok(number_text(v))
-        }
-    }
-    d.deserialize_any(Visitor)
-}
-
 fn optional_number_or_expression<'de, D: serde::Deserializer<'de>>(
     d: D,
 ) -> Result<Option<String>, D::Error> {
@@ -342,6 +309,19 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ),
 ];
 
+/// Built-in scenes of the bar with a temperature (`[heat]`), embedded from `scenes/*.toml`
+/// (listed apart from [`BUILTIN`], whose users run the bar without one).
+pub const THERMAL_BUILTIN: &[(&str, &str)] = &[
+    (
+        "heated-expansion",
+        include_str!("../../scenes/heated-expansion.toml"),
+    ),
+    (
+        "thermal-impact",
+        include_str!("../../scenes/thermal-impact.toml"),
+    ),
+];
+
 /// Built-in plane scenes, embedded from `scenes/*.toml` (listed apart from the bar's
 /// [`crate::scene::BUILTIN`], whose users expect bar scenes).
 pub const PLANE_BUILTIN: &[(&str, &str)] = &[
@@ -389,9 +369,19 @@ pub fn builtin_names() -> Vec<&'static str> {
     BUILTIN.iter().map(|(n, _)| *n).collect()
 }
 
-/// The TOML text of a built-in scene.
+/// The TOML text of a built-in bar scene, with or without a temperature ([`BUILTIN`],
+/// [`THERMAL_BUILTIN`]).
 pub fn builtin_text(name: &str) -> Option<&'static str> {
-    BUILTIN.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
+    BUILTIN
+        .iter()
+        .chain(THERMAL_BUILTIN)
+        .find(|(n, _)| *n == name)
+        .map(|(_, t)| *t)
+}
+
+/// The names of the built-in scenes with a temperature, in order.
+pub fn thermal_builtin_names() -> Vec<&'static str> {
+    THERMAL_BUILTIN.iter().map(|(n, _)| *n).collect()
 }
 
 /// A plane scene given where only bar scenes are taken (`converge`, `compare`, `figures`).
@@ -416,9 +406,11 @@ pub fn load(name_or_path: &str, overrides: &[String]) -> Result<(String, Scene),
         None => {
             let path = Path::new(name_or_path);
             if !path.is_file() {
+                let mut names = builtin_names();
+                names.extend(thermal_builtin_names());
                 return Err(SceneError::UnknownScene {
                     name: name_or_path.to_string(),
-                    builtins: builtin_names().join(", "),
+                    builtins: names.join(", "),
                 });
             }
             let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
@@ -447,7 +439,9 @@ impl Scene {
         if table.contains_key("plane") && !table.contains_key("bar") {
             return Err(plane_not_here("this scene"));
         }
-        let scene: Scene = with_overrides(table, overrides)?;
+        let table = overridden(table, overrides)?;
+        crate::scene::heat::check_end_tables(&table)?;
+        let scene: Scene = table.try_into().map_err(toml_syntax)?;
         scene.validate()?;
         Ok(scene)
     }
@@ -562,6 +556,9 @@ impl Scene {
         if let Some(o) = &self.obstacle {
             o.gap.expression("obstacle.gap")?;
         }
+        if let Some(heat) = &self.heat {
+            heat.validate(self.thermal_view(), self.obstacle.is_some())?;
+        }
         Ok(())
     }
 
@@ -614,9 +611,28 @@ impl Scene {
         Ok(())
     }
 
-    /// Memory a run of this scene needs, estimated before anything is allocated.
+    /// Each end's `condition` name and whether it is a Signorini end, as `[heat]` checks its
+    /// thermal ends against them.
+    pub fn thermal_view(&self) -> [(&'static str, bool); 2] {
+        [&self.left, &self.right].map(|e| {
+            let name = match e.condition {
+                Condition::Signorini => "signorini",
+                Condition::Free => "free",
+                Condition::Clamped => "clamped",
+            };
+            (name, e.condition == Condition::Signorini)
+        })
+    }
+
+    /// Memory a run of this scene needs, estimated before anything is allocated (a bar with a
+    /// temperature: [`crate::scene::heat::HEAT_BYTES_PER_NODE`] more per node).
     pub fn estimated_bytes(&self) -> u64 {
-        (self.mesh.elements + 1).saturating_mul(BYTES_PER_NODE)
+        let per_node = BYTES_PER_NODE
+            + self
+                .heat
+                .as_ref()
+                .map_or(0, |_| crate::scene::heat::HEAT_BYTES_PER_NODE);
+        (self.mesh.elements + 1).saturating_mul(per_node)
     }
 
     /// The scene with `2^level` times as many elements and a step `2^level` times smaller
@@ -774,13 +790,23 @@ pub(crate) fn toml_syntax(e: toml::de::Error) -> SceneError {
 /// `table` with the `key=value` overrides applied, read as a scene of type `T` (not yet
 /// validated): the bar's and the plane's parsing share it.
 pub(crate) fn with_overrides<T: serde::de::DeserializeOwned>(
-    mut table: toml::Table,
+    table: toml::Table,
     overrides: &[String],
 ) -> Result<T, SceneError> {
+    overridden(table, overrides)?
+        .try_into()
+        .map_err(toml_syntax)
+}
+
+/// `table` with the `key=value` overrides applied.
+pub(crate) fn overridden(
+    mut table: toml::Table,
+    overrides: &[String],
+) -> Result<toml::Table, SceneError> {
     for assignment in overrides {
         apply_override(&mut table, assignment)?;
     }
-    table.try_into().map_err(toml_syntax)
+    Ok(table)
 }
 
 pub(crate) fn apply_override(table: &mut toml::Table, assignment: &str) -> Result<(), SceneError> {

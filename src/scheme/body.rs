@@ -18,6 +18,20 @@ pub struct EnergySums {
     pub work: f64,
 }
 
+/// The thermal terms of one step's energy identity, for a body with a temperature `θ` at the
+/// half steps (`θ̄ = (θ^{n+1/2} + θ^{n−1/2})/2`; derivation in `docs/thermal.md`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HeatTerms {
+    /// `½ |θ^{n+1/2}|²_M`, part of `E^{n+1/2}`.
+    pub energy: f64,
+    /// `Δt κ |θ̄|²_K >= 0`.
+    pub dissipation: f64,
+    /// `Δt Σ_e h χ_e (θ̄_e − θ_obs) θ̄_e`: heat given to the obstacles (either sign).
+    pub exchange: f64,
+    /// `Δt Q·θ̄` and the heat let in at the fixed-temperature ends.
+    pub supply: f64,
+}
+
 /// `x ↦ (M x)` restricted to the unknowns, for `x` given at every degree of freedom of the
 /// mesh (clamped ones included): the load vector of a nodal interpolant. Kept by a load that
 /// is evaluated every step; may use scratch space of its own.
@@ -72,6 +86,40 @@ pub trait Body {
     /// on the unknowns, for output (may allocate); `None` for a body whose outputs show no
     /// stress tensor (the bar).
     fn nodal_stress(&self, _u: &[f64], _v: &[f64]) -> Option<Vec<[f64; 4]>> {
+        None
+    }
+
+    // A body with a temperature (the thermal bar) supplies the hooks below; the defaults are
+    // those of a body without one, and leave its steps as they are.
+
+    /// Whether the body has a temperature (its outputs gain the thermal columns).
+    const TEMPERATURE: bool = false;
+    /// Brings the body's data to the step from `t_n` (boundary temperatures at `t_{n+1/2}`,
+    /// which ends exchange heat with `u^n`), before the step's right-hand side; `n = 0` before
+    /// the start-up step. Allocates nothing.
+    fn prepare_step(&mut self, _n: usize, _u: &[f64]) -> Result<(), RunError> {
+        Ok(())
+    }
+    /// Completes the start-up increment `u^1 − u^0` that the scheme has put in `increment`
+    /// (the displacement's Taylor step from `u^0 = u0`, `u_1 = v0`).
+    fn complete_start_up(
+        &self,
+        _u0: &[f64],
+        _v0: &[f64],
+        _increment: &mut [f64],
+    ) -> Result<(), RunError> {
+        Ok(())
+    }
+    /// `½ |θ|²_M` of the state `u` (`None` without a temperature).
+    fn heat_energy(&self, _u: &[f64]) -> Option<f64> {
+        None
+    }
+    /// The thermal terms of the step just taken, after `u += z` (`None` without a temperature).
+    fn heat_terms(&self, _u: &[f64], _z: &[f64], _w: &[f64]) -> Option<HeatTerms> {
+        None
+    }
+    /// `θ` at a mesh node in the state `u` (`None` without a temperature).
+    fn temperature(&self, _u: &[f64], _node: usize) -> Option<f64> {
         None
     }
 }

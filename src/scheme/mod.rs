@@ -15,7 +15,7 @@ pub mod friction;
 pub mod load;
 pub mod stepper;
 
-pub use body::{Body, EnergySums};
+pub use body::{Body, EnergySums, HeatTerms};
 pub use contact::{CONTACT_GAP_TOL, ContactSet, ContactState, GroupState, in_contact};
 pub use error::RunError;
 pub use friction::{FrictionState, SLIP_TOL, is_slipping};

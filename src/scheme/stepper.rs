@@ -1,7 +1,7 @@
 //! The scheme's state, its start-up step and its step, for any [`Body`]: see [`Scheme::step`].
 
 use crate::linalg::tridiag::dot;
-use crate::scheme::body::{Body, EnergySums};
+use crate::scheme::body::{Body, EnergySums, HeatTerms};
 use crate::scheme::clock::{PhaseClock, PhaseTimes};
 use crate::scheme::contact::{ContactSet, ContactState};
 use crate::scheme::error::RunError;
@@ -27,7 +27,8 @@ pub struct StepRecord {
     /// `D = −½ Σ_k r_k (s_k (u^{n+1} − u^{n−1})_{i_k} + g_k^{n+1} − g_k^{n−1}) >= 0`.
     pub contact_dissipation: f64,
     /// `|E^{n+1/2} − E^{n−1/2} − work − obstacle_work + viscous + D + D_f|` over the largest
-    /// of those terms.
+    /// of those terms (with a temperature: `+ thermal dissipation + exchange − supply`,
+    /// [`HeatTerms`]).
     pub identity_residual: f64,
     /// `W = −½ Σ_k r_k (g_k^{n+1} − g_k^{n−1})`, the work of moving obstacles (0 when none
     /// moves; of either sign).
@@ -37,6 +38,9 @@ pub struct StepRecord {
     /// Frictional nodes in contact that stick and that slip ([`crate::scheme::friction`]).
     pub stick_nodes: usize,
     pub slip_nodes: usize,
+    /// The thermal terms of a body with a temperature (measured steps; `E^{1/2}`'s at the
+    /// start-up step).
+    pub heat: Option<HeatTerms>,
     /// The contact state of `u^{n+1}`.
     pub contact: ContactState,
     /// The step solver's iterations (active sets tried, ADMM iterations…).
@@ -141,6 +145,7 @@ impl<B: Body> Scheme<B> {
     /// `u^1` is admissible. `z`, `w` and `b` serve as its work space.
     fn start_up(&mut self, v0: &[f64]) -> Result<(), RunError> {
         let (dt, alpha) = (self.body.dt(), self.body.viscosity());
+        self.body.prepare_step(0, &self.u)?;
         // a = M⁻¹ (F^0 − K u^0 − α K u_1), in z.
         let (acc, kv) = (&mut self.z, &mut self.b);
         self.body.stiffness_mul(&self.u, acc);
@@ -156,6 +161,7 @@ impl<B: Body> Scheme<B> {
         for i in 0..acc.len() {
             self.w[i] = dt * v0[i] + 0.5 * dt * dt * acc[i];
         }
+        self.body.complete_start_up(&self.u, v0, &mut self.w)?;
         self.body.step_matrix_mul(&self.w, &mut self.b);
         self.contact.advance_gaps(dt)?;
         self.contact.lower_bounds_into(&self.u, &mut self.lower);
@@ -166,8 +172,15 @@ impl<B: Body> Scheme<B> {
         add_in_place(&mut self.u, &self.z);
         self.body.mass_mul(&self.z, &mut self.b);
         let potential = self.body.stiffness_form(&self.u);
-        let energy =
+        let mut energy =
             0.5 * dot(&self.z, &self.b) * (1.0 / (dt * dt)) + 0.25 * (potential + potential0);
+        let heat = self.body.heat_energy(&self.u).map(|energy| HeatTerms {
+            energy,
+            ..Default::default()
+        });
+        if let Some(h) = heat {
+            energy += h.energy;
+        }
         if !energy.is_finite() {
             return Err(self.failure(1, StepFailure::NonFinite));
         }
@@ -181,6 +194,7 @@ impl<B: Body> Scheme<B> {
             time: dt,
             measured: true,
             energy,
+            heat,
             iterations: info.iterations,
             ..Default::default()
         };
@@ -234,7 +248,12 @@ impl<B: Body> Scheme<B> {
     pub fn step(&mut self) -> Result<StepRecord, RunError> {
         let n = self.n;
         let clock = PhaseClock::start(self.timing.samples(n));
+        let measure = (n + 1).is_multiple_of(self.diagnostics_every) || n + 1 == self.last_step;
+        if measure && !self.balance.measured {
+            self.restart_balance();
+        }
         // 1. F^n and b.
+        self.body.prepare_step(n, &self.u)?;
         self.load.update(&self.body, n)?;
         let force = self.load.force();
         self.body.rhs_into(&self.u, &self.w, force, &mut self.b);
@@ -242,10 +261,6 @@ impl<B: Body> Scheme<B> {
         // 2. The bounds of the increment (moving obstacles first moved to t_{n+1}).
         self.contact.advance_gaps((n + 1) as f64 * self.body.dt())?;
         self.contact.lower_bounds_into(&self.u, &mut self.lower);
-        let measure = (n + 1).is_multiple_of(self.diagnostics_every) || n + 1 == self.last_step;
-        if measure && !self.balance.measured {
-            self.restart_balance();
-        }
         // 3. The constrained minimisation, and u^{n+1} = u^n + z.
         self.solver.set_previous_increment(&self.w);
         let info = (self.solver)
@@ -268,7 +283,8 @@ impl<B: Body> Scheme<B> {
         if measure {
             let sums = (self.body).energy_sums(&self.u, &self.z, &self.w, self.load.force());
             record.obstacle_work = self.contact.obstacle_work(&self.reactions);
-            self.close_balance(&mut record, sums, [contact, friction.dissipation])?;
+            let heat = self.body.heat_terms(&self.u, &self.z, &self.w);
+            self.close_balance(&mut record, sums, [contact, friction.dissipation], heat)?;
         }
         self.balance.measured = measure;
         std::mem::swap(&mut self.w, &mut self.z);
@@ -286,20 +302,28 @@ impl<B: Body> Scheme<B> {
         self.balance.potential = potential;
         self.balance.energy =
             0.5 * self.body.mass_form(&self.w) * (1.0 / (dt * dt)) + 0.25 * (potential + before);
+        if let Some(heat) = self.body.heat_energy(&self.u) {
+            self.balance.energy += heat;
+        }
     }
 
     /// The energy identity of the step just taken from its sums, the contact term `D` and the
-    /// friction term `D_f`, into `record`; the balance moves on to `n + 1`.
+    /// friction term `D_f` and the thermal terms of a body with a temperature, into `record`;
+    /// the balance moves on to `n + 1`.
     fn close_balance(
         &mut self,
         record: &mut StepRecord,
         sums: EnergySums,
         [contact, friction]: [f64; 2],
+        heat: Option<HeatTerms>,
     ) -> Result<(), RunError> {
         let (dt, alpha) = (self.body.dt(), self.body.viscosity());
         let before = self.balance.energy;
-        let energy = 0.5 * sums.kinetic * (1.0 / (dt * dt))
+        let mut energy = 0.5 * sums.kinetic * (1.0 / (dt * dt))
             + 0.25 * (sums.potential + self.balance.potential);
+        if let Some(h) = heat {
+            energy += h.energy;
+        }
         let viscous = if alpha > 0.0 {
             alpha / (4.0 * dt) * sums.viscous
         } else {
@@ -307,12 +331,12 @@ impl<B: Body> Scheme<B> {
         };
         let work = 0.5 * sums.work;
         let obstacle = record.obstacle_work;
-        let residual = if obstacle == 0.0 {
+        let mut residual = if obstacle == 0.0 {
             energy - before - work + viscous + contact + friction
         } else {
             energy - before - work - obstacle + viscous + contact + friction
         };
-        let scale = [
+        let mut scale = [
             energy,
             before,
             work.abs(),
@@ -323,6 +347,12 @@ impl<B: Body> Scheme<B> {
         ]
         .into_iter()
         .fold(0.0, f64::max);
+        if let Some(h) = heat {
+            residual += h.dissipation + h.exchange - h.supply;
+            scale = [h.dissipation, h.exchange.abs(), h.supply.abs()]
+                .into_iter()
+                .fold(scale, f64::max);
+        }
         if !(energy.is_finite() && residual.is_finite()) {
             return Err(self.failure(record.step, StepFailure::NonFinite));
         }
@@ -331,6 +361,7 @@ impl<B: Body> Scheme<B> {
         record.viscous_dissipation = viscous;
         record.contact_dissipation = contact;
         record.friction_dissipation = friction;
+        record.heat = heat;
         record.identity_residual = if scale > 0.0 {
             residual.abs() / scale
         } else {
@@ -360,10 +391,11 @@ impl<B: Body> Scheme<B> {
         &self.contact
     }
 
-    /// Whether something can feed energy in: a load, or a moving obstacle (without either a
-    /// run cannot gain energy).
+    /// Whether something can feed energy in: a load, a moving obstacle, or a temperature (heat
+    /// may come in through the ends, a source or an exchange); without any a run cannot gain
+    /// energy.
     pub fn is_forced(&self) -> bool {
-        self.load.force().is_some() || self.contact.is_moving()
+        self.load.force().is_some() || self.contact.is_moving() || B::TEMPERATURE
     }
 
     /// The load vector `F^n` on the unknowns (zeros without a load), as the step from `t_n`
@@ -495,6 +527,22 @@ impl<B: Body> Unstarted<B> {
 
     pub fn contact(&self) -> &ContactSet {
         &self.scheme.contact
+    }
+
+    /// The set-up back, short of the start-up step: for a body that extends this one (the
+    /// thermal bar takes the bar's body, solver, constraints, load and initial data).
+    pub fn into_setup(self) -> Setup<B> {
+        let Self { scheme, v0 } = self;
+        Setup {
+            body: scheme.body,
+            solver: scheme.solver,
+            contact: scheme.contact,
+            load: scheme.load,
+            displacement: scheme.u,
+            velocity: v0,
+            steps: scheme.last_step,
+            diagnostics_every: scheme.diagnostics_every,
+        }
     }
 
     /// Takes the start-up step to `u^1`: the Taylor step projected onto `K_h` in the `C`-norm.

@@ -13,6 +13,7 @@ mod random_problems;
 mod scanner;
 mod scenes;
 mod solvers;
+mod thermal;
 
 pub use friction::*;
 pub use matrices::*;
@@ -20,6 +21,7 @@ pub use plane::*;
 pub use random_problems::*;
 pub use scenes::*;
 pub use solvers::*;
+pub use thermal::*;
 
 use crate::stiff::{CaseResult, checks};
 use crate::viscous_contact;
@@ -586,6 +588,7 @@ pub fn registry_markdown(
     let mut measured = measured()?;
     measured.extend(plane_measured()?);
     measured.extend(friction_measured()?);
+    measured.extend(thermal_measured()?);
     Ok(registry_markdown_of(
         measured,
         results,
@@ -595,7 +598,8 @@ pub fn registry_markdown(
 }
 
 /// [`registry_markdown`] from the measurements `measured` (those of [`measured`],
-/// [`plane_measured`] and [`friction_measured`], in that order) taken apart.
+/// [`plane_measured`], [`friction_measured`] and [`thermal_measured`], in that order) taken
+/// apart.
 pub fn registry_markdown_of(
     mut measured: Vec<Measured>,
     results: &[CaseResult],

@@ -1,0 +1,566 @@
+//! The thermal bar as a [`Body`] of the scheme: the state is `[u | θ]`, the bar's displacement
+//! `u^n` on its unknowns followed by the temperature `θ^{n−1/2}` on the nodes whose temperature
+//! is not fixed. Its kernels are the bar's on the displacement block (so the scheme's energy
+//! sums are the bar's) and the coupled ones where the step needs them: the right-hand side and
+//! the step matrix `[[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]]` ([`crate::thermal::matrices`]). The hooks
+//! evaluate the boundary data of each step, the start-up half step of `θ` and the thermal
+//! terms of the energy identity. Derivation: `docs/thermal.md`.
+
+use crate::bar::BarBody;
+use crate::linalg::ldlt::Ldlt;
+use crate::scene::SceneError;
+use crate::scene::heat::{EndHeat, HeatExpressions};
+use crate::scheme::body::{Body, EnergySums, FullMassRows, HeatTerms};
+use crate::scheme::{RunError, in_contact};
+use crate::thermal::matrices::ThermalMatrices;
+
+/// An exchange end: its node, constraint, unknown, gap and coefficient `h`, `θ_obs(t)`.
+#[derive(Clone, Debug)]
+pub struct ExchangeEnd {
+    pub node: usize,
+    /// Index into the bar's constraints (the order of the step's bounds).
+    pub constraint: usize,
+    pub unknown: usize,
+    pub gap: f64,
+    pub coefficient: f64,
+    pub obstacle: crate::scene::expr::Expression,
+}
+
+/// A fixed-temperature end: its node and `θ_end(t)`.
+#[derive(Clone, Debug)]
+pub struct FixedEnd {
+    pub node: usize,
+    pub value: crate::scene::expr::Expression,
+    /// `θ_end(t_{n−1/2})` and `θ_end(t_{n+1/2})` of the step being taken.
+    pub old: f64,
+    pub new: f64,
+}
+
+/// The bar with a temperature.
+pub struct ThermalBody {
+    pub(crate) bar: BarBody,
+    pub(crate) m: ThermalMatrices,
+    pub(crate) exchange: Vec<ExchangeEnd>,
+    pub(crate) fixed: Vec<FixedEnd>,
+    source: Option<crate::scene::expr::Expression>,
+    /// `Q^n = M_θ q(·, t_n)` on every node (empty without a source).
+    q: Vec<f64>,
+    /// `q(x_j, t_n)` (scratch).
+    q_nodal: Vec<f64>,
+    /// The exchange state of the step (bit `e`: exchange end `e` in contact with `u^n`) and
+    /// `θ_obs(t_n)` of each exchange end.
+    mask: usize,
+    theta_obs: [f64; 2],
+}
+
+/// `name(t)` finite, or the scene error naming `key`.
+fn eval_t(e: &crate::scene::expr::Expression, x: f64, t: f64, key: &str) -> Result<f64, RunError> {
+    let v = e.eval(x, t)?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(crate::scene::error::invalid(key, v, "must be finite at every node and time").into())
+    }
+}
+
+impl ThermalBody {
+    /// The body from the bar's and the parsed `[heat]` table (`constraints`: the bar's
+    /// constrained nodes with their gaps, in the order of the bounds).
+    pub fn new(
+        bar: BarBody,
+        (kappa, gamma): (f64, f64),
+        heat: HeatExpressions,
+        constraints: &[(usize, f64)],
+    ) -> Result<Self, SceneError> {
+        let disc = bar.discretisation();
+        let (nodes, dx, dt, first, n_u) =
+            (disc.nodes, disc.dx, disc.dt, disc.first, disc.unknowns());
+        let HeatExpressions { source, ends, .. } = heat;
+        let mut exchange = Vec::new();
+        let mut fixed = Vec::new();
+        for (side, end) in ends.into_iter().enumerate() {
+            let node = if side == 0 { 0 } else { nodes - 1 };
+            let key = if side == 0 { "heat.left" } else { "heat.right" };
+            match end {
+                EndHeat::Insulated => {}
+                EndHeat::Temperature(value) => {
+                    let v0 = value.eval(0.0, 0.0)?;
+                    if !v0.is_finite() {
+                        return Err(crate::scene::error::invalid(
+                            &format!("{key}.value"),
+                            v0,
+                            "must be finite",
+                        ));
+                    }
+                    fixed.push(FixedEnd {
+                        node,
+                        value,
+                        old: v0,
+                        new: v0,
+                    })
+                }
+                EndHeat::Exchange {
+                    coefficient,
+                    obstacle,
+                } => {
+                    let constraint = (constraints.iter())
+                        .position(|&(n, _)| n == node)
+                        .expect("validated: an exchange end is a Signorini end");
+                    exchange.push(ExchangeEnd {
+                        node,
+                        constraint,
+                        unknown: node - first,
+                        gap: constraints[constraint].1,
+                        coefficient,
+                        obstacle,
+                    });
+                }
+            }
+        }
+        let is_fixed = [0, nodes - 1].map(|n| fixed.iter().any(|f| f.node == n));
+        let m = ThermalMatrices::new(
+            nodes,
+            dx,
+            dt,
+            (kappa, gamma),
+            (first, n_u),
+            is_fixed,
+            exchange.iter().map(|e| (e.node, e.coefficient)).collect(),
+        );
+        let with_source = source.is_some();
+        Ok(Self {
+            bar,
+            m,
+            exchange,
+            fixed,
+            source,
+            q: if with_source {
+                vec![0.0; nodes]
+            } else {
+                Vec::new()
+            },
+            q_nodal: if with_source {
+                vec![0.0; nodes]
+            } else {
+                Vec::new()
+            },
+            mask: 0,
+            theta_obs: [0.0; 2],
+        })
+    }
+
+    /// The bar's body.
+    pub fn bar(&self) -> &BarBody {
+        &self.bar
+    }
+
+    /// The matrices and the layout of the unknowns.
+    pub fn matrices(&self) -> &ThermalMatrices {
+        &self.m
+    }
+
+    /// The exchange ends' constraint indices, in the order of the exchange state's bits.
+    pub fn exchange_constraints(&self) -> Vec<usize> {
+        self.exchange.iter().map(|e| e.constraint).collect()
+    }
+
+    /// The exchange state of the step being taken.
+    pub fn exchange_state(&self) -> usize {
+        self.mask
+    }
+
+    /// `θ` at `node`: the state's where it is an unknown, the fixed end's `new` value otherwise.
+    #[inline(always)]
+    fn theta(&self, u: &[f64], node: usize) -> f64 {
+        match self.m.theta_unknown(node) {
+            Some(j) => u[j],
+            None => self.fixed_at(node).map_or(0.0, |f| f.new),
+        }
+    }
+
+    #[inline(always)]
+    fn fixed_at(&self, node: usize) -> Option<&FixedEnd> {
+        self.fixed.iter().find(|f| f.node == node)
+    }
+
+    /// `φ_j`: `θ^{n−1/2}_j` at an unknown (from `u`), the mean `½(old + new)` at a fixed end.
+    #[inline(always)]
+    fn phi(&self, u: &[f64], node: usize) -> f64 {
+        match self.m.theta_unknown(node) {
+            Some(j) => u[j],
+            None => self.fixed_at(node).map_or(0.0, |f| 0.5 * (f.old + f.new)),
+        }
+    }
+
+    /// The fixed ends' increment `new − old` at `node` (0 elsewhere).
+    #[inline(always)]
+    fn fixed_increment(&self, node: usize) -> f64 {
+        self.fixed_at(node).map_or(0.0, |f| f.new - f.old)
+    }
+
+    /// `x` at every node for a displacement-block vector (0 at clamped nodes).
+    #[inline(always)]
+    fn disp(&self, x: &[f64], node: usize) -> f64 {
+        self.m.u_unknown(node).map_or(0.0, |i| x[i])
+    }
+
+    /// `(T v)_j` for a tridiagonal `T` on every node and `v` given node by node.
+    #[inline(always)]
+    fn tri_row(t: &crate::linalg::tridiag::SymTridiag, j: usize, v: impl Fn(usize) -> f64) -> f64 {
+        let n = t.diag.len();
+        let mut s = t.diag[j] * v(j);
+        if j > 0 {
+            s += t.off[j - 1] * v(j - 1);
+        }
+        if j + 1 < n {
+            s += t.off[j] * v(j + 1);
+        }
+        s
+    }
+
+    /// `(G φ)_i = ∫ φ φ_i'` at node `i` for `φ` given node by node.
+    #[inline(always)]
+    fn g_row(&self, i: usize, v: impl Fn(usize) -> f64) -> f64 {
+        let nodes = self.m.nodes;
+        let mut s = 0.0;
+        if i > 0 {
+            s += 0.5 * (v(i - 1) + v(i));
+        }
+        if i + 1 < nodes {
+            s -= 0.5 * (v(i) + v(i + 1));
+        }
+        s
+    }
+
+    /// `(Gᵀ v)_j = ∫ v_x ψ_j` at node `j` for `v` given node by node.
+    #[inline(always)]
+    fn gt_row(&self, j: usize, v: impl Fn(usize) -> f64) -> f64 {
+        let nodes = self.m.nodes;
+        let mut s = 0.0;
+        if j > 0 {
+            s += 0.5 * (v(j) - v(j - 1));
+        }
+        if j + 1 < nodes {
+            s += 0.5 * (v(j + 1) - v(j));
+        }
+        s
+    }
+
+    /// `h_e` at the exchange end at `node` when it exchanges in this step, and its `θ_obs`.
+    #[inline(always)]
+    fn exchanging(&self, node: usize) -> Option<(f64, f64)> {
+        (self.exchange.iter().enumerate())
+            .find(|(e, x)| x.node == node && self.mask & (1 << e) != 0)
+            .map(|(e, x)| (x.coefficient, self.theta_obs[e]))
+    }
+
+    /// `|x|²_K` of the temperature's stiffness on every node, by elements (exact for constants).
+    fn stiffness_quad(&self, x: impl Fn(usize) -> f64) -> f64 {
+        let off = &self.m.stiffness.off;
+        (0..off.len())
+            .map(|e| -off[e] * (x(e + 1) - x(e)).powi(2))
+            .sum()
+    }
+
+    /// `|x|²_M` of the temperature's mass on every node.
+    fn mass_quad(&self, x: impl Fn(usize) -> f64) -> f64 {
+        let mass = &self.m.mass;
+        let mut s = 0.0;
+        for j in 0..mass.diag.len() {
+            let xj = x(j);
+            s += mass.diag[j] * xj * xj;
+            if j + 1 < mass.diag.len() {
+                s += 2.0 * mass.off[j] * xj * x(j + 1);
+            }
+        }
+        s
+    }
+
+    /// The `θ` block of the right-hand side over the temperature's unknowns: the heat rows
+    /// times `−Δt` (`s = Δt`), or the start-up's half step (`s = Δt/2`) without the sign.
+    fn heat_rhs(&self, u: &[f64], w_u: &[f64], s: f64, sign: f64, b_theta: &mut [f64]) {
+        let m = &self.m;
+        let (kappa, gamma) = (m.kappa, m.gamma);
+        for (jt, bj) in b_theta.iter_mut().enumerate() {
+            let j = m.t_first + jt;
+            let mut r = -s * kappa * Self::tri_row(&m.stiffness, j, |k| self.phi(u, k));
+            if !self.q.is_empty() {
+                r += s * self.q[j];
+            }
+            if let Some((h, obs)) = self.exchanging(j) {
+                r -= s * h * (self.phi(u, j) - obs);
+            }
+            if gamma != 0.0 {
+                r -= 0.5 * gamma * self.gt_row(j, |k| self.disp(w_u, k));
+            }
+            if !self.fixed.is_empty() {
+                r -= Self::tri_row(&m.mass, j, |k| self.fixed_increment(k));
+            }
+            *bj = sign * r;
+        }
+    }
+}
+
+impl Body for ThermalBody {
+    const NAME: &'static str = "bar";
+    const TEMPERATURE: bool = true;
+
+    fn unknowns(&self) -> usize {
+        self.m.n_u + self.m.n_t
+    }
+
+    fn dt(&self) -> f64 {
+        self.bar.dt()
+    }
+
+    fn viscosity(&self) -> f64 {
+        self.bar.viscosity()
+    }
+
+    /// The bar's right-hand side plus `γ G φ` on the displacement, the heat rows times `−Δt`
+    /// on the temperature (`docs/thermal.md`).
+    fn rhs_into(&self, u: &[f64], w: &[f64], force: Option<&[f64]>, b: &mut [f64]) {
+        let n_u = self.m.n_u;
+        let (bu, bt) = b.split_at_mut(n_u);
+        let force = force.map(|f| &f[..n_u]);
+        self.bar.rhs_into(&u[..n_u], &w[..n_u], force, bu);
+        let gamma = self.m.gamma;
+        if gamma != 0.0 {
+            for (i, bi) in bu.iter_mut().enumerate() {
+                *bi += gamma * self.g_row(self.m.u_first + i, |k| self.phi(u, k));
+            }
+        }
+        self.heat_rhs(u, &w[..n_u], self.dt(), -1.0, bt);
+    }
+
+    fn energy_sums(&self, u: &[f64], z: &[f64], w: &[f64], force: Option<&[f64]>) -> EnergySums {
+        let n = self.m.n_u;
+        let force = force.map(|f| &f[..n]);
+        self.bar.energy_sums(&u[..n], &z[..n], &w[..n], force)
+    }
+
+    fn stiffness_form(&self, x: &[f64]) -> f64 {
+        self.bar.stiffness_form(&x[..self.m.n_u])
+    }
+
+    fn stiffness_form_of_difference(&self, u: &[f64], w: &[f64]) -> f64 {
+        let n = self.m.n_u;
+        self.bar.stiffness_form_of_difference(&u[..n], &w[..n])
+    }
+
+    fn mass_form(&self, x: &[f64]) -> f64 {
+        self.bar.mass_form(&x[..self.m.n_u])
+    }
+
+    fn mass_mul(&self, x: &[f64], y: &mut [f64]) {
+        let n = self.m.n_u;
+        self.bar.mass_mul(&x[..n], &mut y[..n]);
+        y[n..].fill(0.0);
+    }
+
+    fn stiffness_mul(&self, x: &[f64], y: &mut [f64]) {
+        let n = self.m.n_u;
+        self.bar.stiffness_mul(&x[..n], &mut y[..n]);
+        y[n..].fill(0.0);
+    }
+
+    /// `[[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]] x` with the step's exchange state.
+    fn step_matrix_mul(&self, x: &[f64], y: &mut [f64]) {
+        let m = &self.m;
+        let (n_u, gamma, s) = (m.n_u, m.gamma, 0.5 * self.dt());
+        let (xu, xt) = x.split_at(n_u);
+        let theta = |k: usize| m.theta_unknown(k).map_or(0.0, |j| x[j]);
+        let (yu, yt) = y.split_at_mut(n_u);
+        self.bar.step_matrix_mul(xu, yu);
+        for (i, yi) in yu.iter_mut().enumerate() {
+            *yi -= 0.5 * gamma * self.g_row(m.u_first + i, theta);
+        }
+        for (jt, yj) in yt.iter_mut().enumerate() {
+            let j = m.t_first + jt;
+            let mut h = Self::tri_row(&m.mass, j, theta)
+                + s * m.kappa * Self::tri_row(&m.stiffness, j, theta);
+            if let Some((coefficient, _)) = self.exchanging(j) {
+                h += s * coefficient * xt[jt];
+            }
+            *yj = -h - 0.5 * gamma * self.gt_row(j, |k| self.disp(xu, k));
+        }
+    }
+
+    fn solve_mass(&self, a: &mut [f64]) -> Result<(), RunError> {
+        let n = self.m.n_u;
+        self.bar.solve_mass(&mut a[..n])?;
+        a[n..].fill(0.0);
+        Ok(())
+    }
+
+    fn full_mass_rows(&self) -> FullMassRows {
+        let mut rows = self.bar.full_mass_rows();
+        let n = self.m.n_u;
+        Box::new(move |x, out| {
+            let k = n.min(out.len());
+            rows(x, &mut out[..k]);
+            out[k..].fill(0.0);
+        })
+    }
+
+    fn nodes(&self) -> usize {
+        self.bar.nodes()
+    }
+
+    fn elements(&self) -> usize {
+        self.bar.elements()
+    }
+
+    fn lattice(&self) -> [usize; 2] {
+        self.bar.lattice()
+    }
+
+    fn components(&self) -> usize {
+        1
+    }
+
+    fn point(&self, node: usize) -> (f64, Option<f64>) {
+        self.bar.point(node)
+    }
+
+    fn unknown_of(&self, dof: usize) -> Option<usize> {
+        self.bar.unknown_of(dof)
+    }
+
+    /// The exchange state from the gaps of `u^n` (as the step's bounds give them), `θ_obs(t_n)`,
+    /// the fixed ends' `θ_end(t_{n∓1/2})` and the source's `Q^n`. Allocates nothing.
+    fn prepare_step(&mut self, n: usize, u: &[f64]) -> Result<(), RunError> {
+        let dt = self.dt();
+        let t = n as f64 * dt;
+        let mut mask = 0;
+        for (e, x) in self.exchange.iter().enumerate() {
+            let lower = -x.gap - 1.0 * u[x.unknown];
+            if in_contact(-lower) {
+                mask |= 1 << e;
+            }
+            let key = if x.node == 0 {
+                "heat.left.obstacle"
+            } else {
+                "heat.right.obstacle"
+            };
+            self.theta_obs[e] = eval_t(&x.obstacle, 0.0, t, key)?;
+        }
+        self.mask = mask;
+        let (t_old, t_new) = if n == 0 {
+            (0.0, 0.5 * dt)
+        } else {
+            ((2 * n - 1) as f64 * 0.5 * dt, (2 * n + 1) as f64 * 0.5 * dt)
+        };
+        for f in &mut self.fixed {
+            let key = if f.node == 0 {
+                "heat.left.value"
+            } else {
+                "heat.right.value"
+            };
+            f.old = eval_t(&f.value, 0.0, t_old, key)?;
+            f.new = eval_t(&f.value, 0.0, t_new, key)?;
+        }
+        if let Some(source) = &self.source {
+            let dx = self.bar.discretisation().dx;
+            for (j, q) in self.q_nodal.iter_mut().enumerate() {
+                *q = eval_t(source, j as f64 * dx, t, "heat.source")?;
+            }
+            self.m.mass.mul_into(&self.q_nodal, &mut self.q);
+        }
+        Ok(())
+    }
+
+    /// The Taylor increment's thermal stress `Δt²/2 M⁻¹ γ G θ^0`, then `θ^{1/2} − θ^0` by a
+    /// Crank–Nicolson half step with the displacement's Taylor increment in the coupling: `(M + Δt/4 (κK + hχ)) Δθ = Δt/2 (Q − κKφ − hχ(θ^0 − θ_obs)) − γ/2 Gᵀ z_u`.
+    fn complete_start_up(
+        &self,
+        u0: &[f64],
+        _v0: &[f64],
+        increment: &mut [f64],
+    ) -> Result<(), RunError> {
+        let (n_u, gamma, dt) = (self.m.n_u, self.m.gamma, self.dt());
+        let (zu, zt) = increment.split_at_mut(n_u);
+        if gamma != 0.0 {
+            // The thermal stress in the Taylor step's acceleration: Δt²/2 M⁻¹ γ G θ^0.
+            let theta0 = |k: usize| match self.m.theta_unknown(k) {
+                Some(j) => u0[j],
+                None => self.fixed_at(k).map_or(0.0, |f| f.old),
+            };
+            let mut a: Vec<f64> = (0..n_u)
+                .map(|i| gamma * self.g_row(self.m.u_first + i, theta0))
+                .collect();
+            self.bar.solve_mass(&mut a)?;
+            for (z, ai) in zu.iter_mut().zip(&a) {
+                *z += 0.5 * dt * dt * ai;
+            }
+        }
+        self.heat_rhs(u0, zu, 0.5 * dt, 1.0, zt);
+        let h = self.m.heat_matrix(0.25 * dt, self.mask);
+        if !zt.is_empty() {
+            Ldlt::factor(&h)
+                .map_err(|e| {
+                    RunError::Scene(SceneError::Invalid {
+                        field: "heat.diffusivity".into(),
+                        value: self.m.kappa.to_string(),
+                        allowed: format!("the temperature's start-up matrix is not definite: {e}"),
+                    })
+                })?
+                .solve_in_place(zt);
+        }
+        Ok(())
+    }
+
+    fn heat_energy(&self, u: &[f64]) -> Option<f64> {
+        Some(0.5 * self.mass_quad(|k| self.theta(u, k)))
+    }
+
+    /// `½|θ^{n+1/2}|²_M`, `Δt κ |θ̄|²_K`, the exchange and the supply (source and the heat let
+    /// in at the fixed ends: the residual of their heat rows).
+    fn heat_terms(&self, u: &[f64], z: &[f64], w: &[f64]) -> Option<HeatTerms> {
+        let m = &self.m;
+        let dt = self.dt();
+        let n_u = m.n_u;
+        let bar_theta = |k: usize| match m.theta_unknown(k) {
+            Some(j) => u[j] - 0.5 * z[j],
+            None => self.fixed_at(k).map_or(0.0, |f| 0.5 * (f.old + f.new)),
+        };
+        let energy = 0.5 * self.mass_quad(|k| self.theta(u, k));
+        let dissipation = dt * m.kappa * self.stiffness_quad(bar_theta);
+        let mut exchange = 0.0;
+        for (e, x) in self.exchange.iter().enumerate() {
+            if self.mask & (1 << e) != 0 {
+                let tb = bar_theta(x.node);
+                exchange += dt * x.coefficient * (tb - self.theta_obs[e]) * tb;
+            }
+        }
+        let mut supply = 0.0;
+        if !self.q.is_empty() {
+            supply += dt * (0..m.nodes).map(|k| self.q[k] * bar_theta(k)).sum::<f64>();
+        }
+        for f in &self.fixed {
+            let j = f.node;
+            let delta = |k: usize| self.disp(&z[..n_u], k) + self.disp(&w[..n_u], k);
+            let dtheta = |k: usize| match m.theta_unknown(k) {
+                Some(i) => z[i],
+                None => self.fixed_increment(k),
+            };
+            let mut rho = Self::tri_row(&m.mass, j, dtheta)
+                + dt * m.kappa * Self::tri_row(&m.stiffness, j, bar_theta)
+                + 0.5 * m.gamma * self.gt_row(j, delta);
+            if !self.q.is_empty() {
+                rho -= dt * self.q[j];
+            }
+            supply += bar_theta(j) * rho;
+        }
+        Some(HeatTerms {
+            energy,
+            dissipation,
+            exchange,
+            supply,
+        })
+    }
+
+    fn temperature(&self, u: &[f64], node: usize) -> Option<f64> {
+        Some(self.theta(u, node))
+    }
+}

@@ -1,0 +1,117 @@
+//! Setting a thermal bar scene up: the bar's displacement, constraints and load as for the bar
+//! without a temperature, the initial temperature, and the step solver of the coupled step
+//! (one factorisation per exchange state, formed once).
+
+use crate::bar::Simulation;
+use crate::scene::Expression;
+use crate::scene::{Scene, SceneError, SolverMethod};
+use crate::scheme::{Body, Load, RunError, Scheme, Setup, Unstarted};
+use crate::step::{CondensedSolver, Constraints, StepSolver};
+use crate::thermal::body::ThermalBody;
+use crate::thermal::solver::{CoupledSolver, DecoupledSolver};
+use crate::thermal::system::CoupledSystem;
+
+/// A run of a thermal bar scene: the scheme stepping the bar with a temperature.
+pub type ThermalSimulation = Scheme<ThermalBody>;
+
+impl Scheme<ThermalBody> {
+    /// Sets up a run of `scene` (which has `[heat]`) and takes the start-up step.
+    pub fn new(scene: &Scene) -> Result<Self, RunError> {
+        Self::prepare(scene)?.start()
+    }
+
+    /// Sets `scene` up short of the start-up step.
+    pub fn prepare(scene: &Scene) -> Result<Unstarted<ThermalBody>, RunError> {
+        let Some(heat) = &scene.heat else {
+            return Err(SceneError::Invalid {
+                field: "heat".into(),
+                value: "missing".into(),
+                allowed: "the thermal bar needs a [heat] table".into(),
+            }
+            .into());
+        };
+        if scene.solver.method != SolverMethod::Exact {
+            return Err(SceneError::Invalid {
+                field: "solver.method".into(),
+                value: format!("{:?}", scene.solver.method).to_lowercase(),
+                allowed: "a scene with [heat] takes the exact step solver (\"exact\")".into(),
+            }
+            .into());
+        }
+        let expressions = heat.validate(scene.thermal_view(), scene.obstacle.is_some())?;
+        let bar = Simulation::prepare_mechanics(scene)?.into_setup();
+        let disc = bar.body.discretisation().clone();
+        let constraints: Vec<(usize, f64)> =
+            disc.constraints.iter().map(|c| (c.node, c.gap)).collect();
+        let dx = disc.dx;
+        let body = ThermalBody::new(
+            bar.body,
+            (heat.diffusivity, heat.coupling),
+            expressions.clone(),
+            &constraints,
+        )?;
+        let m = body.matrices().clone();
+        // [u^0 | θ^0] and [u_1 | 0].
+        let mut displacement = bar.displacement;
+        let mut velocity = bar.velocity;
+        let u_scale = crate::linalg::norms::max_abs(&displacement);
+        let u0 = displacement.clone();
+        for j in 0..m.n_t {
+            let x = (m.t_first + j) as f64 * dx;
+            let v = expressions.temperature.eval(x, 0.0)?;
+            if !v.is_finite() {
+                return Err(crate::scene::error::invalid(
+                    "heat.temperature",
+                    v,
+                    "must be finite at every node",
+                )
+                .into());
+            }
+            displacement.push(v);
+            velocity.push(0.0);
+        }
+        let exchange = body.exchange_constraints();
+        let masks = 1usize << exchange.len();
+        let solver: Box<dyn StepSolver> = if m.gamma == 0.0 {
+            let heat = (0..masks)
+                .map(|mask| crate::linalg::ldlt::Ldlt::factor(&m.heat_matrix(0.5 * disc.dt, mask)))
+                .collect::<Result<Vec<_>, _>>()?;
+            Box::new(DecoupledSolver::new(
+                bar.solver, heat, m.n_u, exchange, u_scale, u0,
+            ))
+        } else {
+            let mut variants: Vec<Box<dyn StepSolver>> = Vec::with_capacity(masks);
+            for mask in 0..masks {
+                let system =
+                    CoupledSystem::new(m.coupled(&disc.step_matrix, mask), m.interleaved_order())
+                        .map_err(|e| SceneError::Invalid {
+                        field: "heat.coupling".into(),
+                        value: m.gamma.to_string(),
+                        allowed: format!("the coupled step matrix has no LDLᵀ: {e}"),
+                    })?;
+                let constraints = Constraints::lower_bounds(&disc.constrained_locals());
+                variants.push(Box::new(CondensedSolver::new(system, constraints, 0.0)?));
+            }
+            Box::new(CoupledSolver::new(variants, exchange))
+        };
+        debug_assert_eq!(displacement.len(), body.unknowns());
+        // The load on the whole state (zero on the temperature's rows).
+        let load = match &scene.load.density {
+            None => Load::none(),
+            Some(text) => Load::new(
+                vec![Some(Expression::parse("load.density", text, true)?)],
+                &body,
+            )?,
+        };
+        Ok(Scheme::unstarted(Setup {
+            body,
+            solver,
+            contact: bar.contact,
+            load,
+            displacement,
+            velocity,
+            steps: bar.steps,
+            diagnostics_every: bar.diagnostics_every,
+        }))
+    }
+}

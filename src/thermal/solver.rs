@@ -1,0 +1,174 @@
+//! The thermal bar's step solvers behind the one seam ([`StepSolver`]), on the block layout
+//! `[u | θ]`. An exchange end changes the temperature's step matrix while it is in contact, so
+//! each exchange state has its own matrix, factorised once at set-up; the state of a step is
+//! read off its bounds (`lo_k = −gap_k(u^n)`, [`exchange_state`]), exactly as the body reads
+//! it for its right-hand side. Without coupling (`γ = 0`) the displacement is the bar's own
+//! step, by the bar's own solver ([`DecoupledSolver`]: the bar's bits), and the temperature a
+//! tridiagonal solve; with coupling, one solver per exchange state on the coupled matrix
+//! ([`CoupledSolver`]).
+
+use crate::linalg::ldlt::Ldlt;
+use crate::scheme::in_contact;
+use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
+
+/// The exchange state of a step: bit `e` set when the constraint `exchange[e]` is in contact
+/// with `u^n`, its gap `−lower[k]` at most [`crate::scheme::CONTACT_GAP_TOL`].
+#[inline]
+pub fn exchange_state(lower: &[f64], exchange: &[usize]) -> usize {
+    exchange
+        .iter()
+        .enumerate()
+        .filter(|(_, k)| in_contact(-lower[**k]))
+        .fold(0, |mask, (e, _)| mask | (1 << e))
+}
+
+/// `γ = 0`: the bar's step by the bar's solver on the displacement block, then
+/// `θ`'s increment from `−H_χ z_θ = b_θ`.
+pub struct DecoupledSolver {
+    mechanical: Box<dyn StepSolver>,
+    /// `H_χ` factorised, per exchange state.
+    heat: Vec<Ldlt>,
+    n_u: usize,
+    exchange: Vec<usize>,
+    /// The state scales the bar's own run would hand its solver at the start-up step and at
+    /// the first step (`max |u^0|`, `max |u^1|`), in place of the scheme's, which it takes over
+    /// the whole state `[u | θ]`; `u^0` until the start-up's increment is known.
+    scales: [Option<f64>; 2],
+    u0: Vec<f64>,
+}
+
+impl DecoupledSolver {
+    pub fn new(
+        mechanical: Box<dyn StepSolver>,
+        heat: Vec<Ldlt>,
+        n_u: usize,
+        exchange: Vec<usize>,
+        initial_u_scale: f64,
+        u0: Vec<f64>,
+    ) -> Self {
+        Self {
+            mechanical,
+            heat,
+            n_u,
+            exchange,
+            scales: [Some(initial_u_scale), None],
+            u0,
+        }
+    }
+
+    fn solve_heat(&self, rhs: &[f64], lower: &[f64], z: &mut [f64]) {
+        let n_u = self.n_u;
+        let zt = &mut z[n_u..];
+        for (zi, b) in zt.iter_mut().zip(&rhs[n_u..]) {
+            *zi = -b;
+        }
+        self.heat[exchange_state(lower, &self.exchange)].solve_in_place(zt);
+    }
+}
+
+impl StepSolver for DecoupledSolver {
+    fn name(&self) -> &'static str {
+        self.mechanical.name()
+    }
+
+    fn solve(
+        &mut self,
+        rhs: &[f64],
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<SolveInfo, StepFailure> {
+        let n_u = self.n_u;
+        let info = (self.mechanical).solve(&rhs[..n_u], lower, &mut z[..n_u], reactions)?;
+        if !self.u0.is_empty() {
+            // The start-up step: `max |u^0 + z|` as the scheme's addition gives it.
+            let u1 = self.u0.iter().zip(&z[..n_u]).map(|(u, z)| (u + z).abs());
+            self.scales[1] = Some(u1.fold(0.0, f64::max));
+            self.u0 = Vec::new();
+        }
+        self.solve_heat(rhs, lower, z);
+        Ok(info)
+    }
+
+    fn set_state_scale(&mut self, max_abs_u: f64) {
+        let scale = match self.scales {
+            [Some(s), _] => {
+                self.scales[0] = None;
+                s
+            }
+            [None, Some(s)] => {
+                self.scales[1] = None;
+                s
+            }
+            [None, None] => max_abs_u,
+        };
+        self.mechanical.set_state_scale(scale);
+    }
+
+    /// The bar's own advance on the displacement (its state scale returned), then the
+    /// temperature's.
+    fn solve_and_advance(
+        &mut self,
+        rhs: &[f64],
+        lower: &[f64],
+        u: &mut [f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<(SolveInfo, f64), StepFailure> {
+        let n_u = self.n_u;
+        let (info, scale) = self.mechanical.solve_and_advance(
+            &rhs[..n_u],
+            lower,
+            &mut u[..n_u],
+            &mut z[..n_u],
+            reactions,
+        )?;
+        self.solve_heat(rhs, lower, z);
+        for (ui, zi) in u[n_u..].iter_mut().zip(&z[n_u..]) {
+            *ui += zi;
+        }
+        Ok((info, scale))
+    }
+
+    fn report(&self) -> Option<SolverReport> {
+        self.mechanical.report()
+    }
+}
+
+/// `γ > 0`: one solver per exchange state on the coupled matrix.
+pub struct CoupledSolver {
+    variants: Vec<Box<dyn StepSolver>>,
+    exchange: Vec<usize>,
+}
+
+impl CoupledSolver {
+    /// `variants[mask]` solves the steps of exchange state `mask`.
+    pub fn new(variants: Vec<Box<dyn StepSolver>>, exchange: Vec<usize>) -> Self {
+        assert_eq!(variants.len(), 1 << exchange.len());
+        Self { variants, exchange }
+    }
+}
+
+impl StepSolver for CoupledSolver {
+    fn name(&self) -> &'static str {
+        self.variants[0].name()
+    }
+
+    fn solve(
+        &mut self,
+        rhs: &[f64],
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> Result<SolveInfo, StepFailure> {
+        let mask = exchange_state(lower, &self.exchange);
+        self.variants[mask].solve(rhs, lower, z, reactions)
+    }
+
+    /// The report of the variant that solved the most steps.
+    fn report(&self) -> Option<SolverReport> {
+        (self.variants.iter())
+            .filter_map(|v| v.report())
+            .max_by_key(|r| r.audit.steps)
+    }
+}

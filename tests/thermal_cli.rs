@@ -1,0 +1,170 @@
+//! The thermal bar through the command line: its files (history's thermal columns, the
+//! profile's `theta`) and its bad input, refused with exit 2 naming the key, nothing written.
+
+mod common;
+use common::{assert_each_refused, fresh_dir, viscobar};
+
+#[test]
+fn a_thermal_run_writes_the_thermal_columns() {
+    let out = fresh_dir("thermal", "columns");
+    let o = viscobar(&[
+        "run",
+        "thermal-impact",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "time.end=0.5",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    let header = history.lines().next().unwrap();
+    assert!(header.starts_with(
+        "step,t,energy,work,viscous_dissipation,contact_dissipation,identity_residual,\
+         thermal_energy,thermal_dissipation,exchange,heat_supply,gap_left,reaction_left"
+    ));
+    let columns = header.split(',').count();
+    assert!(
+        history
+            .lines()
+            .skip(1)
+            .all(|l| l.split(',').count() == columns)
+    );
+    let profile = std::fs::read_to_string(out.join("displacement.csv")).unwrap();
+    assert_eq!(profile.lines().next(), Some("t,x,u,v,theta"));
+    assert!(profile.lines().skip(1).all(|l| l.split(',').count() == 5));
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn bad_thermal_input_exits_2_naming_the_key_and_writes_nothing() {
+    let out = fresh_dir("thermal", "bad");
+    let cases: &[(&str, &[&str], &str)] = &[
+        (
+            "zero diffusivity",
+            &["heat.diffusivity=0"],
+            "heat.diffusivity",
+        ),
+        (
+            "negative diffusivity",
+            &["heat.diffusivity=-1"],
+            "heat.diffusivity",
+        ),
+        (
+            "nan diffusivity",
+            &["heat.diffusivity=nan"],
+            "heat.diffusivity",
+        ),
+        (
+            "negative coupling",
+            &["heat.coupling=-0.1"],
+            "heat.coupling",
+        ),
+        ("infinite coupling", &["heat.coupling=inf"], "heat.coupling"),
+        (
+            "negative exchange",
+            &["heat.left.coefficient=-1"],
+            "heat.left.coefficient",
+        ),
+        (
+            "nan exchange",
+            &["heat.left.coefficient=nan"],
+            "heat.left.coefficient",
+        ),
+        (
+            "exchange at a free end",
+            &["heat.right.condition=exchange", "heat.right.coefficient=1"],
+            "heat.right.condition",
+        ),
+        (
+            "value at an exchange end",
+            &["heat.left.value=1"],
+            "heat.left.value",
+        ),
+        (
+            "non-finite temperature",
+            &["heat.temperature=\"1/0\""],
+            "heat.temperature",
+        ),
+        (
+            "source non-finite mid-run",
+            &["heat.source=\"sqrt(0.1 - t)\""],
+            "heat.source",
+        ),
+        (
+            "non-finite obstacle",
+            &["heat.left.obstacle=\"1/0\""],
+            "heat.left.obstacle",
+        ),
+        ("unknown key", &["heat.conductivity=1"], "conductivity"),
+        ("osqp", &["solver.method=osqp"], "solver.method"),
+        ("penalty", &["solver.method=penalty"], "solver.method"),
+        (
+            "obstacle under every node",
+            &["obstacle.gap=0.1"],
+            "obstacle.gap",
+        ),
+    ];
+    assert_each_refused("thermal-impact", cases, &out);
+    let fixed: &[(&str, &[&str], &str)] = &[
+        (
+            "non-finite end temperature",
+            &["heat.right.value=\"1/t\""],
+            "heat.right.value",
+        ),
+        (
+            "temperature without value",
+            &["heat.right.value=\"\""],
+            "heat.right.value",
+        ),
+    ];
+    assert_each_refused("heated-expansion", fixed, &out);
+    let clamped: &[(&str, &[&str], &str)] = &[(
+        "exchange at a clamped end",
+        &[
+            "right.condition=clamped",
+            "heat.right.condition=exchange",
+            "heat.right.coefficient=1",
+        ],
+        "heat.right.condition",
+    )];
+    assert_each_refused("thermal-impact", clamped, &out);
+    // A thermal end on a bar without [heat].
+    let no_heat: &[(&str, &[&str], &str)] = &[
+        (
+            "thermal end without [heat]",
+            &["heat.left.condition=insulated"],
+            "heat.coupling",
+        ),
+        (
+            "thermal key in [left]",
+            &["left.coefficient=2"],
+            "left.coefficient",
+        ),
+        (
+            "thermal condition in [left]",
+            &["left.condition=exchange"],
+            "left.condition",
+        ),
+    ];
+    assert_each_refused("impact", no_heat, &out);
+}
+
+/// The commands that take bar scenes without a temperature refuse a thermal one (exit 2).
+#[test]
+fn commands_without_a_temperature_refuse_a_thermal_scene() {
+    let o = viscobar(&[
+        "converge",
+        "heated-expansion",
+        "--levels",
+        "2",
+        "--solvers",
+        "exact",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("heat"));
+}
