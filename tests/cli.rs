@@ -71,8 +71,9 @@ fn scenes_lists_every_builtin_with_a_whole_first_sentence() {
     let o = viscobar(&["scenes"]);
     assert!(o.status.success());
     let text = String::from_utf8_lossy(&o.stdout);
-    // Bar scenes, then plane scenes.
+    // Bar scenes, the bar's with a temperature, then plane scenes.
     let mut names = viscobar::scene::builtin_names();
+    names.extend(viscobar::scene::thermal_builtin_names());
     names.extend(
         viscobar::scene::plane::PLANE_BUILTIN
             .iter()
