@@ -71,7 +71,9 @@ impl KeptSteps {
         kept: Kept<'_, B>,
     ) -> Result<(), RunError> {
         match self {
-            KeptSteps::Table { profiles, path } => profiles.write(t, state).map_err(io(path)),
+            KeptSteps::Table { profiles, path } => {
+                profiles.write(t, state, kept.0).map_err(io(path))
+            }
             #[cfg(feature = "vtk")]
             KeptSteps::Vtu(s) => s.write(step, t, state, kept),
         }

@@ -54,8 +54,6 @@ impl Scheme<ThermalBody> {
         // [u^0 | θ^0] and [u_1 | 0].
         let mut displacement = bar.displacement;
         let mut velocity = bar.velocity;
-        let u_scale = crate::linalg::norms::max_abs(&displacement);
-        let u0 = displacement.clone();
         for j in 0..m.n_t {
             let x = (m.t_first + j) as f64 * dx;
             let v = expressions.temperature.eval(x, 0.0)?;
@@ -76,9 +74,7 @@ impl Scheme<ThermalBody> {
             let heat = (0..masks)
                 .map(|mask| crate::linalg::ldlt::Ldlt::factor(&m.heat_matrix(0.5 * disc.dt, mask)))
                 .collect::<Result<Vec<_>, _>>()?;
-            Box::new(DecoupledSolver::new(
-                bar.solver, heat, m.n_u, exchange, u_scale, u0,
-            ))
+            Box::new(DecoupledSolver::new(bar.solver, heat, m.n_u, exchange))
         } else {
             let mut variants: Vec<Box<dyn StepSolver>> = Vec::with_capacity(masks);
             for mask in 0..masks {

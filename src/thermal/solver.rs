@@ -30,11 +30,6 @@ pub struct DecoupledSolver {
     heat: Vec<Ldlt>,
     n_u: usize,
     exchange: Vec<usize>,
-    /// The state scales the bar's own run would hand its solver at the start-up step and at
-    /// the first step (`max |u^0|`, `max |u^1|`), in place of the scheme's, which it takes over
-    /// the whole state `[u | θ]`; `u^0` until the start-up's increment is known.
-    scales: [Option<f64>; 2],
-    u0: Vec<f64>,
 }
 
 impl DecoupledSolver {
@@ -43,16 +38,12 @@ impl DecoupledSolver {
         heat: Vec<Ldlt>,
         n_u: usize,
         exchange: Vec<usize>,
-        initial_u_scale: f64,
-        u0: Vec<f64>,
     ) -> Self {
         Self {
             mechanical,
             heat,
             n_u,
             exchange,
-            scales: [Some(initial_u_scale), None],
-            u0,
         }
     }
 
@@ -80,54 +71,8 @@ impl StepSolver for DecoupledSolver {
     ) -> Result<SolveInfo, StepFailure> {
         let n_u = self.n_u;
         let info = (self.mechanical).solve(&rhs[..n_u], lower, &mut z[..n_u], reactions)?;
-        if !self.u0.is_empty() {
-            // The start-up step: `max |u^0 + z|` as the scheme's addition gives it.
-            let u1 = self.u0.iter().zip(&z[..n_u]).map(|(u, z)| (u + z).abs());
-            self.scales[1] = Some(u1.fold(0.0, f64::max));
-            self.u0 = Vec::new();
-        }
         self.solve_heat(rhs, lower, z);
         Ok(info)
-    }
-
-    fn set_state_scale(&mut self, max_abs_u: f64) {
-        let scale = match self.scales {
-            [Some(s), _] => {
-                self.scales[0] = None;
-                s
-            }
-            [None, Some(s)] => {
-                self.scales[1] = None;
-                s
-            }
-            [None, None] => max_abs_u,
-        };
-        self.mechanical.set_state_scale(scale);
-    }
-
-    /// The bar's own advance on the displacement (its state scale returned), then the
-    /// temperature's.
-    fn solve_and_advance(
-        &mut self,
-        rhs: &[f64],
-        lower: &[f64],
-        u: &mut [f64],
-        z: &mut [f64],
-        reactions: &mut [f64],
-    ) -> Result<(SolveInfo, f64), StepFailure> {
-        let n_u = self.n_u;
-        let (info, scale) = self.mechanical.solve_and_advance(
-            &rhs[..n_u],
-            lower,
-            &mut u[..n_u],
-            &mut z[..n_u],
-            reactions,
-        )?;
-        self.solve_heat(rhs, lower, z);
-        for (ui, zi) in u[n_u..].iter_mut().zip(&z[n_u..]) {
-            *ui += zi;
-        }
-        Ok((info, scale))
     }
 
     fn report(&self) -> Option<SolverReport> {
