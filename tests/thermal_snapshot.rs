@@ -13,23 +13,17 @@ use viscobar::scene;
 use viscobar::scheme::Body;
 use viscobar::thermal::ThermalSimulation;
 
+mod common;
+
 /// Significant digits kept, relative to the largest magnitude of each quantity.
 const SIGNIFICANT_DIGITS: i32 = 7;
 /// Rows of the snapshot (10 intervals) and nodes sampled (4 intervals).
 const T_POINTS: usize = 11;
 const X_POINTS: usize = 5;
 
+/// [`common::round_to_digits`] with this file's [`SIGNIFICANT_DIGITS`].
 fn round_sig(x: f64, scale: f64) -> f64 {
-    if x == 0.0 || scale == 0.0 {
-        return x;
-    }
-    let exponent = scale.abs().log10().floor() as i32 - (SIGNIFICANT_DIGITS - 1);
-    let q = 10f64.powi(exponent);
-    let digits = (-exponent).max(0) as usize;
-    let r: f64 = format!("{:.*}", digits, (x / q).round() * q)
-        .parse()
-        .unwrap();
-    r + 0.0
+    common::round_to_digits(x, scale, SIGNIFICANT_DIGITS)
 }
 
 #[derive(Serialize)]

@@ -86,3 +86,20 @@ pub fn assert_each_refused(scene: &str, cases: &[(&str, &[&str], &str)], out: &s
         assert!(!out.exists(), "{what}: wrote {}", out.display());
     }
 }
+
+/// Rounds `x` to `digits` significant digits of `scale` (the largest magnitude of the same
+/// quantity): to a multiple of `10^(e − digits + 1)`, `10^e` the order of `scale`, printed in
+/// decimal so the snapshot shows the rounded value; `−0` becomes `0`. The plane, friction and
+/// thermal snapshots use it.
+pub fn round_to_digits(x: f64, scale: f64, digits: i32) -> f64 {
+    if x == 0.0 || scale == 0.0 {
+        return x;
+    }
+    let exponent = scale.abs().log10().floor() as i32 - (digits - 1);
+    let q = 10f64.powi(exponent);
+    let decimals = (-exponent).max(0) as usize;
+    let r: f64 = format!("{:.*}", decimals, (x / q).round() * q)
+        .parse()
+        .unwrap();
+    r + 0.0
+}
