@@ -33,10 +33,9 @@ const MIXED_LOAD_NS_TARGET: f64 = 30.0;
 const DISTRIBUTED_RATIO_TARGET: f64 = 4.0;
 const DISTRIBUTED_DT10DX_RATIO_TARGET: f64 = 15.0;
 
-/// Targets of the set-up and the output: a one-step run of the 16384-element two-end bar (ms),
-/// the 400-step run against its steps alone, that run's ns per node-step, and the refined
-/// 1e5-element run end to end (ns per node-step).
-const ONE_STEP_MS_TARGET: f64 = 5.0;
+/// Targets of the set-up and the output: the 400-step run against its steps alone, that run's
+/// ns per node-step, and the refined 1e5-element run end to end (ns per node-step). The
+/// one-step run is reported for information, without a target.
 const SETUP_RATIO_TARGET: f64 = 1.3;
 const SETUP_NS_TARGET: f64 = 4.5;
 const REFINED_NS_TARGET: f64 = 3.0;
@@ -354,14 +353,6 @@ impl Measurements {
             let _ = writeln!(out, "| {name} (stale) | | |");
         }
         let _ = writeln!(out, "\nTargets (set-up and output):");
-        if let Some(t) = setup.get("one-step") {
-            let _ = writeln!(
-                out,
-                "- one-step run, 16384 elements: {:.2} ms (target <= {ONE_STEP_MS_TARGET}): {}",
-                t / 1e6,
-                verdict(t / 1e6 <= ONE_STEP_MS_TARGET)
-            );
-        }
         if let (Some(run), Some(steps)) = (setup.get("400-steps"), setup.get("400-steps-stepping"))
         {
             let _ = writeln!(
@@ -518,13 +509,9 @@ impl Measurements {
             ),
         );
         let setup = &self.setup.rows;
-        let one_step = setup.get("one-step").map_or(MISSING.to_string(), |t| {
-            let ms = t / 1e6;
-            format!(
-                "{ms:.2} ms (target <= {ONE_STEP_MS_TARGET}: {})",
-                verdict(ms <= ONE_STEP_MS_TARGET)
-            )
-        });
+        let one_step = setup
+            .get("one-step")
+            .map_or(MISSING.to_string(), |t| format!("{:.2} ms", t / 1e6));
         let four_hundred = match (setup.get("400-steps"), setup.get("400-steps-stepping")) {
             (Some(run), Some(steps)) => {
                 let per = run / setup_node_steps("400-steps");
