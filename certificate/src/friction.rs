@@ -417,36 +417,11 @@ pub fn markdown() -> Result<String, ConvergeError> {
         (convergence()?, CONVERGENCE_REFERENCE),
         (full_convergence()?, FULL_CONVERGENCE_REFERENCE),
     ] {
-        md.push_str(&convergence_markdown(&levels, reference));
+        md.push_str(&crate::plane_contact::convergence_markdown(
+            &levels,
+            reference,
+            CONVERGENCE_END,
+        ));
     }
     Ok(md)
-}
-
-/// One convergence study's table and its reference line.
-fn convergence_markdown(levels: &[crate::plane_contact::ContactLevel], reference: u32) -> String {
-    let orders = crate::plane_contact::orders(levels);
-    let mut md = String::from(
-        "\n| level | nx × ny | Δt | max nodal error / max abs(u_ref) | order |\n|---|---|---|---|---|\n",
-    );
-    for (k, l) in levels.iter().enumerate() {
-        let order = if k == 0 {
-            "–".to_string()
-        } else {
-            format!("{:.2}", orders[k - 1])
-        };
-        let _ = writeln!(
-            md,
-            "| {} | {} × {} | {} | {:.3e} | {order} |",
-            l.level,
-            l.nx,
-            l.nx / 2,
-            l.dt,
-            l.max_error
-        );
-    }
-    let _ = writeln!(
-        md,
-        "\nReference: level {reference} (exact solver), T = {CONVERGENCE_END}."
-    );
-    md
 }

@@ -331,11 +331,8 @@ impl<B: Body> Scheme<B> {
         };
         let work = 0.5 * sums.work;
         let obstacle = record.obstacle_work;
-        let mut residual = if obstacle == 0.0 {
-            energy - before - work + viscous + contact + friction
-        } else {
-            energy - before - work - obstacle + viscous + contact + friction
-        };
+        // Subtracting a zero obstacle work is exact: fixed obstacles keep their bits.
+        let mut residual = energy - before - work - obstacle + viscous + contact + friction;
         let mut scale = [
             energy,
             before,

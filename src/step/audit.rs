@@ -270,7 +270,15 @@ pub fn record_and_check(
         w.observe(law.1, law.2);
     }
     let in_order = [primal, negative, comp].into_iter().chain(penalty_law);
-    for (what, value, tolerance) in in_order.chain([stationarity, displacement]) {
+    first_failure(in_order.chain([stationarity, displacement]))
+}
+
+/// The audit's verdict on its checks `(what, value, tolerance)` in order: the first whose
+/// value exceeds its tolerance (or is NaN) fails the step.
+pub(crate) fn first_failure(
+    checks: impl IntoIterator<Item = (&'static str, f64, f64)>,
+) -> Result<(), StepFailure> {
+    for (what, value, tolerance) in checks {
         // Negated so that a NaN residual fails.
         #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if !(value <= tolerance) {
@@ -284,7 +292,8 @@ pub fn record_and_check(
     Ok(())
 }
 
-fn ratio(value: f64, tolerance: f64) -> f64 {
+/// `value / tolerance`, infinite for a positive value against a zero tolerance.
+pub(crate) fn ratio(value: f64, tolerance: f64) -> f64 {
     if tolerance > 0.0 {
         value / tolerance
     } else if value > 0.0 {

@@ -178,9 +178,7 @@ impl<S: SpdSystem> StepSolver for FrictionalSolver<S> {
     }
 
     fn set_previous_increment(&mut self, w: &[f64]) {
-        for (v, &t) in self.previous.iter_mut().zip(&self.friction.tangents) {
-            *v = w[t];
-        }
+        self.friction.tangential_into(w, &mut self.previous);
         self.slip_known = true;
     }
 

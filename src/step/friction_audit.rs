@@ -10,6 +10,7 @@
 
 use crate::linalg::norms::max_abs;
 use crate::linalg::system::{SpdSystem, inverse_norm_estimate};
+use crate::step::audit::{first_failure, ratio};
 use crate::step::report::{AuditReport, StepFailure, Worst};
 use crate::step::solver::{Constraints, Friction};
 
@@ -177,7 +178,7 @@ impl FrictionAudit {
         observe(&mut rep.complementarity, comp);
         observe(&mut rep.friction_cone, (cone, cone_tol));
         observe(&mut rep.slip_law, slip);
-        for (what, value, tolerance) in [
+        first_failure([
             ("primal violation (lo_k - s_k z_k)+", primal, tol_z),
             ("negative reaction (-r_N)+", negative, tol_f),
             ("complementarity |r_N (s_k z_k - lo_k)|", comp.0, comp.1),
@@ -189,27 +190,6 @@ impl FrictionAudit {
                 displacement,
                 tol_dz,
             ),
-        ] {
-            // Negated so that a NaN residual fails.
-            #[allow(clippy::neg_cmp_op_on_partial_ord)]
-            if !(value <= tolerance) {
-                return Err(StepFailure::AuditFailed {
-                    what,
-                    value,
-                    tolerance,
-                });
-            }
-        }
-        Ok(())
-    }
-}
-
-fn ratio(value: f64, tolerance: f64) -> f64 {
-    if tolerance > 0.0 {
-        value / tolerance
-    } else if value > 0.0 {
-        f64::INFINITY
-    } else {
-        0.0
+        ])
     }
 }

@@ -56,6 +56,13 @@ pub struct Friction {
 }
 
 impl Friction {
+    /// `w` at the tangential unknowns, into `out` (one per frictional node).
+    pub fn tangential_into(&self, w: &[f64], out: &mut [f64]) {
+        for (v, &t) in out.iter_mut().zip(&self.tangents) {
+            *v = w[t];
+        }
+    }
+
     /// `p`, the frictional nodes.
     pub fn len(&self) -> usize {
         self.normals.len()
