@@ -3,7 +3,8 @@
 //! (`study::figure_writer` writes each file whole or not at all).
 //!
 //! Per scene (`<scene>.png`, `<scene>.svg`): the displacement `u(x, t)` as a colour map with a
-//! colour bar, beside the contact history. Per talk figure (`figure-<k>.png/.svg`): the `l = 0`
+//! colour bar (for a bar with a temperature, `θ(x, t)` beside it on its own scale), beside the
+//! contact history. Per talk figure (`figure-<k>.png/.svg`): the `l = 0`
 //! scene beside the forced one, as the talk lays them out.
 //!
 //! Only with the `plots` feature (on by default), which brings plotters and the font.
@@ -18,7 +19,7 @@ use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::element::Polygon;
 use plotters::prelude::*;
-use plotters::style::colors::colormaps::ViridisRGB;
+use plotters::style::colors::colormaps::{Copper, ViridisRGB};
 use std::path::{Path, PathBuf};
 
 /// The talk's figures, in order: file stem, caption, and the scenes of its two panels
@@ -57,6 +58,8 @@ pub const MAX_REACTION_LINES: usize = 2;
 
 /// Size of a one-scene figure (pixels; kept small for the README).
 pub const SCENE_SIZE: (u32, u32) = (1200, 500);
+/// Size of a one-scene figure of a bar with a temperature: a second colour-map column, `θ`.
+pub const THERMAL_SCENE_SIZE: (u32, u32) = (SCENE_SIZE.0 + MAP_COLUMN_WIDTH, SCENE_SIZE.1);
 /// Size of a two-panel talk figure.
 pub const PAIR_SIZE: (u32, u32) = (1200, 900);
 
@@ -114,8 +117,9 @@ pub fn write_talk_figures(out: &Path, overrides: &[String]) -> Result<Vec<PathBu
 }
 
 /// Runs one bar scene and writes its figure (the colour map of u(x, t) beside its contact
-/// panel, as [`write_talk_figures`] draws each talk scene) as `<name>.png` and `<name>.svg`
-/// into `out`; returns the files written (`viscobar run SCENE --figure`).
+/// panel, as [`write_talk_figures`] draws each talk scene; with `[heat]`, the colour map of
+/// θ(x, t) between them) as `<name>.png` and `<name>.svg` into `out`; returns the files
+/// written (`viscobar run SCENE --figure`).
 pub fn write_scene_figure(
     name: &str,
     scene: &scene::Scene,
@@ -161,6 +165,7 @@ enum TalkFigure<'a> {
 impl Drawing for TalkFigure<'_> {
     fn size(&self) -> (u32, u32) {
         match self {
+            TalkFigure::Scene(run) if run.theta.is_some() => THERMAL_SCENE_SIZE,
             TalkFigure::Scene(_) => SCENE_SIZE,
             TalkFigure::Pair(..) => PAIR_SIZE,
         }
@@ -212,7 +217,15 @@ where
     )?;
     let body = body.titled(&run.parameters_label(), sans(SUBTITLE_FONT))?;
     let (left, right) = body.split_horizontally(MAP_COLUMN_WIDTH);
-    draw_u_map(&left, run)?;
+    draw_map(&left, run, &Field::displacement(run))?;
+    let right = match Field::temperature(run) {
+        Some(theta) => {
+            let (middle, right) = right.split_horizontally(MAP_COLUMN_WIDTH);
+            draw_map(&middle, run, &theta)?;
+            right
+        }
+        None => right,
+    };
     draw_contact(&right, run)
 }
 
@@ -233,7 +246,14 @@ where
         let column = column.titled(&run.parameters_label(), sans(SUBTITLE_FONT - 2))?;
         let (_, h) = column.dim_in_pixel();
         let (top, bottom) = column.split_vertically(h * MAP_HEIGHT_PERCENT / 100);
-        draw_u_map(&top, run)?;
+        match Field::temperature(run) {
+            Some(theta) => {
+                let maps = top.split_evenly((1, 2));
+                draw_map(&maps[0], run, &Field::displacement(run))?;
+                draw_map(&maps[1], run, &theta)?;
+            }
+            None => draw_map(&top, run, &Field::displacement(run))?,
+        }
         draw_contact(&bottom, run)?;
     }
     Ok(())
@@ -336,25 +356,59 @@ where
     Ok(chart)
 }
 
-/// `u(x, t)` as a colour map, with its colour bar on the right.
-fn draw_u_map<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, run: &SampledRun) -> DrawResult
+/// A sampled field over `(x, t)` drawn as a colour map: its values (in the layout of
+/// [`SampledRun::u`]), the panel's title, the colour bar's label and the colour map.
+struct Field<'a> {
+    values: &'a [f64],
+    title: &'static str,
+    label: &'static str,
+    palette: fn(f64, f64, f64) -> RGBColor,
+}
+
+impl<'a> Field<'a> {
+    fn displacement(run: &'a SampledRun) -> Self {
+        Self {
+            values: &run.u,
+            title: "displacement u(x, t)",
+            label: "u",
+            palette: ViridisRGB::get_color_normalized::<f64>,
+        }
+    }
+
+    /// `θ(x, t)` of a bar with a temperature, in a colour map of its own (dark is cold).
+    fn temperature(run: &'a SampledRun) -> Option<Self> {
+        Some(Self {
+            values: run.theta.as_deref()?,
+            title: "temperature θ(x, t)",
+            label: "θ",
+            palette: Copper::get_color_normalized::<f64>,
+        })
+    }
+}
+
+/// `field` as a colour map on its own scale, with its colour bar on the right.
+fn draw_map<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    run: &SampledRun,
+    field: &Field,
+) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
-    let area = area.titled("displacement u(x, t)", sans(PANEL_FONT))?;
+    let area = area.titled(field.title, sans(PANEL_FONT))?;
     let (w, _) = area.dim_in_pixel();
     let (map_area, bar_area) = area.split_horizontally(w.saturating_sub(COLOUR_BAR_WIDTH));
-    let (lo, hi) = value_range(&run.u);
+    let (lo, hi) = value_range(field.values);
     let colour = |v: f64| {
         let level = ((v - lo) / (hi - lo) * COLOUR_LEVELS as f64).floor();
         let level = level.clamp(0.0, COLOUR_LEVELS as f64 - 1.0);
-        ViridisRGB::get_color_normalized(level + 0.5, 0.0, COLOUR_LEVELS as f64)
+        (field.palette)(level + 0.5, 0.0, COLOUR_LEVELS as f64)
     };
     let extent = (run.length, run.final_time());
     let mut chart = space_time_chart(&map_area, extent)?;
     let nx = run.xs.len();
     draw_raster(&mut chart, extent, &run.xs, &run.ts, |i, k| {
-        colour(run.u[k * nx + i])
+        colour(field.values[k * nx + i])
     })?;
 
     // Same top margin and x-label height as the map, so bar and map line up.
@@ -371,7 +425,7 @@ where
         .y_labels(8)
         .y_label_formatter(&|v| tick(*v, decimals))
         .x_labels(0)
-        .x_desc("u")
+        .x_desc(field.label)
         .axis_desc_style(sans(AXIS_FONT))
         .label_style(sans(TICK_FONT))
         .draw()?;

@@ -1,18 +1,20 @@
-//! A run reduced to what the talk's figures and the snapshots need: `u` on a bounded grid of
-//! mesh points, the energy at the sampled steps, and the contact history binned between them,
-//! all kept while stepping (memory is that of the samples, not of the run).
+//! A run reduced to what the talk's figures and the snapshots need: `u` (and, for a bar with a
+//! temperature, `θ`) on a bounded grid of mesh points, the energy at the sampled steps, and the
+//! contact history binned between them, all kept while stepping (memory is that of the samples,
+//! not of the run).
 //!
 //! Apart from the drawing (`study::figures`) because `tests/snapshots.rs` pins these samples
 //! without drawing them. Only with the `plots` feature, like the figures it feeds.
 
 #![cfg(feature = "plots")]
 
-use crate::bar::Simulation;
+use crate::bar::{Discretisation, Simulation};
 use crate::output::summary::{Summary, Tracker};
 use crate::scene::Scene;
 use crate::scheme::CONTACT_GAP_TOL;
-use crate::scheme::RunError;
 use crate::scheme::StepRecord;
+use crate::scheme::{Body, RunError, Scheme, Unstarted};
+use crate::thermal::ThermalSimulation;
 
 /// At most this many x-intervals of `u` are kept (a 400-element mesh is kept node for node;
 /// more nodes than plot pixels would add memory, not detail).
@@ -119,6 +121,8 @@ pub struct SampledRun {
     pub name: String,
     pub solver: String,
     pub alpha: f64,
+    /// The diffusivity `κ` and the coupling `γ` of a bar with a temperature (`[heat]`).
+    pub heat: Option<(f64, f64)>,
     pub length: f64,
     pub elements: usize,
     pub dt: f64,
@@ -133,6 +137,8 @@ pub struct SampledRun {
     pub ts: Vec<f64>,
     /// `u[k * xs.len() + i]` = `u` at node `nodes[i]` after step `steps_sampled[k]`.
     pub u: Vec<f64>,
+    /// `θ` in the layout of `u` (the profile file's `theta`), for a bar with a temperature.
+    pub theta: Option<Vec<f64>>,
     /// `E^{n−1/2}` recorded by sampled step `n` (`None` for `n = 0`, which has no record).
     pub energy: Vec<Option<f64>>,
     /// Binned like `steps_sampled` (bin `k` ends at sampled step `k + 1`).
@@ -146,15 +152,24 @@ impl SampledRun {
         &self.u[k * self.xs.len()..(k + 1) * self.xs.len()]
     }
 
+    /// Row `k` of the sampled temperature (`None` without one).
+    pub fn theta_row(&self, k: usize) -> Option<&[f64]> {
+        let n = self.xs.len();
+        self.theta.as_deref().map(|t| &t[k * n..(k + 1) * n])
+    }
+
     /// `l = 0` or `l = <expression>`.
     pub fn load_label(&self) -> String {
         format!("l = {}", self.load.as_deref().unwrap_or("0"))
     }
 
-    /// The line naming the discretisation and the solver.
+    /// The line naming the discretisation and the solver (and `κ`, `γ` with a temperature).
     pub fn parameters_label(&self) -> String {
+        let heat = self
+            .heat
+            .map_or_else(String::new, |(k, g)| format!(", κ = {k}, γ = {g}"));
         format!(
-            "α = {}, J = {} ({} elements), Δt = {}, solver: {}",
+            "α = {}{heat}, J = {} ({} elements), Δt = {}, solver: {}",
             self.alpha,
             self.elements.saturating_sub(1),
             self.elements,
@@ -168,38 +183,101 @@ impl SampledRun {
     }
 }
 
-/// Runs `scene`, keeping `u` at the sampled mesh points, the energy at the sampled steps and
-/// the contact history binned between them. Memory is that of the samples, not of the run.
+/// Runs `scene` (as the thermal bar when it has `[heat]`), keeping `u` (and `θ`) at the sampled
+/// mesh points, the energy at the sampled steps and the contact history binned between them.
+/// Memory is that of the samples, not of the run.
 pub fn sample_run(name: &str, scene: &Scene, sampling: Sampling) -> Result<SampledRun, RunError> {
-    let mut sim = Simulation::new(scene)?;
-    let mut tracker = Tracker::new(&sim, scene.load.density.is_none());
-    let disc = sim.discretisation();
-    let nodes = strided(disc.nodes - 1, sampling.x_stride);
-    let xs: Vec<f64> = nodes.iter().map(|&i| disc.x(i)).collect();
+    if scene.heat.is_some() {
+        let prepared = ThermalSimulation::prepare(scene)?;
+        let grid = Grid::new(prepared.body().bar().discretisation(), scene, sampling);
+        sample_scheme(name, scene, prepared, grid)
+    } else {
+        let prepared = Simulation::prepare(scene)?;
+        let grid = Grid::new(prepared.body().discretisation(), scene, sampling);
+        sample_scheme(name, scene, prepared, grid)
+    }
+}
+
+/// The sampled nodes and steps of a bar run, and its empty contact history.
+struct Grid {
+    nodes: Vec<usize>,
+    xs: Vec<f64>,
+    steps_sampled: Vec<usize>,
+    ts: Vec<f64>,
+    contact: ContactHistory,
+}
+
+impl Grid {
+    fn new(disc: &Discretisation, scene: &Scene, sampling: Sampling) -> Self {
+        let nodes = strided(disc.nodes - 1, sampling.x_stride);
+        let xs: Vec<f64> = nodes.iter().map(|&i| disc.x(i)).collect();
+        let steps_sampled = strided(scene.steps(), sampling.t_stride);
+        let ts: Vec<f64> = steps_sampled.iter().map(|&n| n as f64 * disc.dt).collect();
+        let contact = ContactHistory::new(
+            disc.constraints
+                .iter()
+                .map(|c| {
+                    c.side.map_or_else(
+                        || format!("x = {:.3}", disc.x(c.node)),
+                        |s| s.name().to_string(),
+                    )
+                })
+                .collect(),
+            disc.constraints.iter().map(|c| disc.x(c.node)).collect(),
+        );
+        Self {
+            nodes,
+            xs,
+            steps_sampled,
+            ts,
+            contact,
+        }
+    }
+}
+
+/// [`sample_run`] of a bar set up (`prepared`, short of its start-up step) on `grid`: the
+/// start-up step, then every step; `θ` where the body has a temperature.
+fn sample_scheme<B: Body>(
+    name: &str,
+    scene: &Scene,
+    prepared: Unstarted<B>,
+    grid: Grid,
+) -> Result<SampledRun, RunError> {
+    let Grid {
+        nodes,
+        xs,
+        steps_sampled,
+        ts,
+        mut contact,
+    } = grid;
     let steps = scene.steps();
-    let steps_sampled = strided(steps, sampling.t_stride);
-    let ts: Vec<f64> = steps_sampled.iter().map(|&n| n as f64 * disc.dt).collect();
-    let mut contact = ContactHistory::new(
-        disc.constraints
-            .iter()
-            .map(|c| {
-                c.side.map_or_else(
-                    || format!("x = {:.3}", disc.x(c.node)),
-                    |s| s.name().to_string(),
-                )
-            })
-            .collect(),
-        disc.constraints.iter().map(|c| disc.x(c.node)).collect(),
-    );
-    let mut full = vec![0.0; disc.nodes];
-    let mut gaps = vec![0.0; disc.constraints.len()];
-    let mut u = Vec::with_capacity(nodes.len() * steps_sampled.len());
+    let rows = nodes.len() * steps_sampled.len();
+    let mut u = Vec::with_capacity(rows);
+    let mut theta = B::TEMPERATURE.then(|| Vec::with_capacity(rows));
     let mut energy = Vec::with_capacity(steps_sampled.len());
-    let keep = |full: &[f64], u: &mut Vec<f64>| u.extend(nodes.iter().map(|&i| full[i]));
-    keep(&sim.initial_state().0, &mut u);
+    // `u` at every mesh node from the unknowns `state` (clamped nodes 0), and `θ` beside it.
+    let mut full = vec![0.0; prepared.body().nodes()];
+    let mut keep = |body: &B, state: &[f64], u: &mut Vec<f64>, theta: &mut Option<Vec<f64>>| {
+        for (dof, f) in full.iter_mut().enumerate() {
+            *f = body.unknown_of(dof).map_or(0.0, |i| state[i]);
+        }
+        u.extend(nodes.iter().map(|&i| full[i]));
+        if let Some(theta) = theta {
+            theta.extend(
+                nodes
+                    .iter()
+                    .map(|&i| body.temperature(state, i).unwrap_or(0.0)),
+            );
+        }
+    };
+    // `u^0` (and `θ^0`) before the start-up step moves it on, as the profile file writes it.
+    keep(prepared.body(), prepared.state().u, &mut u, &mut theta);
     energy.push(None);
+    let mut sim = prepared.start()?;
+    let mut tracker = Tracker::new(&sim, !sim.is_forced());
+    let mut gaps = vec![0.0; contact.constraints()];
     let mut next = 1; // index into steps_sampled of the next step to keep
-    let mut observe = |sim: &Simulation, r: &StepRecord, u: &mut Vec<f64>, energy: &mut Vec<_>| {
+    let mut observe = |sim: &Scheme<B>, r: &StepRecord, u: &mut Vec<f64>, energy: &mut Vec<_>| {
         let k = contact.constraints();
         let new_bin = r.step == steps_sampled[next - 1] + 1; // the previous bin closed
         // Per-constraint contact data come from the simulation (a step record keeps only the
@@ -207,8 +285,7 @@ pub fn sample_run(name: &str, scene: &Scene, sampling: Sampling) -> Result<Sampl
         sim.gaps_into(&mut gaps[..k]);
         contact.observe(r.time, &gaps[..k], &sim.reactions()[..k], new_bin);
         if steps_sampled.get(next) == Some(&r.step) {
-            sim.displacement_into(&mut full);
-            keep(&full, u);
+            keep(sim.body(), sim.displacement(), u, &mut theta);
             energy.push(Some(r.energy));
             next += 1;
         }
@@ -226,6 +303,7 @@ pub fn sample_run(name: &str, scene: &Scene, sampling: Sampling) -> Result<Sampl
         name: name.to_string(),
         solver: sim.solver_name().to_string(),
         alpha: scene.bar.viscosity,
+        heat: (scene.heat.as_ref()).map(|h| (h.diffusivity, h.coupling)),
         length: scene.bar.length,
         elements: scene.elements(),
         dt: scene.time.step,
@@ -236,6 +314,7 @@ pub fn sample_run(name: &str, scene: &Scene, sampling: Sampling) -> Result<Sampl
         steps_sampled,
         ts,
         u,
+        theta,
         energy,
         contact,
         summary,
