@@ -7,6 +7,7 @@ use common::viscobar;
 
 use std::path::{Path, PathBuf};
 use viscobar::Simulation;
+use viscobar::output::text::output_time;
 use viscobar::study::figures::{self, TALK_FIGURES};
 use viscobar::study::sampled_run::{self, Sampling};
 
@@ -86,6 +87,53 @@ fn sampled_run_holds_the_runs_mesh_values_and_peak_reactions() {
     );
     let (_, summary, _) = viscobar::output::run_in_memory("both-ends", &scene).unwrap();
     assert_eq!(run.summary.contact_intervals, summary.contact_intervals);
+}
+
+/// A bar with a temperature is sampled with its `θ`: at every sampled node and step, `u` and
+/// `θ` are the values the run's profile file (`displacement.csv`, a separate writer) holds, bit
+/// for bit, in the file's own rows; a bar without a temperature has none.
+#[test]
+fn sampled_run_of_a_thermal_bar_holds_the_profile_files_theta() {
+    let scene = common::builtin("thermal-impact", &["time.end=0.5"]); // 100 steps, every 5
+    let sampling = Sampling {
+        x_stride: 7,
+        t_stride: 10,
+    };
+    let run = sampled_run::sample_run("thermal-impact", &scene, sampling).unwrap();
+    let out = tmpdir("thermal-profile");
+    viscobar::run_to_dir("thermal-impact", &scene, &out, false).unwrap();
+    let profile = std::fs::read_to_string(out.join("displacement.csv")).unwrap();
+    let _ = std::fs::remove_dir_all(&out);
+    let mut lines = profile.lines();
+    assert_eq!(lines.next(), Some("t,x,u,v,theta"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
+        .collect();
+    // The file keeps every 5th step, each with all 201 nodes in order; times and coordinates
+    // are written rounded (`output_time`), the values exactly.
+    let (every, nodes) = (5, 201);
+    assert_eq!(rows.len(), (100 / every + 1) * nodes);
+    let theta = run.theta.as_ref().expect("a thermal run samples θ");
+    assert_eq!(theta.len(), run.u.len());
+    assert_eq!(run.steps_sampled.len(), 11);
+    for (k, &n) in run.steps_sampled.iter().enumerate() {
+        for (i, &node) in run.nodes.iter().enumerate() {
+            let row = &rows[n / every * nodes + node];
+            let (t, x) = (run.ts[k], run.xs[i]);
+            assert_eq!((row[0], row[1]), (output_time(t), output_time(x)));
+            assert_eq!(run.u_row(k)[i], row[2], "u at t = {t}, x = {x}");
+            assert_eq!(
+                run.theta_row(k).unwrap()[i],
+                row[4],
+                "θ at t = {t}, x = {x}"
+            );
+        }
+    }
+    // The exchange heats the end in contact: the panel has something to show.
+    assert!(theta.iter().any(|&v| v > 0.0), "θ stays 0");
+    let bar = common::builtin("both-ends", &["time.end=0.1"]);
+    let bar = sampled_run::sample_run("both-ends", &bar, sampling).unwrap();
+    assert!(bar.theta.is_none() && bar.theta_row(0).is_none());
 }
 
 #[test]

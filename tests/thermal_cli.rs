@@ -1,5 +1,6 @@
 //! The thermal bar through the command line: its files (history's thermal columns, the
-//! profile's `theta`) and its bad input, refused with exit 2 naming the key, nothing written.
+//! profile's `theta`, the figure's θ panel) and its bad input, refused with exit 2 naming the
+//! key, nothing written; a figure that fails after the run exits 1.
 
 mod common;
 use common::{assert_each_refused, fresh_dir, viscobar};
@@ -32,6 +33,89 @@ fn a_thermal_run_writes_the_thermal_columns() {
     let profile = std::fs::read_to_string(out.join("displacement.csv")).unwrap();
     assert_eq!(profile.lines().next(), Some("t,x,u,v,theta"));
     assert!(profile.lines().skip(1).all(|l| l.split(',').count() == 5));
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// The width and height in a PNG's IHDR chunk.
+fn png_size(bytes: &[u8]) -> (u32, u32) {
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
+    assert_eq!(&bytes[12..16], b"IHDR");
+    let be = |b: &[u8]| u32::from_be_bytes(b.try_into().unwrap());
+    (be(&bytes[16..20]), be(&bytes[20..24]))
+}
+
+/// `run SCENE --figure` of a scene with `[heat]` draws the bar's figure with the θ panel: the
+/// wider size, the panel's title and colour bar label, and a second colour map (each map is one
+/// embedded image; the bar without a temperature has one).
+#[test]
+fn a_thermal_run_draws_its_figure_with_theta() {
+    let out = fresh_dir("thermal", "figure");
+    let o = viscobar(&[
+        "run",
+        "thermal-impact",
+        "--figure",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "time.end=0.5",
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for ext in ["png", "svg"] {
+        let f = out.join(format!("thermal-impact.{ext}"));
+        assert!(
+            std::fs::metadata(&f).unwrap().len() > 1000,
+            "{}",
+            f.display()
+        );
+        assert!(
+            stdout.contains(&format!("thermal-impact.{ext}")),
+            "{stdout}"
+        );
+    }
+    let png = std::fs::read(out.join("thermal-impact.png")).unwrap();
+    assert_eq!(png_size(&png), viscobar::study::figures::THERMAL_SCENE_SIZE);
+    let svg = std::fs::read_to_string(out.join("thermal-impact.svg")).unwrap();
+    let texts: Vec<&str> = svg
+        .split("<text")
+        .map(|t| t.split('<').next().unwrap())
+        .collect();
+    let has = |label: &str| {
+        texts
+            .iter()
+            .any(|t| t.split('>').nth(1).map(str::trim) == Some(label))
+    };
+    assert!(has("temperature θ(x, t)") && has("θ"), "no θ panel");
+    assert!(has("displacement u(x, t)") && has("u"));
+    assert_eq!(
+        svg.matches("data:image/png;base64,").count(),
+        2,
+        "two colour maps"
+    );
+    assert!(out.join("history.csv").exists());
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// A figure that cannot be written after the run has written its files is a failed run: exit
+/// 1, the error names the file, and the run's own files stay.
+#[test]
+fn a_figure_that_fails_after_the_run_exits_1() {
+    let out = fresh_dir("thermal", "figure-fails");
+    // A folder (not empty) where the SVG goes: the rename into place fails.
+    std::fs::create_dir_all(out.join("thermal-impact.svg/inside")).unwrap();
+    let o = viscobar(&[
+        "run",
+        "thermal-impact",
+        "--figure",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "time.end=0.1",
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("thermal-impact.svg"), "{stderr}");
+    assert!(out.join("history.csv").exists() && out.join("summary.json").exists());
     std::fs::remove_dir_all(&out).unwrap();
 }
 
