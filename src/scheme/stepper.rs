@@ -6,6 +6,7 @@ use crate::scheme::clock::{PhaseClock, PhaseTimes};
 use crate::scheme::contact::{ContactSet, ContactState};
 use crate::scheme::error::RunError;
 use crate::scheme::load::Load;
+use crate::step::solver::add_in_place;
 use crate::step::{SolverReport, StepFailure, StepSolver};
 
 /// The diagnostics of one step `u^n → u^{n+1}`.
@@ -264,9 +265,14 @@ impl<B: Body> Scheme<B> {
         // 3. The constrained minimisation, and u^{n+1} = u^n + z.
         self.solver.set_previous_increment(&self.w);
         let info = (self.solver)
-            .solve(&self.b, &self.lower, &mut self.z, &mut self.reactions)
+            .solve_and_advance(
+                &self.b,
+                &self.lower,
+                &mut self.z,
+                &mut self.reactions,
+                &mut self.u,
+            )
             .map_err(|failure| self.failure(n + 1, failure))?;
-        add_in_place(&mut self.u, &self.z);
         let clock = clock.lap(&mut self.timing.solve_ns);
         // 4. The contact state and the energy identity.
         let mut record = StepRecord {
@@ -490,13 +496,6 @@ impl<B: Body> Scheme<B> {
     /// The gaps `s_k u^n_{i_k} + g_k` of every constraint.
     pub fn gaps_into(&self, out: &mut [f64]) {
         self.contact.gaps_into(&self.u, out);
-    }
-}
-
-/// `u += z`.
-fn add_in_place(u: &mut [f64], z: &[f64]) {
-    for (ui, zi) in u.iter_mut().zip(z) {
-        *ui += zi;
     }
 }
 

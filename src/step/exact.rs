@@ -18,6 +18,7 @@ use crate::step::schur::{
     StepFactor, constraint_rows, factor_each_subset, least_violating, masked_solve, row_product,
     schur_complement,
 };
+use crate::step::solver::add_in_place;
 use crate::step::{SolveInfo, StepFailure, StepSolver};
 
 /// Exact enumeration for zero, one or two constrained nodes.
@@ -148,6 +149,24 @@ impl ExactSolver {
 impl StepSolver for ExactSolver {
     fn name(&self) -> &'static str {
         "exact"
+    }
+
+    /// Without a constrained node, the solve and the update in one pass (`TwistedLdlt`'s fused sweep).
+    fn solve_and_advance(
+        &mut self,
+        rhs: &[f64],
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+        u: &mut [f64],
+    ) -> Result<SolveInfo, StepFailure> {
+        if self.nodes.is_empty() {
+            self.factor.solve_into_and_add(rhs, z, u);
+            return Ok(SolveInfo { iterations: 1 });
+        }
+        let info = self.solve(rhs, lower, z, reactions)?;
+        add_in_place(u, z);
+        Ok(info)
     }
 
     /// The warm start on the previous active set; on a miss, `z⁰`, the enumeration and the

@@ -6,6 +6,7 @@
 use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite, RowChange};
 use crate::linalg::ldlt_fast::TwistedLdlt;
 use crate::linalg::tridiag::SymTridiag;
+use crate::step::solver::add_in_place;
 
 /// A factorisation the end solvers solve with every step: the optimised twin (their default)
 /// or the plain one (to measure what the twin buys, `benches/twins.rs`).
@@ -34,6 +35,17 @@ impl StepFactor {
         match self {
             Self::Plain(f) => f.solve_in_place(x),
             Self::Twisted(f) => f.solve_in_place(x),
+        }
+    }
+
+    /// `x = A⁻¹ b`, then `u += x` (one pass with the twin).
+    pub(crate) fn solve_into_and_add(&self, b: &[f64], x: &mut [f64], u: &mut [f64]) {
+        match self {
+            Self::Plain(f) => {
+                f.solve_into(b, x);
+                add_in_place(u, x);
+            }
+            Self::Twisted(f) => f.solve_into_and_add(b, x, u),
         }
     }
 

@@ -100,6 +100,21 @@ pub trait StepSolver {
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure>;
 
+    /// [`StepSolver::solve`], then the scheme's update `u += z`. A solver may fuse the two into
+    /// one pass over the unknowns; the bits are those of the solve followed by the addition.
+    fn solve_and_advance(
+        &mut self,
+        rhs: &[f64],
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+        u: &mut [f64],
+    ) -> Result<SolveInfo, StepFailure> {
+        let info = self.solve(rhs, lower, z, reactions)?;
+        add_in_place(u, z);
+        Ok(info)
+    }
+
     /// The previous increment `w = u^n − u^{n−1}`, given before each solve of a step after the
     /// start-up step: a frictional solver's central slip is `(z + w)` at its tangential
     /// unknowns. Default: ignored.
@@ -108,5 +123,12 @@ pub trait StepSolver {
     /// Statistics over all solves so far; `None` for solvers that keep none.
     fn report(&self) -> Option<SolverReport> {
         None
+    }
+}
+
+/// `u += z`.
+pub(crate) fn add_in_place(u: &mut [f64], z: &[f64]) {
+    for (ui, zi) in u.iter_mut().zip(z) {
+        *ui += zi;
     }
 }
