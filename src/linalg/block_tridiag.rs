@@ -177,6 +177,41 @@ impl BlockLdlt {
             x[i] = z;
         }
     }
+    /// [`BlockLdlt::solve_in_place`] on two fields given apart, with the same bits: field
+    /// `f = (values, first)` has its entry of block `i` at `values[i − first]` where that
+    /// exists (0 in the right-hand side and not written back elsewhere); `y` (one entry per
+    /// block) carries the forward sweep. Allocates nothing.
+    pub fn solve_fields(&self, fields: [(&mut [f64], usize); 2], y: &mut [[f64; 2]]) {
+        let [(u, fu), (t, ft)] = fields;
+        let n = self.blocks();
+        let y = &mut y[..n];
+        let mut prev = [0.0; 2];
+        for (i, (yi, li)) in y.iter_mut().zip(&self.l).enumerate() {
+            let b = [
+                u.get(i.wrapping_sub(fu)).copied().unwrap_or(0.0),
+                t.get(i.wrapping_sub(ft)).copied().unwrap_or(0.0),
+            ];
+            let m = mul(li, prev);
+            prev = [b[0] - m[0], b[1] - m[1]];
+            *yi = prev;
+        }
+        let mut z = [0.0; 2];
+        for i in (0..n).rev() {
+            let v = d_inv_mul(&self.inv_d[i], y[i]);
+            z = if i + 1 < n {
+                let m = mul_transposed(&self.l[i + 1], z);
+                [v[0] - m[0], v[1] - m[1]]
+            } else {
+                v
+            };
+            if let Some(x) = u.get_mut(i.wrapping_sub(fu)) {
+                *x = z[0];
+            }
+            if let Some(x) = t.get_mut(i.wrapping_sub(ft)) {
+                *x = z[1];
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -226,6 +261,30 @@ mod tests {
             let mut b = vec![[0.0; 2]; n];
             a.mul_into(&x, &mut b);
             let mut flat: Vec<f64> = b.iter().flatten().copied().collect();
+            // The two fields apart, the first missing in block 0 and the second in the last
+            // block (zero right-hand sides there): the bits of the interleaved solve.
+            let (mut u, mut t): (Vec<f64>, Vec<f64>) = b.iter().map(|v| (v[0], v[1])).unzip();
+            if n > 1 {
+                (b[0][0], b[n - 1][1]) = (0.0, 0.0);
+            }
+            let (u, t) = if n > 1 {
+                (&mut u[1..], &mut t[..n - 1])
+            } else {
+                (&mut u[..], &mut t[..])
+            };
+            let first = usize::from(n > 1);
+            let mut interleaved = b.clone();
+            block.solve_in_place(&mut interleaved);
+            block.solve_fields([(u, first), (t, 0)], &mut vec![[0.0; 2]; n]);
+            for (i, v) in interleaved.iter().enumerate() {
+                if i >= first {
+                    assert_eq!(u[i - first].to_bits(), v[0].to_bits());
+                }
+                if i < t.len() {
+                    assert_eq!(t[i].to_bits(), v[1].to_bits());
+                }
+            }
+            a.mul_into(&x, &mut b);
             block.solve_in_place(&mut b);
             scalar.solve_in_place(&mut flat);
             // Round-off: these blocks are well conditioned (κ below 100), so a backward-stable

@@ -20,16 +20,17 @@ pub struct CoupledEnds {
     /// rows and columns of the active ends in `mask` replaced by identity ones.
     factor: BlockLdlt,
     reduced: Vec<BlockLdlt>,
-    /// Node `i`'s displacement and temperature positions in the block layout (`None`: not an
-    /// unknown).
-    slots: Vec<[Option<usize>; 2]>,
+    /// The first nodes of the displacement and the temperature unknowns.
+    firsts: [usize; 2],
     /// The constrained displacement unknowns (at most two), the rows of `C` there
     /// ([`constraint_rows`]) and `−γ/2 G_ij` with the temperature's position `j`.
     unknowns: Vec<usize>,
     rows: [[f64; 3]; 2],
     theta: [Vec<(usize, f64)>; 2],
     n_u: usize,
-    /// The right-hand side of a solve, node by node.
+    /// `n_u + n_t`.
+    dim: usize,
+    /// The forward sweep of a solve, node by node.
     scratch: Vec<[f64; 2]>,
 }
 
@@ -68,42 +69,36 @@ impl CoupledEnds {
         Ok(Self {
             factor,
             reduced,
-            slots: (0..m.nodes)
-                .map(|node| [m.u_unknown(node), m.theta_unknown(node)])
-                .collect(),
+            firsts: [m.u_first, m.t_first],
             unknowns: unknowns.to_vec(),
             rows: constraint_rows(c, unknowns),
             theta,
             n_u: m.n_u,
+            dim: m.n_u + m.n_t,
             scratch: vec![[0.0; 2]; m.nodes],
         })
     }
 
-    /// `x ← F⁻¹ x` in the block layout by the factor `F`, through the node-by-node scratch.
-    fn solve(factor: &BlockLdlt, slots: &[[Option<usize>; 2]], s: &mut [[f64; 2]], x: &mut [f64]) {
-        for (si, slot) in s.iter_mut().zip(slots) {
-            *si = slot.map(|k| k.map_or(0.0, |k| x[k]));
-        }
-        factor.solve_in_place(s);
-        for (si, slot) in s.iter().zip(slots) {
-            for (v, k) in si.iter().zip(slot) {
-                if let Some(k) = k {
-                    x[*k] = *v;
-                }
-            }
-        }
+    /// `x ← F⁻¹ x` in the block layout by the factor `F`, the sweep carried by `y`.
+    fn solve(&mut self, mask: u8, x: &mut [f64]) {
+        let factor = match mask {
+            0 => &self.factor,
+            _ => &self.reduced[mask as usize - 1],
+        };
+        let (u, t) = x.split_at_mut(self.n_u);
+        let [fu, ft] = self.firsts;
+        factor.solve_fields([(u, fu), (t, ft)], &mut self.scratch);
     }
 }
 
 impl EndSystem for CoupledEnds {
     fn solve_into(&mut self, b: &[f64], x: &mut [f64]) {
         x.copy_from_slice(b);
-        Self::solve(&self.factor, &self.slots, &mut self.scratch, x);
+        self.solve(0, x);
     }
 
     fn solve_reduced_in_place(&mut self, mask: u8, x: &mut [f64]) {
-        let factor = &self.reduced[mask as usize - 1];
-        Self::solve(factor, &self.slots, &mut self.scratch, x);
+        self.solve(mask, x);
     }
 
     /// The neighbouring displacements off the active set, and the temperatures coupled to it.
@@ -135,12 +130,11 @@ impl EndSystem for CoupledEnds {
 
     fn schur_complement(&mut self) -> [[f64; 2]; 2] {
         let mut schur = [[0.0; 2]; 2];
-        let n = self.n_u + self.slots.iter().filter(|s| s[1].is_some()).count();
-        let mut column = vec![0.0; n];
-        for (a, &i) in self.unknowns.iter().enumerate() {
+        let mut column = vec![0.0; self.dim];
+        for (a, i) in self.unknowns.clone().into_iter().enumerate() {
             column.fill(0.0);
             column[i] = 1.0;
-            Self::solve(&self.factor, &self.slots, &mut self.scratch, &mut column);
+            self.solve(0, &mut column);
             for (b, &k) in self.unknowns.iter().enumerate() {
                 schur[a][b] = column[k];
             }
