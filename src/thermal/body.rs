@@ -279,20 +279,28 @@ impl ThermalBody {
     /// `|x|²_K` of the temperature's stiffness on every node, by elements (exact for constants).
     fn stiffness_quad(&self, x: impl Fn(usize) -> f64) -> f64 {
         let off = &self.m.stiffness.off;
-        (0..off.len())
-            .map(|e| -off[e] * (x(e + 1) - x(e)).powi(2))
-            .sum()
+        let mut left = x(0);
+        let mut s = 0.0;
+        for (e, k) in off.iter().enumerate() {
+            let right = x(e + 1);
+            s += -k * (right - left).powi(2);
+            left = right;
+        }
+        s
     }
 
     /// `|x|²_M` of the temperature's mass on every node.
     fn mass_quad(&self, x: impl Fn(usize) -> f64) -> f64 {
         let mass = &self.m.mass;
+        let n = mass.diag.len();
         let mut s = 0.0;
-        for j in 0..mass.diag.len() {
-            let xj = x(j);
+        let mut xj = x(0);
+        for j in 0..n {
             s += mass.diag[j] * xj * xj;
-            if j + 1 < mass.diag.len() {
-                s += 2.0 * mass.off[j] * xj * x(j + 1);
+            if j + 1 < n {
+                let next = x(j + 1);
+                s += 2.0 * mass.off[j] * xj * next;
+                xj = next;
             }
         }
         s
