@@ -395,9 +395,23 @@ impl Body for ThermalBody {
         let gamma = self.m.gamma;
         if gamma != 0.0 {
             let theta = &u[n_u..];
-            let phi = self.nodal(|k| self.phi(u, k), |k| theta[k - self.m.t_first]);
+            let m = &self.m;
+            let phi = self.nodal(|k| self.phi(u, k), |k| theta[k - m.t_first]);
+            // Rows whose stencil reaches an end node by the general reads; the others below.
+            let interior = 2..m.nodes.saturating_sub(2).max(2);
             for (i, bi) in bu.iter_mut().enumerate() {
-                *bi += gamma * self.g_row(self.m.u_first + i, &phi);
+                let node = m.u_first + i;
+                if !interior.contains(&node) {
+                    *bi += gamma * self.g_row(node, &phi);
+                }
+            }
+            if !interior.is_empty() {
+                // `(G φ)_i` on the nodes `i − 1, i, i + 1` read directly.
+                let b = &mut bu[interior.start - m.u_first..interior.end - m.u_first];
+                let phi = &theta[interior.start - 1 - m.t_first..interior.end + 1 - m.t_first];
+                for (bi, p) in b.iter_mut().zip(phi.windows(3)) {
+                    *bi += gamma * (0.5 * (p[0] + p[1]) - 0.5 * (p[1] + p[2]));
+                }
             }
         }
         self.heat_rhs(u, &w[..n_u], self.dt(), -1.0, bt);
