@@ -91,10 +91,8 @@ pub struct BlockLdlt {
     l: Vec<Block>,
     /// `D_i⁻¹ = [[a, b], [b, c]]` as `[a, b, c]`.
     inv_d: Vec<[f64; 3]>,
-    /// `det D_i`, for the inertia.
-    det: Vec<f64>,
-    /// `tr D_i`, for the inertia.
-    trace: Vec<f64>,
+    /// The positive eigenvalues of `D` (the rest are negative).
+    positive: usize,
 }
 
 impl BlockLdlt {
@@ -103,7 +101,7 @@ impl BlockLdlt {
         let n = a.blocks();
         let mut l = vec![[[0.0; 2]; 2]; n];
         let mut inv_d = vec![[0.0; 3]; n];
-        let (mut det, mut trace) = (vec![0.0; n], vec![0.0; n]);
+        let mut positive = 0;
         for i in 0..n {
             let [[mut p, mut q], [_, mut s]] = a.diag[i];
             if i > 0 {
@@ -126,14 +124,14 @@ impl BlockLdlt {
                 });
             }
             inv_d[i] = [s / d, -q / d, p / d];
-            (det[i], trace[i]) = (d, p + s);
+            // det < 0: one eigenvalue of each sign; det > 0: both of the trace's sign.
+            positive += match (d < 0.0, p + s > 0.0) {
+                (true, _) => 1,
+                (false, true) => 2,
+                (false, false) => 0,
+            };
         }
-        Ok(Self {
-            l,
-            inv_d,
-            det,
-            trace,
-        })
+        Ok(Self { l, inv_d, positive })
     }
 
     /// The number of block rows.
@@ -143,15 +141,7 @@ impl BlockLdlt {
 
     /// The positive and the negative eigenvalues of `D`: the inertia of `A` (Sylvester).
     pub fn inertia(&self) -> (usize, usize) {
-        let mut positive = 0;
-        for (d, t) in self.det.iter().zip(&self.trace) {
-            positive += match (*d < 0.0, *t > 0.0) {
-                (true, _) => 1,
-                (false, true) => 2,
-                (false, false) => 0,
-            };
-        }
-        (positive, 2 * self.blocks() - positive)
+        (self.positive, 2 * self.blocks() - self.positive)
     }
 
     /// `x ← A⁻¹ x` (interleaved): `y_i = x_i − L_i y_{i−1}`, then
