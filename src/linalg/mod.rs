@@ -3,12 +3,13 @@
 //! sparse matrices on a CSR pattern ([`sparse`]) and their sparse Cholesky factorisation
 //! ([`cholesky`], faer); the step matrix with its factorisation as the solvers see it
 //! ([`system`]); the CPU dispatch that runs kernels compiled for AVX ([`dispatch`]); ∞-norms
-//! ([`norms`]) and the spectrum of `C` ([`spectrum`]); symmetric banded matrices with their
-//! `LDLᵀ` for quasi-definite coupled systems ([`banded`]).
+//! ([`norms`]) and the spectrum of `C` ([`spectrum`]); quasi-definite coupled systems of two
+//! fields: block-tridiagonal with their block `LDLᵀ` ([`block_tridiag`]), banded ([`banded`]).
 //!
 //! Bottom layer: imports nothing from the crate.
 
 pub mod banded;
+pub mod block_tridiag;
 pub mod cholesky;
 pub mod dispatch;
 pub mod ldlt;

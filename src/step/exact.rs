@@ -11,6 +11,8 @@
 //!
 //! Warm start: the previous step's active set is tried first by the same direct solve and kept
 //! when it meets the KKT conditions ([docs/step-solvers.md](../docs/step-solvers.md#exact-solver)).
+//! The step matrix enters through [`EndSystem`]: the bar's tridiagonal `C` ([`BarEnds`]), or
+//! any body's matrix whose constrained unknowns are at most two.
 
 use crate::linalg::ldlt::{NotPositiveDefinite, RowChange};
 use crate::linalg::tridiag::SymTridiag;
@@ -21,20 +23,98 @@ use crate::step::schur::{
 use crate::step::solver::add_in_place;
 use crate::step::{SolveInfo, StepFailure, StepSolver};
 
-/// Exact enumeration for zero, one or two constrained nodes.
+/// What the enumeration needs of the step matrix `A` (symmetric, nonsingular, `E A⁻¹ Eᵀ` on the
+/// constrained unknowns `i_j` positive definite): solves with `A` and with `A_M`, `A` with the
+/// rows and columns of active set `M` (bit `j`: constraint `j`) replaced by identity ones, both
+/// factorised once, and `A`'s entries in the constrained columns. Solves allocate nothing.
+pub trait EndSystem {
+    /// `x = A⁻¹ b`.
+    fn solve_into(&mut self, b: &[f64], x: &mut [f64]);
+    /// `x ← A_M⁻¹ x` for active set `mask` (not empty).
+    fn solve_reduced_in_place(&mut self, mask: u8, x: &mut [f64]);
+    /// `x_k −= A_{k,i_j} v` at the other rows `k` of column `i_j` off active set `mask`: a
+    /// known `z_{i_j} = v` moved to the right-hand side.
+    fn move_to_rhs(&self, j: usize, v: f64, mask: u8, x: &mut [f64]);
+    /// `(A z)_{i_j}`.
+    fn row_product(&self, j: usize, z: &[f64]) -> f64;
+    /// `S_jk = (A⁻¹)_{i_j i_k}`, bitwise symmetric (set-up only).
+    fn schur_complement(&mut self) -> [[f64; 2]; 2];
+}
+
+/// The bar's `C` (tridiagonal) as an [`EndSystem`]: its factorisation and, for each non-empty
+/// subset of the constrained nodes, that of `C` with those rows and columns replaced by
+/// identity ones.
 #[derive(Clone, Debug)]
-pub struct ExactSolver {
+pub struct BarEnds {
     factor: StepFactor,
     /// The constrained nodes (at most two).
     nodes: Vec<usize>,
-    /// `S = (C⁻¹)_{jk}` on the constrained nodes.
-    schur: [[f64; 2]; 2],
     /// Row `i` of `C` at each constrained node `i`: `C_i,i−1`, `C_i,i+1` (0 where absent) and
     /// the row sum (all the direct solve reads of `C`).
     rows: [[f64; 3]; 2],
     /// The factorisation of `C` with the rows and columns of active set `mask` replaced by
     /// identity ones, at index `mask − 1`.
     reduced: Vec<StepFactor>,
+}
+
+impl BarEnds {
+    /// `twisted`: the optimised twin `TwistedLdlt` (else the plain `Ldlt`).
+    pub fn new(
+        c: &SymTridiag,
+        nodes: &[usize],
+        twisted: bool,
+    ) -> Result<Self, NotPositiveDefinite> {
+        Ok(Self {
+            factor: StepFactor::new(c, &[], RowChange::Identity, twisted)?,
+            rows: constraint_rows(c, nodes),
+            reduced: factor_each_subset(c, nodes, RowChange::Identity, twisted)?,
+            nodes: nodes.to_vec(),
+        })
+    }
+}
+
+impl EndSystem for BarEnds {
+    fn solve_into(&mut self, b: &[f64], x: &mut [f64]) {
+        self.factor.solve_into(b, x);
+    }
+
+    fn solve_reduced_in_place(&mut self, mask: u8, x: &mut [f64]) {
+        self.reduced[mask as usize - 1].solve_in_place(x);
+    }
+
+    /// The neighbours `i ± 1` of node `i = i_j`, where they are not active nodes themselves.
+    fn move_to_rhs(&self, j: usize, v: f64, mask: u8, x: &mut [f64]) {
+        let n = x.len();
+        let i = self.nodes[j];
+        let is_active_node =
+            |i: usize| (0..self.nodes.len()).any(|k| mask & (1 << k) != 0 && self.nodes[k] == i);
+        let [left, right, _] = self.rows[j];
+        if i > 0 && !is_active_node(i - 1) {
+            x[i - 1] -= left * v;
+        }
+        if i + 1 < n && !is_active_node(i + 1) {
+            x[i + 1] -= right * v;
+        }
+    }
+
+    fn row_product(&self, j: usize, z: &[f64]) -> f64 {
+        row_product(self.rows[j], self.nodes[j], z)
+    }
+
+    fn schur_complement(&mut self) -> [[f64; 2]; 2] {
+        schur_complement(&self.factor, &self.nodes)
+    }
+}
+
+/// Exact enumeration for zero, one or two constrained unknowns of the step matrix `E` (the
+/// bar's `C` unless said otherwise).
+#[derive(Clone, Debug)]
+pub struct ExactSolver<E: EndSystem = BarEnds> {
+    system: E,
+    /// The constrained unknowns (at most two).
+    nodes: Vec<usize>,
+    /// `S = (C⁻¹)_{jk}` on the constrained nodes.
+    schur: [[f64; 2]; 2],
     /// Try the previous step's active set first (the default; off to measure what it buys).
     warm_start: bool,
     /// The active set of the last answer (a mask: bit `j` for node `j`), tried first.
@@ -64,17 +144,29 @@ impl ExactSolver {
             nodes.len() <= 2,
             "the end-node enumeration handles at most two bounds"
         );
-        let factor = StepFactor::new(c, &[], RowChange::Identity, twisted)?;
-        Ok(Self {
-            schur: schur_complement(&factor, nodes),
-            rows: constraint_rows(c, nodes),
-            reduced: factor_each_subset(c, nodes, RowChange::Identity, twisted)?,
-            factor,
+        Ok(Self::on(
+            BarEnds::new(c, nodes, twisted)?,
+            nodes,
+            warm_start,
+        ))
+    }
+}
+
+impl<E: EndSystem> ExactSolver<E> {
+    /// The solver on `system`, whose constrained unknowns are `nodes` (at most two).
+    pub fn on(mut system: E, nodes: &[usize], warm_start: bool) -> Self {
+        assert!(
+            nodes.len() <= 2,
+            "the end-node enumeration handles at most two bounds"
+        );
+        Self {
+            schur: system.schur_complement(),
+            system,
             nodes: nodes.to_vec(),
             warm_start,
             previous: 0,
             warm_kept: 0,
-        })
+        }
     }
 
     /// Steps so far answered by the direct solve on the previous step's active set (the warm
@@ -87,34 +179,25 @@ impl ExactSolver {
     /// `r_A = (Cz − b)_A` (round-off below zero clamped). Returns whether the answer met the
     /// KKT conditions before the clamp: `r_A >= 0` and `z_j >= lo_j` off `A` (false on a NaN).
     fn solve_on_active_set(
-        &self,
+        &mut self,
         mask: u8,
         rhs: &[f64],
         lower: &[f64],
         z: &mut [f64],
         reactions: &mut [f64],
     ) -> bool {
-        let n = z.len();
         let active = |j: usize| mask & (1 << j) != 0;
-        let is_active_node =
-            |i: usize| (0..self.nodes.len()).any(|j| active(j) && self.nodes[j] == i);
         z.copy_from_slice(rhs);
         for (j, &i) in self.nodes.iter().enumerate().filter(|&(j, _)| active(j)) {
-            let [left, right, _] = self.rows[j];
             z[i] = lower[j];
-            if i > 0 && !is_active_node(i - 1) {
-                z[i - 1] -= left * lower[j];
-            }
-            if i + 1 < n && !is_active_node(i + 1) {
-                z[i + 1] -= right * lower[j];
-            }
+            self.system.move_to_rhs(j, lower[j], mask, z);
         }
-        self.reduced[mask as usize - 1].solve_in_place(z);
+        self.system.solve_reduced_in_place(mask, z);
         let mut kkt = true;
         for (j, &i) in self.nodes.iter().enumerate() {
             if active(j) {
                 // Round-off below zero clamped; a NaN kept, for the caller's finiteness check.
-                let rj = row_product(self.rows[j], i, z) - rhs[i];
+                let rj = self.system.row_product(j, z) - rhs[i];
                 kkt &= rj >= 0.0;
                 reactions[j] = if rj < 0.0 { 0.0 } else { rj };
             } else {
@@ -146,7 +229,7 @@ impl ExactSolver {
     }
 }
 
-impl StepSolver for ExactSolver {
+impl<E: EndSystem> StepSolver for ExactSolver<E> {
     fn name(&self) -> &'static str {
         "exact"
     }
@@ -187,7 +270,7 @@ impl StepSolver for ExactSolver {
             }
             missed = 1;
         }
-        self.factor.solve_into(rhs, z);
+        self.system.solve_into(rhs, z);
         if k == 0 {
             // Non-finite values anywhere are caught by the stepper's energy check.
             return Ok(SolveInfo { iterations: 1 });

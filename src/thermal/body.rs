@@ -192,6 +192,28 @@ impl ThermalBody {
         }
     }
 
+    /// `v` at every node from its values at the two end nodes (computed once, by the searches
+    /// of [`Self::phi`] and the like) and a direct reader of the interior nodes, where both
+    /// fields are unknowns: the same values, without a search per node.
+    #[inline(always)]
+    fn nodal(
+        &self,
+        v: impl Fn(usize) -> f64,
+        interior: impl Fn(usize) -> f64,
+    ) -> impl Fn(usize) -> f64 {
+        let last = self.m.nodes - 1;
+        let ends = [v(0), v(last)];
+        move |k| {
+            if k == 0 {
+                ends[0]
+            } else if k == last {
+                ends[1]
+            } else {
+                interior(k)
+            }
+        }
+    }
+
     /// The fixed ends' increment `new − old` at `node` (0 elsewhere).
     #[inline(always)]
     fn fixed_increment(&self, node: usize) -> f64 {
@@ -257,20 +279,28 @@ impl ThermalBody {
     /// `|x|²_K` of the temperature's stiffness on every node, by elements (exact for constants).
     fn stiffness_quad(&self, x: impl Fn(usize) -> f64) -> f64 {
         let off = &self.m.stiffness.off;
-        (0..off.len())
-            .map(|e| -off[e] * (x(e + 1) - x(e)).powi(2))
-            .sum()
+        let mut left = x(0);
+        let mut s = 0.0;
+        for (e, k) in off.iter().enumerate() {
+            let right = x(e + 1);
+            s += -k * (right - left).powi(2);
+            left = right;
+        }
+        s
     }
 
     /// `|x|²_M` of the temperature's mass on every node.
     fn mass_quad(&self, x: impl Fn(usize) -> f64) -> f64 {
         let mass = &self.m.mass;
+        let n = mass.diag.len();
         let mut s = 0.0;
-        for j in 0..mass.diag.len() {
-            let xj = x(j);
+        let mut xj = x(0);
+        for j in 0..n {
             s += mass.diag[j] * xj * xj;
-            if j + 1 < mass.diag.len() {
-                s += 2.0 * mass.off[j] * xj * x(j + 1);
+            if j + 1 < n {
+                let next = x(j + 1);
+                s += 2.0 * mass.off[j] * xj * next;
+                xj = next;
             }
         }
         s
@@ -281,9 +311,17 @@ impl ThermalBody {
     fn heat_rhs(&self, u: &[f64], w_u: &[f64], s: f64, sign: f64, b_theta: &mut [f64]) {
         let m = &self.m;
         let (kappa, gamma) = (m.kappa, m.gamma);
+        let theta = &u[m.n_u..];
+        let phi = self.nodal(|k| self.phi(u, k), |k| theta[k - m.t_first]);
+        let disp = self.nodal(|k| self.disp(w_u, k), |k| w_u[k - m.u_first]);
+        // Rows whose stencil reaches an end node by the general reads; the others below.
+        let interior = 2..m.nodes.saturating_sub(2).max(2);
         for (jt, bj) in b_theta.iter_mut().enumerate() {
             let j = m.t_first + jt;
-            let mut r = -s * kappa * Self::tri_row(&m.stiffness, j, |k| self.phi(u, k));
+            if interior.contains(&j) {
+                continue;
+            }
+            let mut r = -s * kappa * Self::tri_row(&m.stiffness, j, &phi);
             if !self.q.is_empty() {
                 r += s * self.q[j];
             }
@@ -291,10 +329,40 @@ impl ThermalBody {
                 r -= s * h * (self.phi(u, j) - obs);
             }
             if gamma != 0.0 {
-                r -= 0.5 * gamma * self.gt_row(j, |k| self.disp(w_u, k));
+                r -= 0.5 * gamma * self.gt_row(j, &disp);
             }
             if !self.fixed.is_empty() {
                 r -= Self::tri_row(&m.mass, j, |k| self.fixed_increment(k));
+            }
+            *bj = sign * r;
+        }
+        // The interior rows, the same formula on the three nodes `j − 1, j, j + 1` read
+        // directly (no exchange, no fixed end there).
+        if interior.is_empty() {
+            return;
+        }
+        let rows = interior.clone();
+        let b = &mut b_theta[rows.start - m.t_first..rows.end - m.t_first];
+        let theta = &theta[rows.start - 1 - m.t_first..rows.end + 1 - m.t_first];
+        let w = &w_u[rows.start - 1 - m.u_first..rows.end + 1 - m.u_first];
+        let (kd, ko) = (
+            &m.stiffness.diag[rows.clone()],
+            &m.stiffness.off[rows.start - 1..rows.end],
+        );
+        let q = if self.q.is_empty() {
+            &[][..]
+        } else {
+            &self.q[rows]
+        };
+        let (a, c) = (-s * kappa, 0.5 * gamma);
+        for (jt, bj) in b.iter_mut().enumerate() {
+            let (th, w, ko) = (&theta[jt..jt + 3], &w[jt..jt + 3], &ko[jt..jt + 2]);
+            let mut r = a * (kd[jt] * th[1] + ko[0] * th[0] + ko[1] * th[2]);
+            if let Some(q) = q.get(jt) {
+                r += s * q;
+            }
+            if gamma != 0.0 {
+                r -= c * (0.5 * (w[1] - w[0]) + 0.5 * (w[2] - w[1]));
             }
             *bj = sign * r;
         }
@@ -326,8 +394,24 @@ impl Body for ThermalBody {
         self.bar.rhs_into(&u[..n_u], &w[..n_u], force, bu);
         let gamma = self.m.gamma;
         if gamma != 0.0 {
+            let theta = &u[n_u..];
+            let m = &self.m;
+            let phi = self.nodal(|k| self.phi(u, k), |k| theta[k - m.t_first]);
+            // Rows whose stencil reaches an end node by the general reads; the others below.
+            let interior = 2..m.nodes.saturating_sub(2).max(2);
             for (i, bi) in bu.iter_mut().enumerate() {
-                *bi += gamma * self.g_row(self.m.u_first + i, |k| self.phi(u, k));
+                let node = m.u_first + i;
+                if !interior.contains(&node) {
+                    *bi += gamma * self.g_row(node, &phi);
+                }
+            }
+            if !interior.is_empty() {
+                // `(G φ)_i` on the nodes `i − 1, i, i + 1` read directly.
+                let b = &mut bu[interior.start - m.u_first..interior.end - m.u_first];
+                let phi = &theta[interior.start - 1 - m.t_first..interior.end + 1 - m.t_first];
+                for (bi, p) in b.iter_mut().zip(phi.windows(3)) {
+                    *bi += gamma * (0.5 * (p[0] + p[1]) - 0.5 * (p[1] + p[2]));
+                }
             }
         }
         self.heat_rhs(u, &w[..n_u], self.dt(), -1.0, bt);
@@ -511,7 +595,9 @@ impl Body for ThermalBody {
     }
 
     fn heat_energy(&self, u: &[f64]) -> Option<f64> {
-        Some(0.5 * self.mass_quad(|k| self.theta(u, k)))
+        let theta = &u[self.m.n_u..];
+        let t_first = self.m.t_first;
+        Some(0.5 * self.mass_quad(self.nodal(|k| self.theta(u, k), |k| theta[k - t_first])))
     }
 
     /// `½|θ^{n+1/2}|²_M`, `Δt κ |θ̄|²_K`, the exchange and the supply (source and the heat let
@@ -524,8 +610,14 @@ impl Body for ThermalBody {
             Some(j) => u[j] - 0.5 * z[j],
             None => self.fixed_at(k).map_or(0.0, |f| 0.5 * (f.old + f.new)),
         };
-        let energy = 0.5 * self.mass_quad(|k| self.theta(u, k));
-        let dissipation = dt * m.kappa * self.stiffness_quad(bar_theta);
+        let bar_theta_at = self.nodal(bar_theta, |k| {
+            let j = n_u + k - m.t_first;
+            u[j] - 0.5 * z[j]
+        });
+        let theta = &u[n_u..];
+        let energy =
+            0.5 * self.mass_quad(self.nodal(|k| self.theta(u, k), |k| theta[k - m.t_first]));
+        let dissipation = dt * m.kappa * self.stiffness_quad(&bar_theta_at);
         let mut exchange = 0.0;
         for (e, x) in self.exchange.iter().enumerate() {
             if self.mask & (1 << e) != 0 {
@@ -535,7 +627,10 @@ impl Body for ThermalBody {
         }
         let mut supply = 0.0;
         if !self.q.is_empty() {
-            supply += dt * (0..m.nodes).map(|k| self.q[k] * bar_theta(k)).sum::<f64>();
+            supply += dt
+                * (0..m.nodes)
+                    .map(|k| self.q[k] * bar_theta_at(k))
+                    .sum::<f64>();
         }
         for f in &self.fixed {
             let j = f.node;

@@ -1,16 +1,12 @@
 //! The thermal bar's matrices on the bar's mesh: the P1 mass `M_θ` and stiffness `K_θ` of the
 //! temperature (every node), the coupling `G_ij = ∫ ψ_j φ_i'` (displacement row `i`,
 //! temperature column `j`), the temperature's step matrix `H_χ = M_θ + Δt κ/2 K_θ + Δt h/2 χ`
-//! on its unknowns, and the coupled step matrix `[[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]]` in the
-//! node-by-node interleaved order that keeps it banded. Derivation: `docs/thermal.md`.
+//! on its unknowns, and the coupled step matrix `[[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]]` node by node,
+//! block-tridiagonal with blocks of order 2. Derivation: `docs/thermal.md`.
 
 use crate::bar::matrices::{MatrixVariant, mass, stiffness};
-use crate::linalg::banded::SymBanded;
+use crate::linalg::block_tridiag::BlockTridiag;
 use crate::linalg::tridiag::SymTridiag;
-
-/// Half-bandwidth of the interleaved coupled matrix: `u_i` couples with `θ_{i+1}` three
-/// positions on.
-pub const BAND: usize = 3;
 
 /// `G_ij = ∫ ψ_j φ_i'` on a uniform mesh of `nodes` nodes: `−½` for `j = i + 1`, `½` for
 /// `j = i − 1`, and on the diagonal `−½` at the left end, `½` at the right end, 0 inside.
@@ -111,47 +107,39 @@ impl ThermalMatrices {
         SymTridiag::new(diag, std::mem::take(&mut h.off))
     }
 
-    /// The interleaved order: position `k` holds block index `order[k]` (node by node, the
-    /// displacement before the temperature).
-    pub fn interleaved_order(&self) -> Vec<usize> {
-        let mut order = Vec::with_capacity(self.n_u + self.n_t);
-        for node in 0..self.nodes {
-            order.extend(self.u_unknown(node));
-            order.extend(self.theta_unknown(node));
-        }
-        order
-    }
-
-    /// The coupled step matrix `[[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]]` (`c`: the bar's `C`) in the
-    /// interleaved order ([`ThermalMatrices::interleaved_order`]).
-    pub fn coupled(&self, c: &SymTridiag, mask: usize) -> SymBanded<BAND> {
-        let order = self.interleaved_order();
-        let mut position = vec![0; order.len()];
-        for (k, &b) in order.iter().enumerate() {
-            position[b] = k;
-        }
-        let mut a = SymBanded::zeros(order.len());
-        for i in 0..self.n_u {
-            a.add(position[i], position[i], c.diag[i]);
-            if i + 1 < self.n_u {
-                a.add(position[i], position[i + 1], c.off[i]);
-            }
-        }
+    /// The coupled step matrix `[[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]]` (`c`: the bar's `C`) node by
+    /// node, block `i` holding `(u_i, θ_i)`: a node without a displacement unknown (clamped),
+    /// or one of `identity` (an active constraint's node), has the row and column of `u_i`
+    /// replaced by identity ones; a node without a temperature unknown (fixed) a row and
+    /// column `−1` on the diagonal, 0 elsewhere, so a solve leaves 0 there.
+    pub fn coupled(&self, c: &SymTridiag, mask: usize, identity: &[usize]) -> BlockTridiag {
         let h = self.heat_matrix(0.5 * self.dt, mask);
-        for j in 0..self.n_t {
-            let p = position[self.n_u + j];
-            a.add(p, p, -h.diag[j]);
-            if j + 1 < self.n_t {
-                a.add(p, position[self.n_u + j + 1], -h.off[j]);
+        let u = |node: usize| self.u_unknown(node).filter(|_| !identity.contains(&node));
+        let t = |node: usize| self.theta_unknown(node).map(|j| j - self.n_u);
+        let g = |i: usize, j: usize| -0.5 * self.gamma * coupling_entry(i, j, self.nodes);
+        let mut a = BlockTridiag::zeros(self.nodes);
+        for node in 0..self.nodes {
+            let d = &mut a.diag[node];
+            d[0][0] = u(node).map_or(1.0, |i| c.diag[i]);
+            d[1][1] = t(node).map_or(-1.0, |j| -h.diag[j]);
+            if u(node).is_some() && t(node).is_some() {
+                (d[0][1], d[1][0]) = (g(node, node), g(node, node));
             }
-        }
-        for iu in 0..self.n_u {
-            let node = self.u_first + iu;
-            for tnode in node.saturating_sub(1)..=(node + 1).min(self.nodes - 1) {
-                let g = coupling_entry(node, tnode, self.nodes);
-                if let (Some(jt), true) = (self.theta_unknown(tnode), g != 0.0) {
-                    a.add(position[iu], position[jt], -0.5 * self.gamma * g);
-                }
+            if node == 0 {
+                continue;
+            }
+            let (prev, e) = (node - 1, &mut a.lower[node]);
+            if let (Some(i), Some(_)) = (u(node), u(prev)) {
+                e[0][0] = c.off[i - 1];
+            }
+            if let (Some(_), Some(_)) = (u(node), t(prev)) {
+                e[0][1] = g(node, prev);
+            }
+            if let (Some(_), Some(_)) = (t(node), u(prev)) {
+                e[1][0] = g(prev, node);
+            }
+            if let (Some(j), Some(_)) = (t(node), t(prev)) {
+                e[1][1] = -h.off[j - 1];
             }
         }
         a
@@ -197,11 +185,13 @@ mod tests {
         }
     }
 
-    /// The coupled matrix in the interleaved order is quasi-definite: symmetric, with as many
-    /// positive pivots as displacement unknowns.
+    /// The coupled matrix node by node is quasi-definite: as many positive pivots as
+    /// displacement unknowns (and padding rows of clamped nodes), by the block factor and by
+    /// the banded `LDLᵀ` of the same matrix, with and without identity rows at the ends.
     #[test]
     fn the_coupled_matrix_has_the_inertia_of_its_blocks() {
-        use crate::linalg::banded::BandedLdlt;
+        use crate::linalg::banded::{BandedLdlt, SymBanded};
+        use crate::linalg::block_tridiag::BlockLdlt;
         let nodes = 11;
         let dx = 0.1;
         let dt = 0.05;
@@ -224,9 +214,23 @@ mod tests {
                 stiffness(MatrixVariant::Consistent, nodes, dx).sub(u_first, u_first + n_u - 1);
             let c = SymTridiag::combine(1.0 / (dt * dt), &um, 0.5 + 0.1 / (2.0 * dt), &uk);
             for mask in 0..=usize::from(!fixed[0]) {
-                let a = m.coupled(&c, mask);
-                let f = BandedLdlt::factor(&a).unwrap();
-                assert_eq!(f.inertia(), (m.n_u, m.n_t));
+                for identity in [&[][..], &[nodes - 1][..]] {
+                    let a = m.coupled(&c, mask, identity);
+                    let mut banded = SymBanded::<3>::zeros(2 * nodes);
+                    for i in 0..nodes {
+                        for r in 0..2 {
+                            for col in 0..=r {
+                                banded.add(2 * i + r, 2 * i + col, a.diag[i][r][col]);
+                            }
+                            for col in (0..2).filter(|_| i > 0) {
+                                banded.add(2 * i + r, 2 * i - 2 + col, a.lower[i][r][col]);
+                            }
+                        }
+                    }
+                    let expected = (nodes, nodes);
+                    assert_eq!(BlockLdlt::factor(&a).unwrap().inertia(), expected);
+                    assert_eq!(BandedLdlt::factor(&banded).unwrap().inertia(), expected);
+                }
             }
         }
     }

@@ -1,15 +1,15 @@
 //! Setting a thermal bar scene up: the bar's displacement, constraints and load as for the bar
 //! without a temperature, the initial temperature, and the step solver of the coupled step
-//! (one factorisation per exchange state, formed once).
+//! (the factorisations of each exchange state, formed once).
 
 use crate::bar::Simulation;
 use crate::scene::Expression;
 use crate::scene::{Scene, SceneError, SolverMethod};
 use crate::scheme::{Body, Load, RunError, Scheme, Setup, Unstarted};
-use crate::step::{CondensedSolver, Constraints, StepSolver};
+use crate::step::{ExactSolver, StepSolver};
 use crate::thermal::body::ThermalBody;
 use crate::thermal::solver::{CoupledSolver, DecoupledSolver};
-use crate::thermal::system::CoupledSystem;
+use crate::thermal::system::CoupledEnds;
 
 /// A run of a thermal bar scene: the scheme stepping the bar with a temperature.
 pub type ThermalSimulation = Scheme<ThermalBody>;
@@ -77,16 +77,17 @@ impl Scheme<ThermalBody> {
             Box::new(DecoupledSolver::new(bar.solver, heat, m.n_u, exchange))
         } else {
             let mut variants: Vec<Box<dyn StepSolver>> = Vec::with_capacity(masks);
+            let unknowns = disc.constrained_locals();
             for mask in 0..masks {
                 let system =
-                    CoupledSystem::new(m.coupled(&disc.step_matrix, mask), m.interleaved_order())
-                        .map_err(|e| SceneError::Invalid {
-                        field: "heat.coupling".into(),
-                        value: m.gamma.to_string(),
-                        allowed: format!("the coupled step matrix has no LDLᵀ: {e}"),
+                    CoupledEnds::new(&m, &disc.step_matrix, mask, &unknowns).map_err(|e| {
+                        SceneError::Invalid {
+                            field: "heat.coupling".into(),
+                            value: m.gamma.to_string(),
+                            allowed: format!("the coupled step matrix has no block LDLᵀ: {e}"),
+                        }
                     })?;
-                let constraints = Constraints::lower_bounds(&disc.constrained_locals());
-                variants.push(Box::new(CondensedSolver::new(system, constraints, 0.0)?));
+                variants.push(Box::new(ExactSolver::on(system, &unknowns, true)));
             }
             Box::new(CoupledSolver::new(variants, exchange))
         };

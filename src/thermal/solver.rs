@@ -4,8 +4,8 @@
 //! read off its bounds (`lo_k = −gap_k(u^n)`, [`exchange_state`]), exactly as the body reads
 //! it for its right-hand side. Without coupling (`γ = 0`) the displacement is the bar's own
 //! step, by the bar's own solver ([`DecoupledSolver`]: the bar's bits), and the temperature a
-//! tridiagonal solve; with coupling, one solver per exchange state on the coupled matrix
-//! ([`CoupledSolver`]).
+//! tridiagonal solve; with coupling, the exact end solver per exchange state on the coupled
+//! matrix ([`CoupledSolver`], [`crate::thermal::system::CoupledEnds`]).
 
 use crate::linalg::ldlt::Ldlt;
 use crate::scheme::in_contact;

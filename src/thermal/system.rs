@@ -1,144 +1,146 @@
-//! The thermal bar's coupled step matrix with its factorisation, as the step solvers see it
-//! ([`SpdSystem`]): vectors in the body's block layout `[u | θ]`, the matrix and its banded
-//! `LDLᵀ` in the interleaved order (a gather before and a scatter after each solve). The
-//! matrix `[[C, −γ/2 G], [−γ/2 Gᵀ, −H]]` is symmetric quasi-definite, not positive definite;
-//! what the condensed solver needs holds all the same: `E A⁻¹ Eᵀ` on displacement unknowns is
-//! the inverse's block `(C + γ²/4 G H⁻¹ Gᵀ)⁻¹`, positive definite, so the contact step stays
-//! an exact convex LCP. Factorised once per exchange state.
+//! The thermal bar's coupled step matrix `A_χ = [[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]]` as the exact
+//! end solver sees it ([`EndSystem`]): vectors in the body's block layout `[u | θ]`, the matrix
+//! node by node (blocks `(u_i, θ_i)`, [`ThermalMatrices::coupled`]) with its block `LDLᵀ`, and
+//! one more factor per non-empty set of active ends (their displacement rows and columns
+//! replaced by identity ones), all formed once per exchange state. `A_χ` is quasi-definite,
+//! not positive definite; what the enumeration needs holds all the same: `E A_χ⁻¹ Eᵀ` on
+//! displacement unknowns is the inverse's block `(C + γ²/4 G H_χ⁻¹ Gᵀ)⁻¹`, positive definite,
+//! so the contact step stays an exact convex LCP (`docs/thermal.md`).
 
-use crate::linalg::banded::{BandedLdlt, SymBanded, ZeroPivot};
-use crate::linalg::system::{Csc, SpdSystem};
-use crate::thermal::matrices::BAND;
+use crate::linalg::block_tridiag::{BlockLdlt, SingularBlock};
+use crate::linalg::tridiag::SymTridiag;
+use crate::step::exact::EndSystem;
+use crate::step::schur::{constraint_rows, row_product};
+use crate::thermal::matrices::{ThermalMatrices, coupling_entry};
 
-/// The coupled step matrix and its factor, in the block layout.
+/// The coupled step matrix of one exchange state with its factors, for the end enumeration.
 #[derive(Clone, Debug)]
-pub struct CoupledSystem {
-    matrix: SymBanded<BAND>,
-    factor: BandedLdlt<BAND>,
-    /// Interleaved position → block index, and back.
-    order: Vec<usize>,
-    position: Vec<usize>,
-    /// The interleaved right-hand side of a solve.
-    scratch: Vec<f64>,
+pub struct CoupledEnds {
+    /// The block `LDLᵀ` of `A_χ`, and at index `mask − 1` that of `A_χ` with the displacement
+    /// rows and columns of the active ends in `mask` replaced by identity ones.
+    factor: BlockLdlt,
+    reduced: Vec<BlockLdlt>,
+    /// The first nodes of the displacement and the temperature unknowns.
+    firsts: [usize; 2],
+    /// The constrained displacement unknowns (at most two), the rows of `C` there
+    /// ([`constraint_rows`]) and `−γ/2 G_ij` with the temperature's position `j`.
+    unknowns: Vec<usize>,
+    rows: [[f64; 3]; 2],
+    theta: [Vec<(usize, f64)>; 2],
+    n_u: usize,
+    /// `n_u + n_t`.
+    dim: usize,
+    /// The forward sweep of a solve, node by node.
+    scratch: Vec<[f64; 2]>,
 }
 
-impl CoupledSystem {
-    /// Factorises `matrix` (interleaved as `order` says: position `k` holds block index
-    /// `order[k]`).
-    pub fn new(matrix: SymBanded<BAND>, order: Vec<usize>) -> Result<Self, ZeroPivot> {
-        let factor = BandedLdlt::factor(&matrix)?;
-        let mut position = vec![0; order.len()];
-        for (k, &b) in order.iter().enumerate() {
-            position[b] = k;
-        }
+impl CoupledEnds {
+    /// `A_χ` of exchange state `mask` (`c`: the bar's `C`), constrained at the displacement
+    /// unknowns `unknowns` (at most two).
+    pub fn new(
+        m: &ThermalMatrices,
+        c: &SymTridiag,
+        mask: usize,
+        unknowns: &[usize],
+    ) -> Result<Self, SingularBlock> {
+        let nodes: Vec<usize> = unknowns.iter().map(|&i| i + m.u_first).collect();
+        let factor = BlockLdlt::factor(&m.coupled(c, mask, &[]))?;
+        let reduced = (1u8..(1 << nodes.len()))
+            .map(|active| {
+                let subset: Vec<usize> = (nodes.iter().enumerate())
+                    .filter(|&(j, _)| active & (1 << j) != 0)
+                    .map(|(_, &node)| node)
+                    .collect();
+                BlockLdlt::factor(&m.coupled(c, mask, &subset))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let theta = [0, 1].map(|j| {
+            let Some(&node) = nodes.get(j) else {
+                return Vec::new();
+            };
+            (node.saturating_sub(1)..=(node + 1).min(m.nodes - 1))
+                .filter_map(|t| {
+                    let g = coupling_entry(node, t, m.nodes);
+                    let k = m.theta_unknown(t)?;
+                    (g != 0.0).then_some((k, -0.5 * m.gamma * g))
+                })
+                .collect()
+        });
         Ok(Self {
-            scratch: vec![0.0; order.len()],
-            matrix,
             factor,
-            order,
-            position,
+            reduced,
+            firsts: [m.u_first, m.t_first],
+            unknowns: unknowns.to_vec(),
+            rows: constraint_rows(c, unknowns),
+            theta,
+            n_u: m.n_u,
+            dim: m.n_u + m.n_t,
+            scratch: vec![[0.0; 2]; m.nodes],
         })
     }
 
-    /// The factor's inertia: (positive, negative) pivots.
-    pub fn inertia(&self) -> (usize, usize) {
-        self.factor.inertia()
-    }
-
-    /// `A_ij` in the block layout.
-    pub fn entry(&self, i: usize, j: usize) -> f64 {
-        self.matrix.get(self.position[i], self.position[j])
+    /// `x ← F⁻¹ x` in the block layout by the factor `F`, the sweep carried by `y`.
+    fn solve(&mut self, mask: u8, x: &mut [f64]) {
+        let factor = match mask {
+            0 => &self.factor,
+            _ => &self.reduced[mask as usize - 1],
+        };
+        let (u, t) = x.split_at_mut(self.n_u);
+        let [fu, ft] = self.firsts;
+        factor.solve_fields([(u, fu), (t, ft)], &mut self.scratch);
     }
 }
 
-impl SpdSystem for CoupledSystem {
-    fn dim(&self) -> usize {
-        self.order.len()
+impl EndSystem for CoupledEnds {
+    fn solve_into(&mut self, b: &[f64], x: &mut [f64]) {
+        x.copy_from_slice(b);
+        self.solve(0, x);
     }
 
-    fn mul_into(&self, x: &[f64], y: &mut [f64]) {
-        let (a, order) = (&self.matrix, &self.order);
-        let n = order.len();
-        for (k, &bi) in order.iter().enumerate() {
-            let mut s = a.diag[k] * x[bi];
-            for d in 1..=BAND.min(k) {
-                s += a.lower[k][d - 1] * x[order[k - d]];
-            }
-            for d in 1..=BAND.min(n - 1 - k) {
-                s += a.lower[k + d][d - 1] * x[order[k + d]];
-            }
-            y[bi] = s;
+    fn solve_reduced_in_place(&mut self, mask: u8, x: &mut [f64]) {
+        self.solve(mask, x);
+    }
+
+    /// The neighbouring displacements off the active set, and the temperatures coupled to it.
+    fn move_to_rhs(&self, j: usize, v: f64, mask: u8, x: &mut [f64]) {
+        let i = self.unknowns[j];
+        let is_active = |k: usize| {
+            (0..self.unknowns.len()).any(|a| mask & (1 << a) != 0 && self.unknowns[a] == k)
+        };
+        let [left, right, _] = self.rows[j];
+        if i > 0 && !is_active(i - 1) {
+            x[i - 1] -= left * v;
+        }
+        if i + 1 < self.n_u && !is_active(i + 1) {
+            x[i + 1] -= right * v;
+        }
+        for &(k, a) in &self.theta[j] {
+            x[k] -= a * v;
         }
     }
 
-    fn solve_in_place(&mut self, x: &mut [f64]) {
-        for (s, &bi) in self.scratch.iter_mut().zip(&self.order) {
-            *s = x[bi];
+    /// `(C z_u)_i` in the bar's difference form, then the coupling to the temperatures.
+    fn row_product(&self, j: usize, z: &[f64]) -> f64 {
+        let mut s = row_product(self.rows[j], self.unknowns[j], &z[..self.n_u]);
+        for &(k, a) in &self.theta[j] {
+            s += a * z[k];
         }
-        self.factor.solve_in_place(&mut self.scratch);
-        for (s, &bi) in self.scratch.iter().zip(&self.order) {
-            x[bi] = *s;
-        }
+        s
     }
 
-    fn inf_norm(&self) -> f64 {
-        self.matrix.inf_norm()
-    }
-
-    fn diagonal(&self, i: usize) -> f64 {
-        self.matrix.diag[self.position[i]]
-    }
-
-    fn abs_row_product(&self, i: usize, x: &[f64]) -> f64 {
-        let order = &self.order;
-        (self.matrix).abs_row_sum(self.position[i], |k| x[order[k]].abs())
-    }
-
-    /// A row of `A z` is at most seven products and six additions, then `− b_i − r_i` two
-    /// more (about 9 ulps of `|A||z| + |b| + |r|` exactly rounded); the banded `LDLᵀ` of a
-    /// quasi-definite matrix is backward stable with a growth bounded by the blocks'
-    /// conditioning (Gill, Saunders & Shinnerl, SIAM J. Matrix Anal. Appl. 17 (1996)), which
-    /// the thermal bar's well-scaled blocks keep small: 64 leaves a margin of about three over
-    /// the tridiagonal bar's 32 · 7/3.
-    fn roundoff_ulps(&self) -> f64 {
-        64.0
-    }
-
-    /// The upper triangle in the block layout. The matrix is quasi-definite, not positive
-    /// semidefinite: it is not a convex QP's `P` (OSQP on the thermal bar takes the reduced
-    /// problem, `crate::thermal::osqp`).
-    fn upper_triangle(&self) -> Csc {
-        let n = self.order.len();
-        let mut columns: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
-        for k in 0..n {
-            for d in 0..=BAND.min(k) {
-                let v = if d == 0 {
-                    self.matrix.diag[k]
-                } else {
-                    self.matrix.lower[k][d - 1]
-                };
-                if v != 0.0 || d == 0 {
-                    let (i, j) = (self.order[k], self.order[k - d]);
-                    let (r, c) = (i.min(j), i.max(j));
-                    columns[c].push((r, v));
-                }
+    fn schur_complement(&mut self) -> [[f64; 2]; 2] {
+        let mut schur = [[0.0; 2]; 2];
+        let mut column = vec![0.0; self.dim];
+        for (a, i) in self.unknowns.clone().into_iter().enumerate() {
+            column.fill(0.0);
+            column[i] = 1.0;
+            self.solve(0, &mut column);
+            for (b, &k) in self.unknowns.iter().enumerate() {
+                schur[a][b] = column[k];
             }
         }
-        let (mut indptr, mut indices, mut data) = (vec![0], Vec::new(), Vec::new());
-        for mut col in columns {
-            col.sort_by_key(|&(r, _)| r);
-            for (r, v) in col {
-                indices.push(r);
-                data.push(v);
-            }
-            indptr.push(indices.len());
-        }
-        Csc {
-            nrows: n,
-            ncols: n,
-            indptr,
-            indices,
-            data,
-        }
+        let s = 0.5 * (schur[0][1] + schur[1][0]);
+        (schur[0][1], schur[1][0]) = (s, s);
+        schur
     }
 }
