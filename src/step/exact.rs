@@ -30,6 +30,11 @@ use crate::step::{SolveInfo, StepFailure, StepSolver};
 pub trait EndSystem {
     /// `x = A⁻¹ b`.
     fn solve_into(&mut self, b: &[f64], x: &mut [f64]);
+    /// `x = A⁻¹ b`, then `u += x`: a system may do both in one pass (the same bits).
+    fn solve_into_and_add(&mut self, b: &[f64], x: &mut [f64], u: &mut [f64]) {
+        self.solve_into(b, x);
+        add_in_place(u, x);
+    }
     /// `x ← A_M⁻¹ x` for active set `mask` (not empty).
     fn solve_reduced_in_place(&mut self, mask: u8, x: &mut [f64]);
     /// `x_k −= A_{k,i_j} v` at the other rows `k` of column `i_j` off active set `mask`: a
@@ -76,6 +81,10 @@ impl BarEnds {
 impl EndSystem for BarEnds {
     fn solve_into(&mut self, b: &[f64], x: &mut [f64]) {
         self.factor.solve_into(b, x);
+    }
+
+    fn solve_into_and_add(&mut self, b: &[f64], x: &mut [f64], u: &mut [f64]) {
+        self.factor.solve_into_and_add(b, x, u);
     }
 
     fn solve_reduced_in_place(&mut self, mask: u8, x: &mut [f64]) {
@@ -234,7 +243,8 @@ impl<E: EndSystem> StepSolver for ExactSolver<E> {
         "exact"
     }
 
-    /// Without a constrained node, the solve and the update in one pass (`TwistedLdlt`'s fused sweep).
+    /// Without a constrained node, the solve and the update in one pass
+    /// ([`EndSystem::solve_into_and_add`]).
     fn solve_and_advance(
         &mut self,
         rhs: &[f64],
@@ -244,7 +254,7 @@ impl<E: EndSystem> StepSolver for ExactSolver<E> {
         u: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
         if self.nodes.is_empty() {
-            self.factor.solve_into_and_add(rhs, z, u);
+            self.system.solve_into_and_add(rhs, z, u);
             return Ok(SolveInfo { iterations: 1 });
         }
         let info = self.solve(rhs, lower, z, reactions)?;
