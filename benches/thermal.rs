@@ -1,8 +1,8 @@
 //! Per-step cost of the thermal bar against the bar without a temperature, in node-steps per
 //! second (group `thermal`): the same two-end bar pressed by a constant load onto obstacles at
 //! gap 0 (contact active at every step), `mechanical` without `[heat]`, `thermal` with a
-//! coupled temperature (γ = 0.1, κ = 0.05, a fixed temperature at one end, an exchange at the
-//! other). Target (benches/README.md): thermal <= 3x mechanical at J = 1e4 … 1e5.
+//! coupled temperature (γ = 0.1, κ = 0.05, an exchange with the obstacle at the left end, the
+//! right end insulated). Target (benches/README.md): thermal <= 3x mechanical at J = 1e4 … 1e5.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use viscobar::Scene;
