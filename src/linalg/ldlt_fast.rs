@@ -8,9 +8,10 @@ use crate::linalg::tridiag::SymTridiag;
 use std::cell::Cell;
 
 /// A factorisation of a symmetric positive definite tridiagonal matrix `A` with a quarter of
-/// the plain sweep's dependent latency: measured 2.5–3x faster than the plain solve on the
-/// bar's unconstrained step at J = 1e4 … 1e6 (benches/README.md, "Plain kernels and their
-/// twins").
+/// the plain sweep's dependent latency, whose solve streams the right-hand side and the
+/// solution but not the factor on a uniform interior ([`TwistedLdlt::solve_into_and_add`]);
+/// what it buys on the bar's steps is measured in benches/README.md, "Plain kernels and their
+/// twins".
 ///
 /// *Reduction.* The odd nodes are not neighbours of each other, so eliminating them first
 /// (pivots `d_o`) leaves a tridiagonal Schur complement `A'` on the even nodes (`ν = ⌈n/2⌉`

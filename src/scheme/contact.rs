@@ -150,6 +150,10 @@ fn max_of(m: f64, x: f64) -> f64 {
     if x > m { x } else { m }
 }
 
+/// `(u^{n+1}, z, w, r)`: the state after a step, its increment, the one before and the
+/// reactions.
+type State<'a> = (&'a [f64], &'a [f64], &'a [f64], &'a [f64]);
+
 impl ContactSet {
     /// Constraints with gaps `gaps`, at unknowns `unknowns` (empty: `i_k = k`) in directions
     /// `directions` (empty: all `+1`), placed at `positions`, reported in `groups`.
@@ -329,12 +333,40 @@ impl ContactSet {
     }
 
     /// One pass over constraints `range` of `u = u^{n+1}` with reactions `r`; with
-    /// `dissipation`, also `−½ Σ r_k s_k (z + w)_{i_k}`, `z + w = u^{n+1} − u^{n−1}`.
-    fn pass(
+    /// `dissipation`, also `−½ Σ r_k (s_k (z + w)_{i_k} + g_k^{n+1} − g_k^{n−1})`,
+    /// `z + w = u^{n+1} − u^{n−1}`. Fixed lower bounds at `i_k = k` (an obstacle under every
+    /// node) take the same loop compiled without the lookups of `i_k`, `s_k` and the motion.
+    fn pass(&self, range: Range<usize>, state: State<'_>, dissipation: bool) -> Pass {
+        let plain = self.unknowns.is_empty() && self.directions.is_empty() && !self.is_moving();
+        match (plain, dissipation) {
+            (true, true) => self.pass_with::<true>(range, state, |k| k, |_| 1.0, |_| 0.0),
+            (true, false) => self.pass_with::<false>(range, state, |k| k, |_| 1.0, |_| 0.0),
+            (false, true) => self.pass_with::<true>(
+                range,
+                state,
+                |k| self.unknown(k),
+                |k| self.direction(k),
+                |k| self.gap_change(k),
+            ),
+            (false, false) => self.pass_with::<false>(
+                range,
+                state,
+                |k| self.unknown(k),
+                |k| self.direction(k),
+                |k| self.gap_change(k),
+            ),
+        }
+    }
+
+    /// [`ContactSet::pass`] with `i_k`, `s_k` and `g_k^{n+1} − g_k^{n−1}` given.
+    #[inline(always)]
+    fn pass_with<const DISSIPATION: bool>(
         &self,
         range: Range<usize>,
-        (u, z, w, r): (&[f64], &[f64], &[f64], &[f64]),
-        dissipation: bool,
+        (u, z, w, r): State<'_>,
+        unknown: impl Fn(usize) -> usize,
+        direction: impl Fn(usize) -> f64,
+        gap_change: impl Fn(usize) -> f64,
     ) -> Pass {
         let mut p = Pass {
             min_gap: f64::INFINITY,
@@ -347,7 +379,7 @@ impl ContactSet {
             last: 0,
         };
         for k in range {
-            let (l, s) = (self.unknown(k), self.direction(k));
+            let (l, s) = (unknown(k), direction(k));
             let gap = s * u[l] + self.gaps[k];
             let reaction = r[k];
             p.total += reaction;
@@ -361,8 +393,8 @@ impl ContactSet {
                 p.last = k;
                 p.count += 1;
             }
-            if dissipation {
-                let change = self.gap_change(k);
+            if DISSIPATION {
+                let change = gap_change(k);
                 p.dissipation += if change == 0.0 {
                     -0.5 * reaction * s * (z[l] + w[l])
                 } else {
