@@ -3,7 +3,8 @@
 //! coupled problems: every symmetric permutation of such a matrix has an `LDLᵀ` with `D`
 //! nonsingular (Vanderbei, SIAM J. Optim. 5 (1995) 100–113), so an ordering that keeps the
 //! band (the two fields interleaved node by node) is factorised as it stands, once. The signs
-//! of `D` give the inertia (as many positive pivots as `A` has rows).
+//! of `D` give the inertia (as many positive pivots as `A` has rows). Test-only: the
+//! independent reference the block factor ([`super::block_tridiag`]) is checked against.
 
 /// A symmetric `n × n` matrix with `A_ij = 0` for `|i − j| > P`: the diagonal and, per row `i`,
 /// `lower[i][s − 1] = A_{i, i−s}` for `s = 1..=P` (0 where `i < s`).
@@ -61,26 +62,6 @@ impl<const P: usize> SymBanded<P> {
             }
             y[i] = s;
         }
-    }
-
-    /// `‖A‖∞`.
-    pub fn inf_norm(&self) -> f64 {
-        (0..self.dim())
-            .map(|i| self.abs_row_sum(i, |_| 1.0))
-            .fold(0.0, f64::max)
-    }
-
-    /// `Σ_j |A_ij| x(j)`.
-    pub fn abs_row_sum(&self, i: usize, x: impl Fn(usize) -> f64) -> f64 {
-        let n = self.dim();
-        let mut s = self.diag[i].abs() * x(i);
-        for d in 1..=P.min(i) {
-            s += self.lower[i][d - 1].abs() * x(i - d);
-        }
-        for d in 1..=P.min(n - 1 - i) {
-            s += self.lower[i + d][d - 1].abs() * x(i + d);
-        }
-        s
     }
 }
 
@@ -144,11 +125,6 @@ impl<const P: usize> BandedLdlt<P> {
 
     pub fn dim(&self) -> usize {
         self.d.len()
-    }
-
-    /// `D`.
-    pub fn pivots(&self) -> &[f64] {
-        &self.d
     }
 
     /// The positive and the negative pivots: the inertia of `A` (Sylvester).

@@ -205,27 +205,31 @@ impl BlockLdlt {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::linalg::banded::{BandedLdlt, SymBanded};
-
-    /// The interleaved scalar matrix of `a`: block row `i` is rows `2i, 2i + 1`.
-    fn banded(a: &BlockTridiag) -> SymBanded<3> {
-        let mut s = SymBanded::<3>::zeros(2 * a.blocks());
-        for i in 0..a.blocks() {
+impl BlockTridiag {
+    /// The interleaved scalar matrix: block row `i` is rows `2i, 2i + 1` (the tests' reference,
+    /// a banded `LDLᵀ` of the same matrix).
+    pub(crate) fn to_banded(&self) -> crate::linalg::banded::SymBanded<3> {
+        let mut s = crate::linalg::banded::SymBanded::<3>::zeros(2 * self.blocks());
+        for i in 0..self.blocks() {
             for r in 0..2 {
                 for c in 0..=r {
-                    s.add(2 * i + r, 2 * i + c, a.diag[i][r][c]);
+                    s.add(2 * i + r, 2 * i + c, self.diag[i][r][c]);
                 }
                 if i > 0 {
                     for c in 0..2 {
-                        s.add(2 * i + r, 2 * (i - 1) + c, a.lower[i][r][c]);
+                        s.add(2 * i + r, 2 * (i - 1) + c, self.lower[i][r][c]);
                     }
                 }
             }
         }
         s
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linalg::banded::BandedLdlt;
 
     /// A quasi-definite block-tridiagonal matrix (an SPD field, a negative definite one, full
     /// couplings): the block factor's inertia and solve agree with the banded `LDLᵀ` of the
@@ -242,7 +246,7 @@ mod tests {
                 }
             }
             let block = BlockLdlt::factor(&a).unwrap();
-            let scalar = BandedLdlt::factor(&banded(&a)).unwrap();
+            let scalar = BandedLdlt::factor(&a.to_banded()).unwrap();
             assert_eq!(block.inertia(), (n, n));
             assert_eq!(scalar.inertia(), (n, n));
             let x: Vec<[f64; 2]> = (0..n)

@@ -19,7 +19,7 @@ use crate::step::solver::Constraints;
 use crate::step::{
     OsqpStatus, SettingsError, SetupError, SolveInfo, SolverReport, StepFailure, StepSolver,
 };
-use osqp::{CscMatrix, Problem, Settings, Status};
+use osqp::{CscMatrix, Problem, Settings, Solution, Status};
 use std::borrow::Cow;
 
 /// OSQP's `eps_abs` and `eps_rel` unless set: tight enough that, polished, the answer agrees
@@ -183,9 +183,17 @@ pub fn raw_problem(
     .map_err(|e| SetupError::Osqp(e.to_string()))
 }
 
-/// OSQP's status, as its C library spells it.
-pub(crate) fn status_of(status: &Status<'_>) -> OsqpStatus {
-    match status {
+/// OSQP's answer and whether it was only `SolvedInaccurate` (accepted when
+/// `accept_inaccurate`); any other status is a failure naming it, as OSQP's C library spells
+/// it, and the iterations run.
+pub(crate) fn accepted(
+    status: Status<'_>,
+    accept_inaccurate: bool,
+) -> Result<(Solution<'_>, bool), StepFailure> {
+    let iterations = status.iter();
+    let status = match status {
+        Status::Solved(s) => return Ok((s, false)),
+        Status::SolvedInaccurate(s) if accept_inaccurate => return Ok((s, true)),
         Status::SolvedInaccurate(_) => OsqpStatus::SolvedInaccurate,
         Status::MaxIterationsReached(_) => OsqpStatus::MaxIterationsReached,
         Status::TimeLimitReached(_) => OsqpStatus::TimeLimitReached,
@@ -195,7 +203,8 @@ pub(crate) fn status_of(status: &Status<'_>) -> OsqpStatus {
         Status::DualInfeasibleInaccurate(_) => OsqpStatus::DualInfeasibleInaccurate,
         Status::NonConvex(_) => OsqpStatus::NonConvex,
         _ => OsqpStatus::Unknown,
-    }
+    };
+    Err(StepFailure::Osqp { status, iterations })
 }
 
 impl OsqpSolver<TridiagSystem> {
@@ -288,16 +297,7 @@ impl<S: SpdSystem> StepSolver for OsqpSolver<S> {
         self.problem.warm_start(&self.x_prev, &self.y_prev);
         let status = self.problem.solve();
         let iterations = status.iter();
-        let (solution, inaccurate) = match status {
-            Status::Solved(s) => (s, false),
-            Status::SolvedInaccurate(s) if self.settings.accept_inaccurate => (s, true),
-            other => {
-                return Err(StepFailure::Osqp {
-                    status: status_of(&other),
-                    iterations,
-                });
-            }
-        };
+        let (solution, inaccurate) = accepted(status, self.settings.accept_inaccurate)?;
         z.copy_from_slice(solution.x());
         let y = solution.y();
         for j in 0..k {

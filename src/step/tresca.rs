@@ -18,10 +18,10 @@ use crate::linalg::system::{Csc, SpdSystem};
 use crate::step::audit::{AUDIT_MARGIN, INACCURATE_FACTOR};
 use crate::step::condensed::condensed_matrix;
 use crate::step::friction_audit::{FrictionAudit, FrictionLaw, Thresholds};
-use crate::step::osqp::{OSQP_INFTY, OsqpSettings, osqp_csc, status_of};
+use crate::step::osqp::{OSQP_INFTY, OsqpSettings, accepted, osqp_csc};
 use crate::step::solver::{Constraints, Friction};
 use crate::step::{SetupError, SolveInfo, SolverReport, StepFailure, StepSolver};
-use osqp::{Problem, Status};
+use osqp::Problem;
 
 /// The fixed point stops when the normal reactions change by at most this, relative to their
 /// largest: polished OSQP answers are exact to round-off, so the iteration can settle far below
@@ -148,18 +148,8 @@ impl<S: SpdSystem> TrescaSolver<S> {
         }
         self.problem.update_bounds(&self.lower, &self.upper);
         self.problem.warm_start(&self.r, &self.y_prev);
-        let status = self.problem.solve();
-        let iterations = status.iter();
-        let (solution, inaccurate) = match status {
-            Status::Solved(s) => (s, false),
-            Status::SolvedInaccurate(s) if self.settings.accept_inaccurate => (s, true),
-            other => {
-                return Err(StepFailure::Osqp {
-                    status: status_of(&other),
-                    iterations,
-                });
-            }
-        };
+        let (solution, inaccurate) =
+            accepted(self.problem.solve(), self.settings.accept_inaccurate)?;
         reactions.copy_from_slice(solution.x());
         self.y_prev.copy_from_slice(solution.y());
         self.r.copy_from_slice(reactions);

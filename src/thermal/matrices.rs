@@ -190,7 +190,7 @@ mod tests {
     /// the banded `LDLᵀ` of the same matrix, with and without identity rows at the ends.
     #[test]
     fn the_coupled_matrix_has_the_inertia_of_its_blocks() {
-        use crate::linalg::banded::{BandedLdlt, SymBanded};
+        use crate::linalg::banded::BandedLdlt;
         use crate::linalg::block_tridiag::BlockLdlt;
         let nodes = 11;
         let dx = 0.1;
@@ -216,17 +216,7 @@ mod tests {
             for mask in 0..=usize::from(!fixed[0]) {
                 for identity in [&[][..], &[nodes - 1][..]] {
                     let a = m.coupled(&c, mask, identity);
-                    let mut banded = SymBanded::<3>::zeros(2 * nodes);
-                    for i in 0..nodes {
-                        for r in 0..2 {
-                            for col in 0..=r {
-                                banded.add(2 * i + r, 2 * i + col, a.diag[i][r][col]);
-                            }
-                            for col in (0..2).filter(|_| i > 0) {
-                                banded.add(2 * i + r, 2 * i - 2 + col, a.lower[i][r][col]);
-                            }
-                        }
-                    }
+                    let banded = a.to_banded();
                     let expected = (nodes, nodes);
                     assert_eq!(BlockLdlt::factor(&a).unwrap().inertia(), expected);
                     assert_eq!(BandedLdlt::factor(&banded).unwrap().inertia(), expected);
