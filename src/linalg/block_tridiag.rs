@@ -4,7 +4,7 @@
 //! is quasi-definite, so each pivot block `D_i = [[p, q], [q, s]]` has `p > 0 > s` and
 //! `det D_i = ps − q² < 0` sums two terms of one sign (no cancellation); `D_i⁻¹` is stored.
 //! A solve is one forward and one backward sweep of 2 × 2 products. The same factorisation
-//! row by row is [`super::banded`]'s (the tests compare them).
+//! row by row is the test-only `banded` module's (the tests compare them).
 
 /// A 2 × 2 block, `b[r][c]`.
 pub type Block = [[f64; 2]; 2];
