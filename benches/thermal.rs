@@ -2,10 +2,13 @@
 //! second (group `thermal`): the same two-end bar pressed by a constant load onto obstacles at
 //! gap 0 (contact active at every step), `mechanical` without `[heat]`, `thermal` with a
 //! coupled temperature (γ = 0.1, κ = 0.05, an exchange with the obstacle at the left end, the
-//! right end insulated). Target (benches/README.md): thermal <= 3x mechanical at J = 1e4 … 1e5.
+//! right end insulated), and `thermal-plain-solve` with the coupled solve by the plain block
+//! sweep instead of its twisted twin. Target (benches/README.md): thermal <= 3x mechanical at
+//! J = 1e4 … 1e5; both factors are in the twins block (`bench-compare --twins`).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use viscobar::Scene;
+use viscobar::bar::Kernels;
 use viscobar::thermal::ThermalSimulation;
 
 fn scene(elements: u64, heat: bool) -> Scene {
@@ -33,10 +36,13 @@ fn bench_thermal(c: &mut Criterion) {
         group.throughput(Throughput::Elements(elements + 1));
         let mut bar = viscobar::Simulation::new(&scene(elements, false)).unwrap();
         let mut thermal = ThermalSimulation::new(&scene(elements, true)).unwrap();
+        let mut plain =
+            ThermalSimulation::with_kernels(&scene(elements, true), Kernels::PLAIN).unwrap();
         // Settle into contact before timing.
         for _ in 0..50 {
             bar.step().unwrap();
             thermal.step().unwrap();
+            plain.step().unwrap();
         }
         group.bench_with_input(
             BenchmarkId::new("mechanical", elements),
@@ -46,6 +52,8 @@ fn bench_thermal(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::new("thermal", elements), &elements, |b, _| {
             b.iter(|| thermal.step().unwrap())
         });
+        let id = BenchmarkId::new("thermal-plain-solve", elements);
+        group.bench_with_input(id, &elements, |b, _| b.iter(|| plain.step().unwrap()));
     }
     group.finish();
 }

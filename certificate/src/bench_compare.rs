@@ -300,11 +300,40 @@ pub fn twins_markdown() -> Result<String, String> {
         cells.join(" | ")
     )
     .unwrap();
+    // The thermal step (benches/thermal.rs): its twin, and its cost over the mechanical step.
+    let (mut cells, mut ratios) = (Vec::new(), Vec::new());
+    for j in &SIZES[..2] {
+        let thermal = read(format!("thermal/thermal/{j}"))?;
+        let plain = read(format!("thermal/thermal-plain-solve/{j}"))?;
+        let mechanical = read(format!("thermal/mechanical/{j}"))?;
+        cells.push(format!("{:.2}x", plain / thermal));
+        ratios.push(thermal / mechanical);
+    }
+    writeln!(
+        rows,
+        "| `block_tridiag_fast::TwistedBlockLdlt` | `block_tridiag::BlockLdlt` | thermal | {} | \
+         not measured |",
+        cells.join(" | ")
+    )
+    .unwrap();
+    let worst = ratios.iter().copied().fold(0.0f64, f64::max);
+    let thermal_line = format!(
+        "\nThe thermal step over the mechanical step (`thermal/thermal` over `thermal/mechanical`): \
+         {:.2}x at J = 1e4, {:.2}x at J = 1e5; target <= {THERMAL_RATIO_LIMIT}x {}.\n",
+        ratios[0],
+        ratios[1],
+        if worst <= THERMAL_RATIO_LIMIT {
+            "met"
+        } else {
+            "**not met**"
+        }
+    );
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
     let mut out = format!(
         "Criterion medians measured {} – {} UTC on {} ({cores} cores) by `cargo bench --bench \
-         twins -- --warm-up-time 0.5 --measurement-time 2`, written by `{COMPARE_COMMAND} \
-         --twins --update benches/README.md`.\n\n",
+         twins -- --warm-up-time 0.5 --measurement-time 2` and `cargo bench --bench thermal -- \
+         --warm-up-time 1 --measurement-time 3`, written by `{COMPARE_COMMAND} --twins \
+         --update benches/README.md`.\n\n",
         utc_date_time_at(span.0),
         utc_date_time_at(span.1),
         cpu_model(),
@@ -313,8 +342,12 @@ pub fn twins_markdown() -> Result<String, String> {
         "| twin | plain version | step | J = 1e4 | J = 1e5 | J = 1e6 |\n|---|---|---|---|---|---|\n",
     );
     out.push_str(&rows);
+    out.push_str(&thermal_line);
     Ok(out)
 }
+
+/// The thermal step's target over the mechanical step (benches/README.md, "Targets").
+pub const THERMAL_RATIO_LIMIT: f64 = 3.0;
 
 /// `bench-compare`: prints the block, or with `update` rewrites it in that file. The exit
 /// code: 0; 1 when a measurement is missing or the file cannot be updated.

@@ -49,7 +49,7 @@ impl BlockTridiag {
 
 /// `B x`.
 #[inline(always)]
-fn mul(b: &Block, x: [f64; 2]) -> [f64; 2] {
+pub(super) fn mul(b: &Block, x: [f64; 2]) -> [f64; 2] {
     [
         b[0][0] * x[0] + b[0][1] * x[1],
         b[1][0] * x[0] + b[1][1] * x[1],
@@ -58,7 +58,7 @@ fn mul(b: &Block, x: [f64; 2]) -> [f64; 2] {
 
 /// `Bᵀ x`.
 #[inline(always)]
-fn mul_transposed(b: &Block, x: [f64; 2]) -> [f64; 2] {
+pub(super) fn mul_transposed(b: &Block, x: [f64; 2]) -> [f64; 2] {
     [
         b[0][0] * x[0] + b[1][0] * x[1],
         b[0][1] * x[0] + b[1][1] * x[1],
@@ -67,12 +67,12 @@ fn mul_transposed(b: &Block, x: [f64; 2]) -> [f64; 2] {
 
 /// `D⁻¹ y` from `[a, b, c]`.
 #[inline(always)]
-fn d_inv_mul(&[a, b, c]: &[f64; 3], y: [f64; 2]) -> [f64; 2] {
+pub(super) fn d_inv_mul(&[a, b, c]: &[f64; 3], y: [f64; 2]) -> [f64; 2] {
     [a * y[0] + b * y[1], b * y[0] + c * y[1]]
 }
 
 #[inline(always)]
-fn add(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+pub(super) fn add(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     [a[0] + b[0], a[1] + b[1]]
 }
 
@@ -137,6 +137,16 @@ impl BlockLdlt {
     /// The number of block rows.
     pub fn blocks(&self) -> usize {
         self.inv_d.len()
+    }
+
+    /// The rows `L_{i,i−1}` (`L_{0,−1}` zero).
+    pub(super) fn l(&self) -> &[Block] {
+        &self.l
+    }
+
+    /// The rows `D_i⁻¹` as `[a, b, c]`.
+    pub(super) fn inv_d(&self) -> &[[f64; 3]] {
+        &self.inv_d
     }
 
     /// The positive and the negative eigenvalues of `D`: the inertia of `A` (Sylvester).

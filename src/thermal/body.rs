@@ -276,39 +276,48 @@ impl ThermalBody {
             .map(|(e, x)| (x.coefficient, self.theta_obs[e]))
     }
 
-    /// `|x|²_K` of the temperature's stiffness on every node, by elements (exact for constants).
-    fn stiffness_quad(&self, x: impl Fn(usize) -> f64) -> f64 {
-        let off = &self.m.stiffness.off;
-        let mut left = x(0);
-        let mut s = 0.0;
-        for (e, k) in off.iter().enumerate() {
-            let right = x(e + 1);
-            s += -k * (right - left).powi(2);
-            left = right;
-        }
-        s
-    }
-
-    /// `|x|²_M` of the temperature's mass on every node.
-    fn mass_quad(&self, x: impl Fn(usize) -> f64) -> f64 {
+    /// `|x|²_M` of the temperature's mass and `|y|²_K` of its stiffness on every node in one
+    /// pass, and `Q·y` with the source's `Q^n` (0 without a source): each node's terms
+    /// `(M_jj x_j + 2 M_j,j+1 x_j+1) x_j` and `−K_j,j+1 (y_j+1 − y_j)²` (difference form, exact
+    /// for constants), with the uniform mesh's coefficients ([`interior_coefficients`]).
+    fn quads(&self, x: impl Fn(usize) -> f64, y: impl Fn(usize) -> f64) -> [f64; 3] {
         let mass = &self.m.mass;
         let n = mass.diag.len();
-        let mut s = 0.0;
-        let mut xj = x(0);
-        for j in 0..n {
-            s += mass.diag[j] * xj * xj;
-            if j + 1 < n {
-                let next = x(j + 1);
-                s += 2.0 * mass.off[j] * xj * next;
-                xj = next;
+        let ([md, mo], [_, ko]) = (
+            interior_coefficients(mass),
+            interior_coefficients(&self.m.stiffness),
+        );
+        let [mut sm, mut sk, mut sq] = [0.0; 3];
+        let (mut xj, mut yj) = (x(0), y(0));
+        for j in 0..n - 1 {
+            let (xn, yn) = (x(j + 1), y(j + 1));
+            let d = if j == 0 { mass.diag[0] } else { md };
+            sm += (d * xj + 2.0 * mo * xn) * xj;
+            sk += -ko * ((yn - yj) * (yn - yj));
+            if let Some(q) = self.q.get(j) {
+                sq += q * yj;
             }
+            (xj, yj) = (xn, yn);
         }
-        s
+        sm += mass.diag[n - 1] * xj * xj;
+        if let Some(q) = self.q.get(n - 1) {
+            sq += q * yj;
+        }
+        [sm, sk, sq]
     }
 
     /// The `θ` block of the right-hand side over the temperature's unknowns: the heat rows
-    /// times `−Δt` (`s = Δt`), or the start-up's half step (`s = Δt/2`) without the sign.
-    fn heat_rhs(&self, u: &[f64], w_u: &[f64], s: f64, sign: f64, b_theta: &mut [f64]) {
+    /// times `−Δt` (`s = Δt`), or the start-up's half step (`s = Δt/2`) without the sign;
+    /// with `coupling = Some(b_u)` (`γ ≠ 0`), also the displacement rows' `+= γ G φ`, read
+    /// off the same nodes.
+    fn heat_rhs(
+        &self,
+        u: &[f64],
+        w_u: &[f64],
+        (s, sign): (f64, f64),
+        b_theta: &mut [f64],
+        coupling: Option<&mut [f64]>,
+    ) {
         let m = &self.m;
         let (kappa, gamma) = (m.kappa, m.gamma);
         let theta = &u[m.n_u..];
@@ -316,11 +325,8 @@ impl ThermalBody {
         let disp = self.nodal(|k| self.disp(w_u, k), |k| w_u[k - m.u_first]);
         // Rows whose stencil reaches an end node by the general reads; the others below.
         let interior = 2..m.nodes.saturating_sub(2).max(2);
-        for (jt, bj) in b_theta.iter_mut().enumerate() {
-            let j = m.t_first + jt;
-            if interior.contains(&j) {
-                continue;
-            }
+        let t_end = m.t_first + b_theta.len();
+        for j in (m.t_first..interior.start).chain(interior.end..t_end) {
             let mut r = -s * kappa * Self::tri_row(&m.stiffness, j, &phi);
             if !self.q.is_empty() {
                 r += s * self.q[j];
@@ -334,39 +340,89 @@ impl ThermalBody {
             if !self.fixed.is_empty() {
                 r -= Self::tri_row(&m.mass, j, |k| self.fixed_increment(k));
             }
-            *bj = sign * r;
+            b_theta[j - m.t_first] = sign * r;
         }
-        // The interior rows, the same formula on the three nodes `j − 1, j, j + 1` read
-        // directly (no exchange, no fixed end there).
+        let mut coupling = coupling;
+        if let Some(bu) = coupling.as_deref_mut() {
+            let u_end = m.u_first + bu.len();
+            for node in (m.u_first..interior.start).chain(interior.end..u_end) {
+                bu[node - m.u_first] += gamma * self.g_row(node, &phi);
+            }
+        }
         if interior.is_empty() {
             return;
         }
+        // The interior rows, the same formulas on the nodes `j − 1, j, j + 1` read directly
+        // (no exchange, no fixed end there), with the interior coefficients of `K_θ`.
         let rows = interior.clone();
         let b = &mut b_theta[rows.start - m.t_first..rows.end - m.t_first];
         let theta = &theta[rows.start - 1 - m.t_first..rows.end + 1 - m.t_first];
         let w = &w_u[rows.start - 1 - m.u_first..rows.end + 1 - m.u_first];
-        let (kd, ko) = (
-            &m.stiffness.diag[rows.clone()],
-            &m.stiffness.off[rows.start - 1..rows.end],
-        );
+        let [kd, ko] = interior_coefficients(&m.stiffness);
         let q = if self.q.is_empty() {
             &[][..]
         } else {
-            &self.q[rows]
+            &self.q[rows.clone()]
         };
-        let (a, c) = (-s * kappa, 0.5 * gamma);
-        for (jt, bj) in b.iter_mut().enumerate() {
-            let (th, w, ko) = (&theta[jt..jt + 3], &w[jt..jt + 3], &ko[jt..jt + 2]);
-            let mut r = a * (kd[jt] * th[1] + ko[0] * th[0] + ko[1] * th[2]);
-            if let Some(q) = q.get(jt) {
-                r += s * q;
+        let row = HeatRow {
+            a: -s * kappa,
+            kd,
+            ko,
+            s,
+            c: 0.5 * gamma,
+            sign,
+        };
+        let rows = (b.iter_mut().zip(theta.windows(3))).zip(w.windows(3));
+        match coupling {
+            None => {
+                for (jt, ((bj, th), w)) in rows.enumerate() {
+                    *bj = row.at(q.get(jt), th, w);
+                }
             }
-            if gamma != 0.0 {
-                r -= c * (0.5 * (w[1] - w[0]) + 0.5 * (w[2] - w[1]));
+            Some(bu) => {
+                let bu = &mut bu[interior.start - m.u_first..interior.end - m.u_first];
+                for (jt, (((bj, th), w), bi)) in rows.zip(bu).enumerate() {
+                    *bj = row.at(q.get(jt), th, w);
+                    *bi += gamma * (0.5 * (th[0] + th[1]) - 0.5 * (th[1] + th[2]));
+                }
             }
-            *bj = sign * r;
         }
     }
+}
+
+/// An interior heat row, `sign (−sκ (K_θ θ)_j + s Q_j − γ/2 (Gᵀ w)_j)`, from the nodes
+/// `j − 1, j, j + 1` (`c = γ/2`).
+struct HeatRow {
+    a: f64,
+    kd: f64,
+    ko: f64,
+    s: f64,
+    c: f64,
+    sign: f64,
+}
+
+impl HeatRow {
+    #[inline(always)]
+    fn at(&self, q: Option<&f64>, th: &[f64], w: &[f64]) -> f64 {
+        let mut r = self.a * (self.kd * th[1] + self.ko * th[0] + self.ko * th[2]);
+        if let Some(q) = q {
+            r += self.s * q;
+        }
+        if self.c != 0.0 {
+            r -= self.c * (0.5 * (w[1] - w[0]) + 0.5 * (w[2] - w[1]));
+        }
+        self.sign * r
+    }
+}
+
+/// `[A_jj, A_j,j+1]` of the interior rows of a P1 matrix on the uniform mesh: every interior
+/// diagonal entry and every off-diagonal one is the same number
+/// ([`crate::bar::matrices::stiffness`]).
+fn interior_coefficients(a: &crate::linalg::tridiag::SymTridiag) -> [f64; 2] {
+    [
+        a.diag[1.min(a.diag.len() - 1)],
+        a.off.first().copied().unwrap_or(0.0),
+    ]
 }
 
 impl Body for ThermalBody {
@@ -392,29 +448,8 @@ impl Body for ThermalBody {
         let (bu, bt) = b.split_at_mut(n_u);
         let force = force.map(|f| &f[..n_u]);
         self.bar.rhs_into(&u[..n_u], &w[..n_u], force, bu);
-        let gamma = self.m.gamma;
-        if gamma != 0.0 {
-            let theta = &u[n_u..];
-            let m = &self.m;
-            let phi = self.nodal(|k| self.phi(u, k), |k| theta[k - m.t_first]);
-            // Rows whose stencil reaches an end node by the general reads; the others below.
-            let interior = 2..m.nodes.saturating_sub(2).max(2);
-            for (i, bi) in bu.iter_mut().enumerate() {
-                let node = m.u_first + i;
-                if !interior.contains(&node) {
-                    *bi += gamma * self.g_row(node, &phi);
-                }
-            }
-            if !interior.is_empty() {
-                // `(G φ)_i` on the nodes `i − 1, i, i + 1` read directly.
-                let b = &mut bu[interior.start - m.u_first..interior.end - m.u_first];
-                let phi = &theta[interior.start - 1 - m.t_first..interior.end + 1 - m.t_first];
-                for (bi, p) in b.iter_mut().zip(phi.windows(3)) {
-                    *bi += gamma * (0.5 * (p[0] + p[1]) - 0.5 * (p[1] + p[2]));
-                }
-            }
-        }
-        self.heat_rhs(u, &w[..n_u], self.dt(), -1.0, bt);
+        let coupling = (self.m.gamma != 0.0).then_some(bu);
+        self.heat_rhs(u, &w[..n_u], (self.dt(), -1.0), bt, coupling);
     }
 
     fn energy_sums(&self, u: &[f64], z: &[f64], w: &[f64], force: Option<&[f64]>) -> EnergySums {
@@ -578,7 +613,7 @@ impl Body for ThermalBody {
                 *z += 0.5 * dt * dt * ai;
             }
         }
-        self.heat_rhs(u0, zu, 0.5 * dt, 1.0, zt);
+        self.heat_rhs(u0, zu, (0.5 * dt, 1.0), zt, None);
         let h = self.m.heat_matrix(0.25 * dt, self.mask);
         if !zt.is_empty() {
             Ldlt::factor(&h)
@@ -597,7 +632,8 @@ impl Body for ThermalBody {
     fn heat_energy(&self, u: &[f64]) -> Option<f64> {
         let theta = &u[self.m.n_u..];
         let t_first = self.m.t_first;
-        Some(0.5 * self.mass_quad(self.nodal(|k| self.theta(u, k), |k| theta[k - t_first])))
+        let x = self.nodal(|k| self.theta(u, k), |k| theta[k - t_first]);
+        Some(0.5 * self.quads(&x, &x)[0])
     }
 
     /// `½|θ^{n+1/2}|²_M`, `Δt κ |θ̄|²_K`, the exchange and the supply (source and the heat let
@@ -615,9 +651,10 @@ impl Body for ThermalBody {
             u[j] - 0.5 * z[j]
         });
         let theta = &u[n_u..];
-        let energy =
-            0.5 * self.mass_quad(self.nodal(|k| self.theta(u, k), |k| theta[k - m.t_first]));
-        let dissipation = dt * m.kappa * self.stiffness_quad(&bar_theta_at);
+        let theta_at = self.nodal(|k| self.theta(u, k), |k| theta[k - m.t_first]);
+        let [mass, stiffness, source] = self.quads(theta_at, &bar_theta_at);
+        let energy = 0.5 * mass;
+        let dissipation = dt * m.kappa * stiffness;
         let mut exchange = 0.0;
         for (e, x) in self.exchange.iter().enumerate() {
             if self.mask & (1 << e) != 0 {
@@ -625,13 +662,7 @@ impl Body for ThermalBody {
                 exchange += dt * x.coefficient * (tb - self.theta_obs[e]) * tb;
             }
         }
-        let mut supply = 0.0;
-        if !self.q.is_empty() {
-            supply += dt
-                * (0..m.nodes)
-                    .map(|k| self.q[k] * bar_theta_at(k))
-                    .sum::<f64>();
-        }
+        let mut supply = dt * source;
         for f in &self.fixed {
             let j = f.node;
             let delta = |k: usize| self.disp(&z[..n_u], k) + self.disp(&w[..n_u], k);

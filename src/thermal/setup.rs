@@ -2,7 +2,7 @@
 //! without a temperature, the initial temperature, and the step solver of the coupled step
 //! (the factorisations of each exchange state, formed once).
 
-use crate::bar::Simulation;
+use crate::bar::{Kernels, Simulation};
 use crate::scene::Expression;
 use crate::scene::{Scene, SceneError, SolverMethod};
 use crate::scheme::{Body, Load, RunError, Scheme, Setup, Unstarted};
@@ -20,8 +20,18 @@ impl Scheme<ThermalBody> {
         Self::prepare(scene)?.start()
     }
 
+    /// [`ThermalSimulation::new`] with the coupled block solve by the twisted twin or by the
+    /// plain sweep as `kernels.twisted_solve` says (the same answers to round-off).
+    pub fn with_kernels(scene: &Scene, kernels: Kernels) -> Result<Self, RunError> {
+        Self::prepare_with(scene, kernels)?.start()
+    }
+
     /// Sets `scene` up short of the start-up step.
     pub fn prepare(scene: &Scene) -> Result<Unstarted<ThermalBody>, RunError> {
+        Self::prepare_with(scene, Kernels::TWINS)
+    }
+
+    fn prepare_with(scene: &Scene, kernels: Kernels) -> Result<Unstarted<ThermalBody>, RunError> {
         let Some(heat) = &scene.heat else {
             return Err(SceneError::Invalid {
                 field: "heat".into(),
@@ -79,14 +89,18 @@ impl Scheme<ThermalBody> {
             let mut variants: Vec<Box<dyn StepSolver>> = Vec::with_capacity(masks);
             let unknowns = disc.constrained_locals();
             for mask in 0..masks {
-                let system =
-                    CoupledEnds::new(&m, &disc.step_matrix, mask, &unknowns).map_err(|e| {
-                        SceneError::Invalid {
-                            field: "heat.coupling".into(),
-                            value: m.gamma.to_string(),
-                            allowed: format!("the coupled step matrix has no block LDLᵀ: {e}"),
-                        }
-                    })?;
+                let system = CoupledEnds::new(
+                    &m,
+                    &disc.step_matrix,
+                    mask,
+                    &unknowns,
+                    kernels.twisted_solve,
+                )
+                .map_err(|e| SceneError::Invalid {
+                    field: "heat.coupling".into(),
+                    value: m.gamma.to_string(),
+                    allowed: format!("the coupled step matrix has no block LDLᵀ: {e}"),
+                })?;
                 variants.push(Box::new(ExactSolver::on(system, &unknowns, true)));
             }
             Box::new(CoupledSolver::new(variants, exchange))

@@ -1,25 +1,43 @@
 //! The thermal bar's coupled step matrix `A_χ = [[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]]` as the exact
 //! end solver sees it ([`EndSystem`]): vectors in the body's block layout `[u | θ]`, the matrix
-//! node by node (blocks `(u_i, θ_i)`, [`ThermalMatrices::coupled`]) with its block `LDLᵀ`, and
+//! node by node (blocks `(u_i, θ_i)`, [`ThermalMatrices::coupled`]) with its block `LDLᵀ`
+//! (by default its twisted twin, [`crate::linalg::block_tridiag_fast`]), and
 //! one more factor per non-empty set of active ends (their displacement rows and columns
 //! replaced by identity ones), all formed once per exchange state. `A_χ` is quasi-definite,
 //! not positive definite; what the enumeration needs holds all the same: `E A_χ⁻¹ Eᵀ` on
 //! displacement unknowns is the inverse's block `(C + γ²/4 G H_χ⁻¹ Gᵀ)⁻¹`, positive definite,
 //! so the contact step stays an exact convex LCP (`docs/thermal.md`).
 
-use crate::linalg::block_tridiag::{BlockLdlt, SingularBlock};
+use crate::linalg::block_tridiag::{BlockLdlt, BlockTridiag, SingularBlock};
+use crate::linalg::block_tridiag_fast::TwistedBlockLdlt;
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::exact::EndSystem;
 use crate::step::schur::{constraint_rows, row_product};
 use crate::thermal::matrices::{ThermalMatrices, coupling_entry};
+
+/// A block factor: the plain sweep, or its twisted twin.
+#[derive(Clone, Debug)]
+enum Factor {
+    Plain(BlockLdlt),
+    Twisted(Box<TwistedBlockLdlt>),
+}
+
+impl Factor {
+    fn new(a: &BlockTridiag, twisted: bool) -> Result<Self, SingularBlock> {
+        Ok(match twisted {
+            true => Self::Twisted(Box::new(TwistedBlockLdlt::factor(a)?)),
+            false => Self::Plain(BlockLdlt::factor(a)?),
+        })
+    }
+}
 
 /// The coupled step matrix of one exchange state with its factors, for the end enumeration.
 #[derive(Clone, Debug)]
 pub struct CoupledEnds {
     /// The block `LDLᵀ` of `A_χ`, and at index `mask − 1` that of `A_χ` with the displacement
     /// rows and columns of the active ends in `mask` replaced by identity ones.
-    factor: BlockLdlt,
-    reduced: Vec<BlockLdlt>,
+    factor: Factor,
+    reduced: Vec<Factor>,
     /// The first nodes of the displacement and the temperature unknowns.
     firsts: [usize; 2],
     /// The constrained displacement unknowns (at most two), the rows of `C` there
@@ -36,22 +54,24 @@ pub struct CoupledEnds {
 
 impl CoupledEnds {
     /// `A_χ` of exchange state `mask` (`c`: the bar's `C`), constrained at the displacement
-    /// unknowns `unknowns` (at most two).
+    /// unknowns `unknowns` (at most two); solved by the twisted twin of the block factor
+    /// when `twisted` ([`crate::linalg::block_tridiag_fast`]).
     pub fn new(
         m: &ThermalMatrices,
         c: &SymTridiag,
         mask: usize,
         unknowns: &[usize],
+        twisted: bool,
     ) -> Result<Self, SingularBlock> {
         let nodes: Vec<usize> = unknowns.iter().map(|&i| i + m.u_first).collect();
-        let factor = BlockLdlt::factor(&m.coupled(c, mask, &[]))?;
+        let factor = Factor::new(&m.coupled(c, mask, &[]), twisted)?;
         let reduced = (1u8..(1 << nodes.len()))
             .map(|active| {
                 let subset: Vec<usize> = (nodes.iter().enumerate())
                     .filter(|&(j, _)| active & (1 << j) != 0)
                     .map(|(_, &node)| node)
                     .collect();
-                BlockLdlt::factor(&m.coupled(c, mask, &subset))
+                Factor::new(&m.coupled(c, mask, &subset), twisted)
             })
             .collect::<Result<Vec<_>, _>>()?;
         let theta = [0, 1].map(|j| {
@@ -87,7 +107,10 @@ impl CoupledEnds {
         };
         let (u, t) = x.split_at_mut(self.n_u);
         let [fu, ft] = self.firsts;
-        factor.solve_fields([(u, fu), (t, ft)], &mut self.scratch);
+        match factor {
+            Factor::Plain(f) => f.solve_fields([(u, fu), (t, ft)], &mut self.scratch),
+            Factor::Twisted(f) => f.solve_fields([(u, fu), (t, ft)]),
+        }
     }
 }
 

@@ -1,0 +1,322 @@
+//! The optimised twin of [`BlockLdlt`]'s solve for the thermal step: a twisted block
+//! factorisation, `L D Lᵀ` from the first block and from the last, joined at a middle twist
+//! block, so that a solve runs two independent chains at once (the plain sweep is one chain,
+//! bound by the latency of its 2 × 2 products); on a uniform interior each half's factor rows
+//! settle bitwise on a fixed point and are read once. Solutions agree with the plain
+//! [`BlockLdlt`] to round-off, not bit for bit; what it buys on a thermal step is measured in
+//! benches/README.md, "Plain kernels and their twins".
+
+use crate::linalg::block_tridiag::{
+    Block, BlockLdlt, BlockTridiag, SingularBlock, d_inv_mul, mul, mul_transposed,
+};
+use std::ops::Range;
+
+/// `A` factorised from both ends: `top` the block `LDLᵀ` of `A` (rows `0..m` used), `bottom`
+/// that of `A` with its blocks in reverse order (rows `0..n − 1 − m` used, row `k` for block
+/// `n − 1 − k`), and the twist pivot `T_m = A_mm − L_m A_{m,m−1}ᵀ − L'_{n−1−m} A_{m+1,m}`, the
+/// Schur complement of `A` on block `m` (quasi-definite when `A` is).
+#[derive(Clone, Debug)]
+pub struct TwistedBlockLdlt {
+    top: Half,
+    bottom: Half,
+    twist: usize,
+    /// `T_m⁻¹ = [[a, b], [b, c]]` as `[a, b, c]`.
+    inv_twist: [f64; 3],
+    n: usize,
+}
+
+/// One direction's factor rows `(L_i, D_i⁻¹)`, with the longest stretch of bitwise-equal rows
+/// (`still`, within `1..n − 1`) and that row kept apart.
+#[derive(Clone, Debug)]
+struct Half {
+    factor: BlockLdlt,
+    still: Range<usize>,
+    row: (Block, [f64; 3]),
+}
+
+impl Half {
+    fn new(factor: BlockLdlt) -> Self {
+        let (l, inv_d) = (factor.l(), factor.inv_d());
+        let n = inv_d.len();
+        let bits = |i: usize| {
+            (
+                l[i].map(|r| r.map(f64::to_bits)),
+                inv_d[i].map(f64::to_bits),
+            )
+        };
+        let (mut still, mut start) = (1..1, 1);
+        for i in 1..n.saturating_sub(1) {
+            if bits(i) != bits(start) {
+                start = i;
+            }
+            if i + 1 - start > still.len() {
+                still = start..i + 1;
+            }
+        }
+        let row = (l.get(still.start), inv_d.get(still.start));
+        let row = (
+            row.0.copied().unwrap_or_default(),
+            row.1.copied().unwrap_or_default(),
+        );
+        Self { factor, still, row }
+    }
+
+    /// `L_i`.
+    #[inline(always)]
+    fn l(&self, i: usize) -> &Block {
+        if self.still.contains(&i) {
+            &self.row.0
+        } else {
+            &self.factor.l()[i]
+        }
+    }
+
+    /// `D_i⁻¹`.
+    #[inline(always)]
+    fn inv_d(&self, i: usize) -> &[f64; 3] {
+        if self.still.contains(&i) {
+            &self.row.1
+        } else {
+            &self.factor.inv_d()[i]
+        }
+    }
+}
+
+fn transpose(b: &Block) -> Block {
+    [[b[0][0], b[1][0]], [b[0][1], b[1][1]]]
+}
+
+impl TwistedBlockLdlt {
+    pub fn factor(a: &BlockTridiag) -> Result<Self, SingularBlock> {
+        let n = a.blocks();
+        let reversed = BlockTridiag {
+            diag: a.diag.iter().rev().copied().collect(),
+            lower: (0..n)
+                .map(|k| match k {
+                    0 => [[0.0; 2]; 2],
+                    _ => transpose(&a.lower[n - k]),
+                })
+                .collect(),
+        };
+        let (top, bottom) = (BlockLdlt::factor(a)?, BlockLdlt::factor(&reversed)?);
+        let twist = n.saturating_sub(1) / 2;
+        let mut inv_twist = [0.0; 3];
+        if n >= 3 {
+            let [[mut p, mut q], [_, mut s]] = a.diag[twist];
+            let k = n - 1 - twist;
+            for (l, e) in [
+                (&top.l()[twist], &a.lower[twist]),
+                (&bottom.l()[k], &reversed.lower[k]),
+            ] {
+                p -= l[0][0] * e[0][0] + l[0][1] * e[0][1];
+                q -= l[0][0] * e[1][0] + l[0][1] * e[1][1];
+                s -= l[1][0] * e[1][0] + l[1][1] * e[1][1];
+            }
+            let d = p * s - q * q;
+            if !(d.is_finite() && d != 0.0) {
+                return Err(SingularBlock {
+                    block: twist,
+                    determinant: d,
+                });
+            }
+            inv_twist = [s / d, -q / d, p / d];
+        }
+        Ok(Self {
+            top: Half::new(top),
+            bottom: Half::new(bottom),
+            twist,
+            inv_twist,
+            n,
+        })
+    }
+
+    /// [`BlockLdlt::solve_fields`] by the twisted factorisation, in place (the same layout:
+    /// every block but possibly the first and the last has its entries in both fields). The
+    /// two chains run inward (`y_i = b_i − L_i y_{i−1}`, kept in the fields), meet at the twist
+    /// (`x_m = T_m⁻¹ (b_m − L_m y_{m−1} − L'_k y'_{k−1})`) and run outward
+    /// (`x_i = D_i⁻¹ y_i − L_{i+1}ᵀ x_{i+1}`). Allocates nothing.
+    pub fn solve_fields(&self, [(u, fu), (t, ft)]: [(&mut [f64], usize); 2]) {
+        let n = self.n;
+        if n < 3 {
+            let mut y = [[0.0; 2]; 2];
+            return self
+                .top
+                .factor
+                .solve_fields([(u, fu), (t, ft)], &mut y[..n]);
+        }
+        let (m, last) = (self.twist, n - 1);
+        let entry = |v: &[f64], f: usize, i: usize| v.get(i.wrapping_sub(f)).copied();
+        let b = |u: &[f64], t: &[f64], i: usize| {
+            [
+                entry(u, fu, i).unwrap_or(0.0),
+                entry(t, ft, i).unwrap_or(0.0),
+            ]
+        };
+        let (b_first, b_last) = (b(u, t, 0), b(u, t, last));
+        // The interior blocks 1..n − 1: the top half's (1..m), the twist, the bottom half's.
+        let (ui, ti) = (&mut u[1 - fu..last - fu], &mut t[1 - ft..last - ft]);
+        let (u_top, u_rest) = ui.split_at_mut(m - 1);
+        let (t_top, t_rest) = ti.split_at_mut(m - 1);
+        let (u_mid, u_bottom) = u_rest.split_at_mut(1);
+        let (t_mid, t_bottom) = t_rest.split_at_mut(1);
+        let (top, bottom) = (&self.top, &self.bottom);
+        let (nt, nb) = (u_top.len(), u_bottom.len());
+        let common = nt.min(nb);
+
+        // Inward: top block 1 + j, bottom block n − 2 − j (its row 1 + j).
+        let y_first = sub(b_first, mul(top.l(0), [0.0; 2]));
+        let y_last = sub(b_last, mul(bottom.l(0), [0.0; 2]));
+        let (mut yt, mut yb) = (y_first, y_last);
+        let step_in = |u: &mut f64, t: &mut f64, l: &Block, y: [f64; 2]| {
+            let y = sub([*u, *t], mul(l, y));
+            (*u, *t) = (y[0], y[1]);
+            y
+        };
+        // The two chains interleaved over their common length, then the longer one's rest.
+        let mut top_in = |j: usize| yt = step_in(&mut u_top[j], &mut t_top[j], top.l(1 + j), yt);
+        let mut bottom_in = |j: usize| {
+            let jb = nb - 1 - j;
+            yb = step_in(&mut u_bottom[jb], &mut t_bottom[jb], bottom.l(1 + j), yb);
+        };
+        for j in 0..common {
+            top_in(j);
+            bottom_in(j);
+        }
+        (common..nt).for_each(top_in);
+        (common..nb).for_each(bottom_in);
+        // The twist.
+        let r = sub(
+            sub([u_mid[0], t_mid[0]], mul(top.l(m), yt)),
+            mul(bottom.l(last - m), yb),
+        );
+        let x_mid = d_inv_mul(&self.inv_twist, r);
+        (u_mid[0], t_mid[0]) = (x_mid[0], x_mid[1]);
+
+        // Outward: top block m − 1 − j, bottom block m + 1 + j (its row last − m − 1 − j).
+        let (mut xt, mut xb) = (x_mid, x_mid);
+        let step_out = |u: &mut f64, t: &mut f64, (inv_d, l): (&[f64; 3], &Block), x: [f64; 2]| {
+            let x = sub(d_inv_mul(inv_d, [*u, *t]), mul_transposed(l, x));
+            (*u, *t) = (x[0], x[1]);
+            x
+        };
+        let mut top_out = |j: usize| {
+            let (jt, i) = (nt - 1 - j, m - 1 - j);
+            let row = (top.inv_d(i), top.l(i + 1));
+            xt = step_out(&mut u_top[jt], &mut t_top[jt], row, xt);
+        };
+        let mut bottom_out = |j: usize| {
+            let k = last - m - 1 - j;
+            let row = (bottom.inv_d(k), bottom.l(k + 1));
+            xb = step_out(&mut u_bottom[j], &mut t_bottom[j], row, xb);
+        };
+        for j in 0..common {
+            top_out(j);
+            bottom_out(j);
+        }
+        (common..nt).for_each(top_out);
+        (common..nb).for_each(bottom_out);
+        let x_first = sub(
+            d_inv_mul(top.inv_d(0), y_first),
+            mul_transposed(top.l(1), xt),
+        );
+        let x_last = sub(
+            d_inv_mul(bottom.inv_d(0), y_last),
+            mul_transposed(bottom.l(1), xb),
+        );
+        for (i, x) in [(0, x_first), (last, x_last)] {
+            if let Some(v) = u.get_mut(i.wrapping_sub(fu)) {
+                *v = x[0];
+            }
+            if let Some(v) = t.get_mut(i.wrapping_sub(ft)) {
+                *v = x[1];
+            }
+        }
+    }
+}
+
+#[inline(always)]
+fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    [a[0] - b[0], a[1] - b[1]]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Agreement of two backward-stable solves of the same well-conditioned system (blocks of
+    /// condition below 100): a few hundred ε per block row of the solution's size.
+    const AGREEMENT_TOL: f64 = 100.0 * f64::EPSILON;
+
+    /// A quasi-definite block-tridiagonal matrix of `n` blocks (an SPD field, a negative
+    /// definite one, full couplings), its diagonal varying node by node unless `uniform`.
+    fn matrix(n: usize, uniform: bool) -> BlockTridiag {
+        let mut a = BlockTridiag::zeros(n);
+        for i in 0..n {
+            let t = if uniform { 0.0 } else { i as f64 };
+            a.diag[i] = [[4.0 + t.sin(), 0.7], [0.7, -(3.0 + t.cos())]];
+            if i > 0 {
+                a.lower[i] = [[-1.0, -0.5], [0.4, 0.9]];
+            }
+        }
+        // Ends unlike the interior, as a bar's end rows are.
+        a.diag[0][0][0] = 2.5;
+        a.diag[n - 1][1][1] = -1.5;
+        a
+    }
+
+    /// Both fields complete, the first missing in block 0, the second in the last block (a
+    /// clamped end and a fixed temperature): the twisted solve agrees with the plain sweep.
+    #[test]
+    fn the_twisted_solve_agrees_with_the_plain_one_to_round_off() {
+        for n in [1usize, 2, 3, 4, 5, 6, 7, 40, 41, 2000] {
+            for uniform in [false, true] {
+                let a = matrix(n, uniform);
+                let plain = BlockLdlt::factor(&a).unwrap();
+                let twisted = TwistedBlockLdlt::factor(&a).unwrap();
+                let layouts = if n > 1 {
+                    vec![(0, n, 0, n), (1, n - 1, 0, n - 1)]
+                } else {
+                    vec![(0, n, 0, n)]
+                };
+                for (fu, nu, ft, nt) in layouts {
+                    let b = |k: usize, f: f64| (0.37 * k as f64 + f).cos();
+                    let mut up: Vec<f64> = (0..nu).map(|k| b(k, 0.0)).collect();
+                    let mut tp: Vec<f64> = (0..nt).map(|k| b(k, 1.0)).collect();
+                    let (mut ut, mut tt) = (up.clone(), tp.clone());
+                    let mut y = vec![[0.0; 2]; n];
+                    plain.solve_fields([(&mut up, fu), (&mut tp, ft)], &mut y);
+                    twisted.solve_fields([(&mut ut, fu), (&mut tt, ft)]);
+                    let scale = up.iter().chain(&tp).fold(1.0f64, |m, v| m.max(v.abs()));
+                    for (p, q) in up.iter().chain(&tp).zip(ut.iter().chain(&tt)) {
+                        assert!(
+                            (p - q).abs() <= AGREEMENT_TOL * n as f64 * scale,
+                            "n {n}, uniform {uniform}, first {fu}: {p} vs {q}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// On a uniform interior both halves settle on one row, read once; a varying diagonal
+    /// leaves no stretch to speak of.
+    #[test]
+    fn a_uniform_interior_is_read_as_one_row() {
+        let n = 2000;
+        let uniform = TwistedBlockLdlt::factor(&matrix(n, true)).unwrap();
+        for half in [&uniform.top, &uniform.bottom] {
+            assert!(half.still.len() > n - 200, "{:?}", half.still);
+        }
+        let varying = TwistedBlockLdlt::factor(&matrix(n, false)).unwrap();
+        assert!(varying.top.still.len() <= 2, "{:?}", varying.top.still);
+    }
+
+    #[test]
+    fn a_singular_block_is_refused() {
+        let mut a = matrix(5, true);
+        a.diag[2] = [[0.0; 2]; 2];
+        a.lower[2] = [[0.0; 2]; 2];
+        a.lower[3] = [[0.0; 2]; 2];
+        assert_eq!(TwistedBlockLdlt::factor(&a).unwrap_err().block, 2);
+    }
+}
