@@ -2,11 +2,12 @@
 //!
 //! The build targets baseline x86-64 (SSE2, two doubles per vector) and uses no target-cpu
 //! flags. On a CPU with AVX (four doubles per vector) the uniform right-hand side
-//! (`bar::rhs_fast`) runs through `run` (the compiler vectorises it) and the uniform energy
-//! sums (`bar::energy_fast`) as AVX intrinsics behind [`has_avx`]. The bits do not change: AVX
-//! without FMA performs the same IEEE operations in the same order (Rust never contracts
-//! `a * b + c` into a fused multiply-add), and every sum has its lane order fixed in the
-//! source. The twins' tests compare the AVX and the portable paths bit for bit.
+//! (`bar::rhs_fast`) and the step's update `u += z` (`step::solver`) run through `run` (the
+//! compiler vectorises them) and the uniform energy sums (`bar::energy_fast`) as AVX
+//! intrinsics behind [`has_avx`]. The bits do not change: AVX without FMA performs the same
+//! IEEE operations in the same order (Rust never contracts `a * b + c` into a fused
+//! multiply-add), and every sum has its lane order fixed in the source. The twins' tests
+//! compare the AVX and the portable paths bit for bit.
 
 /// A streaming kernel with its arguments. `call` must be `#[inline(always)]`: it is then
 /// compiled into each caller, including the AVX one (a closure would be compiled once, for

@@ -137,6 +137,37 @@ struct Pass {
     last: usize,
 }
 
+impl Pass {
+    fn new() -> Self {
+        Self {
+            min_gap: f64::INFINITY,
+            min_reaction: f64::INFINITY,
+            max_comp: 0.0,
+            total: 0.0,
+            dissipation: 0.0,
+            count: 0,
+            first: 0,
+            last: 0,
+        }
+    }
+
+    /// Adds constraint `k` with its gap and reaction (the sums but the dissipation).
+    #[inline(always)]
+    fn add(&mut self, k: usize, gap: f64, reaction: f64) {
+        self.total += reaction;
+        self.min_gap = min_of(self.min_gap, gap);
+        self.min_reaction = min_of(self.min_reaction, reaction);
+        self.max_comp = max_of(self.max_comp, (gap * reaction).abs());
+        if in_contact(gap) {
+            if self.count == 0 {
+                self.first = k;
+            }
+            self.last = k;
+            self.count += 1;
+        }
+    }
+}
+
 /// `m.min(x)` for a running minimum `m` that is never NaN: a NaN `x` is ignored and a tie
 /// keeps `m`, as `f64::min` does here.
 #[inline(always)]
@@ -335,12 +366,13 @@ impl ContactSet {
     /// One pass over constraints `range` of `u = u^{n+1}` with reactions `r`; with
     /// `dissipation`, also `−½ Σ r_k (s_k (z + w)_{i_k} + g_k^{n+1} − g_k^{n−1})`,
     /// `z + w = u^{n+1} − u^{n−1}`. Fixed lower bounds at `i_k = k` (an obstacle under every
-    /// node) take the same loop compiled without the lookups of `i_k`, `s_k` and the motion.
+    /// node) take [`ContactSet::pass_plain`], the same sums without the lookups of `i_k`, `s_k`
+    /// and the motion.
     fn pass(&self, range: Range<usize>, state: State<'_>, dissipation: bool) -> Pass {
         let plain = self.unknowns.is_empty() && self.directions.is_empty() && !self.is_moving();
         match (plain, dissipation) {
-            (true, true) => self.pass_with::<true>(range, state, |k| k, |_| 1.0, |_| 0.0),
-            (true, false) => self.pass_with::<false>(range, state, |k| k, |_| 1.0, |_| 0.0),
+            (true, true) => self.pass_plain::<true>(range, state),
+            (true, false) => self.pass_plain::<false>(range, state),
             (false, true) => self.pass_with::<true>(
                 range,
                 state,
@@ -368,31 +400,12 @@ impl ContactSet {
         direction: impl Fn(usize) -> f64,
         gap_change: impl Fn(usize) -> f64,
     ) -> Pass {
-        let mut p = Pass {
-            min_gap: f64::INFINITY,
-            min_reaction: f64::INFINITY,
-            max_comp: 0.0,
-            total: 0.0,
-            dissipation: 0.0,
-            count: 0,
-            first: 0,
-            last: 0,
-        };
+        let mut p = Pass::new();
         for k in range {
             let (l, s) = (unknown(k), direction(k));
             let gap = s * u[l] + self.gaps[k];
             let reaction = r[k];
-            p.total += reaction;
-            p.min_gap = min_of(p.min_gap, gap);
-            p.min_reaction = min_of(p.min_reaction, reaction);
-            p.max_comp = max_of(p.max_comp, (gap * reaction).abs());
-            if in_contact(gap) {
-                if p.count == 0 {
-                    p.first = k;
-                }
-                p.last = k;
-                p.count += 1;
-            }
+            p.add(k, gap, reaction);
             if DISSIPATION {
                 let change = gap_change(k);
                 p.dissipation += if change == 0.0 {
@@ -400,6 +413,32 @@ impl ContactSet {
                 } else {
                     -0.5 * reaction * (s * (z[l] + w[l]) + change)
                 };
+            }
+        }
+        p
+    }
+
+    /// [`ContactSet::pass_with`] for `i_k = k`, `s_k = 1` and fixed gaps: the same operations
+    /// (`1 · x` is `x`), over slices zipped in one loop without index checks.
+    #[inline(always)]
+    fn pass_plain<const DISSIPATION: bool>(
+        &self,
+        range: Range<usize>,
+        (u, z, w, r): State<'_>,
+    ) -> Pass {
+        let mut p = Pass::new();
+        let (u, g, r) = (
+            &u[range.clone()],
+            &self.gaps[range.clone()],
+            &r[range.clone()],
+        );
+        let (z, w) = (&z[range.clone()], &w[range.clone()]);
+        let rows = u.iter().zip(g).zip(r).zip(z.iter().zip(w));
+        for (k, (((&u, &g), &reaction), (&z, &w))) in range.zip(rows) {
+            let gap = u + g;
+            p.add(k, gap, reaction);
+            if DISSIPATION {
+                p.dissipation += -0.5 * reaction * (z + w);
             }
         }
         p
@@ -483,4 +522,68 @@ pub struct ContactState {
     pub contact_nodes: usize,
     /// Per group of [`ContactSet::groups`], in its order.
     pub groups: [GroupState; MAX_GROUPS],
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The plain pass against the general one with `i_k = k`, `s_k = 1` and no motion, bit for
+    /// bit: gaps and reactions of both signs, zeros, gaps within the contact tolerance, NaN.
+    #[test]
+    fn plain_pass_has_the_bits_of_the_general_pass() {
+        let m = 50;
+        let value = |i: usize, a: f64| (a * i as f64).sin();
+        let gaps: Vec<f64> = (0..m)
+            .map(|k| if k % 5 == 0 { 0.0 } else { value(k, 0.3) })
+            .collect();
+        let set = ContactSet::new(
+            gaps,
+            Vec::new(),
+            Vec::new(),
+            Positions::Grid {
+                first: 0,
+                spacing: 0.1,
+            },
+            Vec::new(),
+        );
+        let u: Vec<f64> = (0..m)
+            .map(|k| {
+                if k % 3 == 0 {
+                    -set.gaps[k]
+                } else {
+                    value(k, 0.7)
+                }
+            })
+            .collect();
+        let (z, w): (Vec<f64>, Vec<f64>) = (0..m).map(|k| (value(k, 1.1), value(k, 1.9))).unzip();
+        let mut r: Vec<f64> = (0..m).map(|k| value(k, 2.3).max(0.0)).collect();
+        r[7] = -0.0;
+        r[11] = f64::NAN;
+        let state = (&u[..], &z[..], &w[..], &r[..]);
+        let fields = |p: Pass| {
+            let sums = [
+                p.min_gap,
+                p.min_reaction,
+                p.max_comp,
+                p.total,
+                p.dissipation,
+            ];
+            (sums.map(f64::to_bits), [p.count, p.first, p.last])
+        };
+        for range in [0..m, 3..17, 9..10, 20..20] {
+            let general = |d: bool| {
+                let (i, s, c) = (|k| k, |_| 1.0, |_| 0.0);
+                if d {
+                    set.pass_with::<true>(range.clone(), state, i, s, c)
+                } else {
+                    set.pass_with::<false>(range.clone(), state, i, s, c)
+                }
+            };
+            let plain = set.pass_plain::<true>(range.clone(), state);
+            assert_eq!(fields(plain), fields(general(true)), "{range:?}");
+            let plain = set.pass_plain::<false>(range.clone(), state);
+            assert_eq!(fields(plain), fields(general(false)), "{range:?}");
+        }
+    }
 }

@@ -53,16 +53,29 @@ pub(crate) fn margins_interior(
     negative: &mut Vec<usize>,
 ) {
     let n = z.len();
-    let (s, e) = (&c.row_sums()[..n], &c.off[..n - 1]);
-    let (active, lo, rhs, margin) = (&active[..n], &lo[..n], &rhs[..n], &mut margin[..n]);
-    for i in 1..n - 1 {
-        let zi = z[i];
-        let m = if active[i] {
-            s[i] * zi + e[i - 1] * (z[i - 1] - zi) + e[i] * (z[i + 1] - zi) - rhs[i]
+    // Node i's neighbourhood: `z` and `e` around it, its other inputs and its margin.
+    let inner = 1..n - 1;
+    let (s, e) = (&c.row_sums()[inner.clone()], c.off[..n - 1].windows(2));
+    let (active, lo, rhs) = (
+        &active[inner.clone()],
+        &lo[inner.clone()],
+        &rhs[inner.clone()],
+    );
+    let rows = z
+        .windows(3)
+        .zip(e)
+        .zip(s)
+        .zip(active.iter().zip(lo).zip(rhs));
+    for ((i, margin), (((z, e), &s), ((&active, &lo), &rhs))) in
+        inner.clone().zip(&mut margin[inner]).zip(rows)
+    {
+        let zi = z[1];
+        let m = if active {
+            s * zi + e[0] * (z[0] - zi) + e[1] * (z[2] - zi) - rhs
         } else {
-            zi - lo[i]
+            zi - lo
         };
-        margin[i] = m;
+        *margin = m;
         if m < 0.0 {
             negative.push(i);
         }
@@ -88,6 +101,7 @@ pub(crate) fn row_product(c: &SymTridiag, i: usize, z: &[f64]) -> f64 {
 /// Runs the recurrence `step` upwards over the rows of the sorted, disjoint ranges `dirty`
 /// (rows whose inputs changed), continuing past a range until `step` reports the carried value
 /// unchanged; the recomputed rows go to `out` (sorted, disjoint), their count to `rows`.
+#[inline]
 pub(crate) fn sweep_up(
     n: usize,
     dirty: &[(usize, usize)],
@@ -117,6 +131,7 @@ pub(crate) fn sweep_up(
 }
 
 /// [`sweep_up`] downwards: the recurrence carries from row `j + 1` to row `j`.
+#[inline]
 pub(crate) fn sweep_down(
     n: usize,
     dirty: &[(usize, usize)],
