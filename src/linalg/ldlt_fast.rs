@@ -3,6 +3,7 @@
 //! chains at once, each link covering two nodes of the bar. Solutions agree with the plain
 //! [`Ldlt`](super::ldlt::Ldlt) to round-off (both backward stable), not bit for bit.
 
+use crate::linalg::dispatch;
 use crate::linalg::ldlt::{NotPositiveDefinite, RowChange, changed_entries, checked_pivot};
 use crate::linalg::tridiag::SymTridiag;
 use std::cell::Cell;
@@ -139,8 +140,13 @@ impl TwistedLdlt {
 
     /// `x = A⁻¹ b`.
     pub fn solve_into(&self, b: &[f64], x: &mut [f64]) {
-        let x = Cell::from_mut(x).as_slice_of_cells();
-        self.sweep::<_, false>(b, x, x);
+        let (b, u) = (Some(b), None);
+        dispatch::run(Sweep {
+            factor: self,
+            b,
+            x,
+            u,
+        })
     }
 
     /// `A⁻¹ e_j` as a new vector (set-up only).
@@ -153,16 +159,26 @@ impl TwistedLdlt {
 
     /// Overwrites `x` (holding `b`) with `A⁻¹ b`.
     pub fn solve_in_place(&self, x: &mut [f64]) {
-        let x = Cell::from_mut(x).as_slice_of_cells();
-        self.sweep::<_, false>(x, x, x);
+        let (b, u) = (None, None);
+        dispatch::run(Sweep {
+            factor: self,
+            b,
+            x,
+            u,
+        })
     }
 
     /// `x = A⁻¹ b`, and `u += x` as each `x_i` is found: the time step's solve and update in
     /// one pass over the bar, with the bits of [`TwistedLdlt::solve_into`] and `u += x`.
     pub fn solve_into_and_add(&self, b: &[f64], x: &mut [f64], u: &mut [f64]) {
         assert_eq!(u.len(), self.n, "state length");
-        let x = Cell::from_mut(x).as_slice_of_cells();
-        self.sweep::<_, true>(b, x, Cell::from_mut(u).as_slice_of_cells());
+        let (b, u) = (Some(b), Some(u));
+        dispatch::run(Sweep {
+            factor: self,
+            b,
+            x,
+            u,
+        })
     }
 
     /// `x = A⁻¹ b`, reading `b` from `b` (which may be `x` itself: each entry of `b` is read
@@ -300,6 +316,30 @@ impl TwistedLdlt {
 }
 
 /// An entry of the right-hand side: a number, or a cell of `x` itself (a solve in place).
+/// A solve's sweep (`b` apart or in `x`, `u += x` or not), for [`dispatch::run`]: compiled for
+/// AVX where the CPU has it, the same operations in the same order (the same bits).
+struct Sweep<'a> {
+    factor: &'a TwistedLdlt,
+    b: Option<&'a [f64]>,
+    x: &'a mut [f64],
+    u: Option<&'a mut [f64]>,
+}
+
+impl dispatch::Kernel for Sweep<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn call(self) {
+        let x = Cell::from_mut(self.x).as_slice_of_cells();
+        match (self.b, self.u) {
+            (Some(b), Some(u)) => {
+                (self.factor).sweep::<_, true>(b, x, Cell::from_mut(u).as_slice_of_cells())
+            }
+            (Some(b), None) => self.factor.sweep::<_, false>(b, x, x),
+            (None, _) => self.factor.sweep::<_, false>(x, x, x),
+        }
+    }
+}
+
 trait Value {
     fn value(&self) -> f64;
 }
