@@ -405,6 +405,7 @@ impl Half {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::linalg::dispatch::Kernel;
     use crate::linalg::ldlt::Ldlt;
     use crate::linalg::tridiag::backward_error;
 
@@ -466,6 +467,18 @@ mod tests {
                     assert_eq!(bits(&w), bits(&x), "n {n}");
                     let added: Vec<f64> = u0.iter().zip(&x).map(|(a, b)| a + b).collect();
                     assert_eq!(bits(&u), bits(&added), "n {n}");
+                    // The solves run the sweep compiled for AVX where the CPU has it; called
+                    // directly, it is compiled for the baseline: the same bits.
+                    let (mut ub, mut wb) = (u0.clone(), vec![0.0; n]);
+                    let (x_b, u_b) = (&mut wb, Some(&mut ub[..]));
+                    Sweep {
+                        factor: &fast,
+                        b: Some(&b),
+                        x: x_b,
+                        u: u_b,
+                    }
+                    .call();
+                    assert_eq!((bits(&wb), bits(&ub)), (bits(&w), bits(&u)), "n {n}");
                     let what = format!("n {n}, d {d}, {nodes:?}");
                     assert!(backward_error(&written, &x, &b) <= BACKWARD_ULPS, "{what}");
                     assert!(backward_error(&written, &p, &b) <= BACKWARD_ULPS, "{what}");
