@@ -72,7 +72,7 @@ pub(super) fn d_inv_mul(&[a, b, c]: &[f64; 3], y: [f64; 2]) -> [f64; 2] {
 }
 
 #[inline(always)]
-pub(super) fn add(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+fn add(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     [a[0] + b[0], a[1] + b[1]]
 }
 

@@ -373,41 +373,26 @@ impl ContactSet {
         match (plain, dissipation) {
             (true, true) => self.pass_plain::<true>(range, state),
             (true, false) => self.pass_plain::<false>(range, state),
-            (false, true) => self.pass_with::<true>(
-                range,
-                state,
-                |k| self.unknown(k),
-                |k| self.direction(k),
-                |k| self.gap_change(k),
-            ),
-            (false, false) => self.pass_with::<false>(
-                range,
-                state,
-                |k| self.unknown(k),
-                |k| self.direction(k),
-                |k| self.gap_change(k),
-            ),
+            (false, true) => self.pass_general::<true>(range, state),
+            (false, false) => self.pass_general::<false>(range, state),
         }
     }
 
-    /// [`ContactSet::pass`] with `i_k`, `s_k` and `g_k^{n+1} − g_k^{n−1}` given.
+    /// [`ContactSet::pass`] reading `i_k`, `s_k` and `g_k^{n+1} − g_k^{n−1}` per constraint.
     #[inline(always)]
-    fn pass_with<const DISSIPATION: bool>(
+    fn pass_general<const DISSIPATION: bool>(
         &self,
         range: Range<usize>,
         (u, z, w, r): State<'_>,
-        unknown: impl Fn(usize) -> usize,
-        direction: impl Fn(usize) -> f64,
-        gap_change: impl Fn(usize) -> f64,
     ) -> Pass {
         let mut p = Pass::new();
         for k in range {
-            let (l, s) = (unknown(k), direction(k));
+            let (l, s) = (self.unknown(k), self.direction(k));
             let gap = s * u[l] + self.gaps[k];
             let reaction = r[k];
             p.add(k, gap, reaction);
             if DISSIPATION {
-                let change = gap_change(k);
+                let change = self.gap_change(k);
                 p.dissipation += if change == 0.0 {
                     -0.5 * reaction * s * (z[l] + w[l])
                 } else {
@@ -418,7 +403,7 @@ impl ContactSet {
         p
     }
 
-    /// [`ContactSet::pass_with`] for `i_k = k`, `s_k = 1` and fixed gaps: the same operations
+    /// [`ContactSet::pass_general`] for `i_k = k`, `s_k = 1` and fixed gaps: the same operations
     /// (`1 · x` is `x`), over slices zipped in one loop without index checks.
     #[inline(always)]
     fn pass_plain<const DISSIPATION: bool>(
@@ -528,8 +513,9 @@ pub struct ContactState {
 mod tests {
     use super::*;
 
-    /// The plain pass against the general one with `i_k = k`, `s_k = 1` and no motion, bit for
-    /// bit: gaps and reactions of both signs, zeros, gaps within the contact tolerance, NaN.
+    /// The plain pass against the general one on the same constraints with `i_k = k` and
+    /// `s_k = 1` spelled out, bit for bit: gaps and reactions of both signs, zeros, gaps within
+    /// the contact tolerance, NaN.
     #[test]
     fn plain_pass_has_the_bits_of_the_general_pass() {
         let m = 50;
@@ -537,16 +523,12 @@ mod tests {
         let gaps: Vec<f64> = (0..m)
             .map(|k| if k % 5 == 0 { 0.0 } else { value(k, 0.3) })
             .collect();
-        let set = ContactSet::new(
-            gaps,
-            Vec::new(),
-            Vec::new(),
-            Positions::Grid {
-                first: 0,
-                spacing: 0.1,
-            },
-            Vec::new(),
-        );
+        let grid = || Positions::Grid {
+            first: 0,
+            spacing: 0.1,
+        };
+        let set = ContactSet::new(gaps.clone(), Vec::new(), Vec::new(), grid(), Vec::new());
+        let spelled = ContactSet::new(gaps, (0..m).collect(), vec![1.0; m], grid(), Vec::new());
         let u: Vec<f64> = (0..m)
             .map(|k| {
                 if k % 3 == 0 {
@@ -572,18 +554,11 @@ mod tests {
             (sums.map(f64::to_bits), [p.count, p.first, p.last])
         };
         for range in [0..m, 3..17, 9..10, 20..20] {
-            let general = |d: bool| {
-                let (i, s, c) = (|k| k, |_| 1.0, |_| 0.0);
-                if d {
-                    set.pass_with::<true>(range.clone(), state, i, s, c)
-                } else {
-                    set.pass_with::<false>(range.clone(), state, i, s, c)
-                }
-            };
-            let plain = set.pass_plain::<true>(range.clone(), state);
-            assert_eq!(fields(plain), fields(general(true)), "{range:?}");
-            let plain = set.pass_plain::<false>(range.clone(), state);
-            assert_eq!(fields(plain), fields(general(false)), "{range:?}");
+            for dissipation in [true, false] {
+                let plain = set.pass(range.clone(), state, dissipation);
+                let general = spelled.pass(range.clone(), state, dissipation);
+                assert_eq!(fields(plain), fields(general), "{range:?}");
+            }
         }
     }
 }

@@ -419,6 +419,10 @@ impl HeatRow {
 /// diagonal entry and every off-diagonal one is the same number
 /// ([`crate::bar::matrices::stiffness`]).
 fn interior_coefficients(a: &crate::linalg::tridiag::SymTridiag) -> [f64; 2] {
+    debug_assert!(
+        a.uniform().is_some(),
+        "the thermal matrices are built on a uniform mesh"
+    );
     [
         a.diag[1.min(a.diag.len() - 1)],
         a.off.first().copied().unwrap_or(0.0),
