@@ -202,7 +202,7 @@ impl ThermalBody {
         interior: impl Fn(usize) -> f64,
     ) -> impl Fn(usize) -> f64 {
         let last = self.m.nodes - 1;
-        let ends = [v(0), v(last)];
+        let ends = self.ends(v);
         move |k| {
             if k == 0 {
                 ends[0]
@@ -212,6 +212,12 @@ impl ThermalBody {
                 interior(k)
             }
         }
+    }
+
+    /// `[v(0), v(last)]`: a nodal value at the two end nodes.
+    #[inline(always)]
+    fn ends(&self, v: impl Fn(usize) -> f64) -> [f64; 2] {
+        [v(0), v(self.m.nodes - 1)]
     }
 
     /// The fixed ends' increment `new − old` at `node` (0 elsewhere).
@@ -280,30 +286,36 @@ impl ThermalBody {
     /// pass, and `Q·y` with the source's `Q^n` (0 without a source): each node's terms
     /// `(M_jj x_j + 2 M_j,j+1 x_j+1) x_j` and `−K_j,j+1 (y_j+1 − y_j)²` (difference form, exact
     /// for constants), with the uniform mesh's coefficients ([`interior_coefficients`]).
-    fn quads(&self, x: impl Fn(usize) -> f64, y: impl Fn(usize) -> f64) -> [f64; 3] {
+    ///
+    /// `x` and `y` are given by their values at the two end nodes and at the interior nodes
+    /// `1..last` in order, so that the interior is one pass without a test per node.
+    fn quads(
+        &self,
+        (x_ends, x): ([f64; 2], impl IntoIterator<Item = f64>),
+        (y_ends, y): ([f64; 2], impl IntoIterator<Item = f64>),
+    ) -> [f64; 3] {
         let mass = &self.m.mass;
-        let n = mass.diag.len();
+        let last = mass.diag.len() - 1;
         let ([md, mo], [_, ko]) = (
             interior_coefficients(mass),
             interior_coefficients(&self.m.stiffness),
         );
-        let [mut sm, mut sk, mut sq] = [0.0; 3];
-        let (mut xj, mut yj) = (x(0), y(0));
-        for j in 0..n - 1 {
-            let (xn, yn) = (x(j + 1), y(j + 1));
-            let d = if j == 0 { mass.diag[0] } else { md };
-            sm += (d * xj + 2.0 * mo * xn) * xj;
-            sk += -ko * ((yn - yj) * (yn - yj));
-            if let Some(q) = self.q.get(j) {
-                sq += q * yj;
-            }
-            (xj, yj) = (xn, yn);
+        let q = &self.q[..];
+        let mut s = [0.0; 3];
+        // The elements (j, j + 1) in order, the first with the end node's own mass entry.
+        let (mut prev, mut d, mut j) = ((x_ends[0], y_ends[0]), mass.diag[0], 0);
+        for next in x.into_iter().zip(y) {
+            add_element(&mut s, (d, mo, ko), q.get(j), prev, next);
+            (prev, d, j) = (next, md, j + 1);
         }
-        sm += mass.diag[n - 1] * xj * xj;
-        if let Some(q) = self.q.get(n - 1) {
-            sq += q * yj;
+        let end = (x_ends[1], y_ends[1]);
+        add_element(&mut s, (d, mo, ko), q.get(j), prev, end);
+        prev = end;
+        s[0] += mass.diag[last] * prev.0 * prev.0;
+        if let Some(q) = q.get(last) {
+            s[2] += q * prev.1;
         }
-        [sm, sk, sq]
+        s
     }
 
     /// The `θ` block of the right-hand side over the temperature's unknowns: the heat rows
@@ -364,54 +376,49 @@ impl ThermalBody {
         } else {
             &self.q[rows.clone()]
         };
-        let row = HeatRow {
-            a: -s * kappa,
-            kd,
-            ko,
-            s,
-            c: 0.5 * gamma,
-            sign,
-        };
-        let rows = (b.iter_mut().zip(theta.windows(3))).zip(w.windows(3));
-        match coupling {
-            None => {
-                for (jt, ((bj, th), w)) in rows.enumerate() {
-                    *bj = row.at(q.get(jt), th, w);
-                }
+        let (a, c, n) = (-s * kappa, 0.5 * gamma, b.len());
+        let (th, w) = (&theta[..n + 2], &w[..n + 2]);
+        // `−sκ (K_θ θ)_j − γ/2 (Gᵀ w)_j`, with `s Q_j` between them when there is a source.
+        let heat = |j: usize| a * (kd * th[j + 1] + ko * th[j] + ko * th[j + 2]);
+        let coupled = |j: usize| c * (0.5 * (w[j + 1] - w[j]) + 0.5 * (w[j + 2] - w[j + 1]));
+        // One loop per case, so that each runs without a test per row.
+        match (q.is_empty(), c == 0.0) {
+            (true, true) => b
+                .iter_mut()
+                .enumerate()
+                .for_each(|(j, bj)| *bj = sign * heat(j)),
+            (true, false) => {
+                (b.iter_mut().enumerate()).for_each(|(j, bj)| *bj = sign * (heat(j) - coupled(j)))
             }
-            Some(bu) => {
-                let bu = &mut bu[interior.start - m.u_first..interior.end - m.u_first];
-                for (jt, (((bj, th), w), bi)) in rows.zip(bu).enumerate() {
-                    *bj = row.at(q.get(jt), th, w);
-                    *bi += gamma * (0.5 * (th[0] + th[1]) - 0.5 * (th[1] + th[2]));
-                }
+            (false, true) => (b.iter_mut().zip(q).enumerate())
+                .for_each(|(j, (bj, qj))| *bj = sign * (heat(j) + s * qj)),
+            (false, false) => (b.iter_mut().zip(q).enumerate())
+                .for_each(|(j, (bj, qj))| *bj = sign * ((heat(j) + s * qj) - coupled(j))),
+        }
+        // `+= γ (G φ)_i` on the same nodes.
+        if let Some(bu) = coupling {
+            let bu = &mut bu[interior.start - m.u_first..interior.end - m.u_first][..n];
+            for (i, bi) in bu.iter_mut().enumerate() {
+                *bi += gamma * (0.5 * (th[i] + th[i + 1]) - 0.5 * (th[i + 1] + th[i + 2]));
             }
         }
     }
 }
 
-/// An interior heat row, `sign (−sκ (K_θ θ)_j + s Q_j − γ/2 (Gᵀ w)_j)`, from the nodes
-/// `j − 1, j, j + 1` (`c = γ/2`).
-struct HeatRow {
-    a: f64,
-    kd: f64,
-    ko: f64,
-    s: f64,
-    c: f64,
-    sign: f64,
-}
-
-impl HeatRow {
-    #[inline(always)]
-    fn at(&self, q: Option<&f64>, th: &[f64], w: &[f64]) -> f64 {
-        let mut r = self.a * (self.kd * th[1] + self.ko * th[0] + self.ko * th[2]);
-        if let Some(q) = q {
-            r += self.s * q;
-        }
-        if self.c != 0.0 {
-            r -= self.c * (0.5 * (w[1] - w[0]) + 0.5 * (w[2] - w[1]));
-        }
-        self.sign * r
+/// Adds the element `(j, j + 1)`'s terms to the sums of [`ThermalBody::quads`]:
+/// `(d x_j + 2 M_j,j+1 x_j+1) x_j`, `−K_j,j+1 (y_j+1 − y_j)²` and `Q_j y_j`.
+#[inline(always)]
+fn add_element(
+    s: &mut [f64; 3],
+    (d, mo, ko): (f64, f64, f64),
+    q: Option<&f64>,
+    (xj, yj): (f64, f64),
+    (xn, yn): (f64, f64),
+) {
+    s[0] += (d * xj + 2.0 * mo * xn) * xj;
+    s[1] += -ko * ((yn - yj) * (yn - yj));
+    if let Some(q) = q {
+        s[2] += q * yj;
     }
 }
 
@@ -636,8 +643,11 @@ impl Body for ThermalBody {
     fn heat_energy(&self, u: &[f64]) -> Option<f64> {
         let theta = &u[self.m.n_u..];
         let t_first = self.m.t_first;
-        let x = self.nodal(|k| self.theta(u, k), |k| theta[k - t_first]);
-        Some(0.5 * self.quads(&x, &x)[0])
+        let x = theta[1 - t_first..self.m.nodes - 1 - t_first]
+            .iter()
+            .copied();
+        let ends = self.ends(|k| self.theta(u, k));
+        Some(0.5 * self.quads((ends, x.clone()), (ends, x))[0])
     }
 
     /// `½|θ^{n+1/2}|²_M`, `Δt κ |θ̄|²_K`, the exchange and the supply (source and the heat let
@@ -650,13 +660,15 @@ impl Body for ThermalBody {
             Some(j) => u[j] - 0.5 * z[j],
             None => self.fixed_at(k).map_or(0.0, |f| 0.5 * (f.old + f.new)),
         };
-        let bar_theta_at = self.nodal(bar_theta, |k| {
-            let j = n_u + k - m.t_first;
-            u[j] - 0.5 * z[j]
-        });
-        let theta = &u[n_u..];
-        let theta_at = self.nodal(|k| self.theta(u, k), |k| theta[k - m.t_first]);
-        let [mass, stiffness, source] = self.quads(theta_at, &bar_theta_at);
+        let interior = 1 - m.t_first..m.nodes - 1 - m.t_first;
+        let (theta, dtheta) = (&u[n_u..][interior.clone()], &z[n_u..][interior]);
+        let [mass, stiffness, source] = self.quads(
+            (self.ends(|k| self.theta(u, k)), theta.iter().copied()),
+            (
+                self.ends(bar_theta),
+                theta.iter().zip(dtheta).map(|(t, dt)| t - 0.5 * dt),
+            ),
+        );
         let energy = 0.5 * mass;
         let dissipation = dt * m.kappa * stiffness;
         let mut exchange = 0.0;
