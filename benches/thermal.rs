@@ -2,9 +2,10 @@
 //! second (group `thermal`): the same two-end bar pressed by a constant load onto obstacles at
 //! gap 0 (contact active at every step), `mechanical` without `[heat]`, `thermal` with a
 //! coupled temperature (γ = 0.1, κ = 0.05, an exchange with the obstacle at the left end, the
-//! right end insulated), and `thermal-plain-solve` with the coupled solve by the plain block
-//! sweep instead of its twisted twin. Target (benches/README.md): thermal <= 3x mechanical at
-//! J = 1e4 … 1e5; both factors are in the twins block (`bench-compare --twins`).
+//! right end insulated), `thermal-plain-solve` with the coupled solve by the plain block sweep
+//! instead of its twisted twin, and `thermal-plain-energy` with the energy terms summed node by
+//! node instead of in four lanes. Target (benches/README.md): thermal <= 3x mechanical at
+//! J = 1e4 … 1e5; the factors are in the twins block (`bench-compare --twins`).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use viscobar::Scene;
@@ -36,13 +37,22 @@ fn bench_thermal(c: &mut Criterion) {
         group.throughput(Throughput::Elements(elements + 1));
         let mut bar = viscobar::Simulation::new(&scene(elements, false)).unwrap();
         let mut thermal = ThermalSimulation::new(&scene(elements, true)).unwrap();
-        let mut plain =
-            ThermalSimulation::with_kernels(&scene(elements, true), Kernels::PLAIN).unwrap();
+        let with = |kernels| ThermalSimulation::with_kernels(&scene(elements, true), kernels);
+        let plain_solve = Kernels {
+            twisted_solve: false,
+            ..Kernels::TWINS
+        };
+        let plain_energy = Kernels {
+            uniform_energy: false,
+            ..Kernels::TWINS
+        };
+        let (mut plain, mut plain_sums) = (with(plain_solve).unwrap(), with(plain_energy).unwrap());
         // Settle into contact before timing.
         for _ in 0..50 {
             bar.step().unwrap();
             thermal.step().unwrap();
             plain.step().unwrap();
+            plain_sums.step().unwrap();
         }
         group.bench_with_input(
             BenchmarkId::new("mechanical", elements),
@@ -54,6 +64,8 @@ fn bench_thermal(c: &mut Criterion) {
         });
         let id = BenchmarkId::new("thermal-plain-solve", elements);
         group.bench_with_input(id, &elements, |b, _| b.iter(|| plain.step().unwrap()));
+        let id = BenchmarkId::new("thermal-plain-energy", elements);
+        group.bench_with_input(id, &elements, |b, _| b.iter(|| plain_sums.step().unwrap()));
     }
     group.finish();
 }

@@ -200,6 +200,15 @@ fn bad_thermal_input_exits_2_naming_the_key_and_writes_nothing() {
             &["heat.right.value=\"\""],
             "heat.right.value",
         ),
+        (
+            "no unknown temperature",
+            &[
+                "mesh.elements=1",
+                "heat.left.condition=temperature",
+                "heat.left.value=0.5",
+            ],
+            "mesh.elements",
+        ),
     ];
     assert_each_refused("heated-expansion", fixed, &out);
     let clamped: &[(&str, &[&str], &str)] = &[(
@@ -231,6 +240,31 @@ fn bad_thermal_input_exits_2_naming_the_key_and_writes_nothing() {
         ),
     ];
     assert_each_refused("impact", no_heat, &out);
+}
+
+/// The smallest meshes run: one element with one fixed temperature (one unknown
+/// temperature), with the coupling and without.
+#[test]
+fn one_element_thermal_bars_run() {
+    for coupling in ["0.1", "0"] {
+        let out = fresh_dir("thermal", &format!("one-element-{coupling}"));
+        let o = viscobar(&[
+            "run",
+            "heated-expansion",
+            "--out",
+            out.to_str().unwrap(),
+            "--set",
+            "mesh.elements=1",
+            "--set",
+            &format!("heat.coupling={coupling}"),
+            "--set",
+            "time.end=0.5",
+        ]);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(0), "{stderr}");
+        assert!(out.join("history.csv").exists());
+        std::fs::remove_dir_all(&out).unwrap();
+    }
 }
 
 /// The commands that take bar scenes without a temperature refuse a thermal one (exit 2).

@@ -300,22 +300,38 @@ pub fn twins_markdown() -> Result<String, String> {
         cells.join(" | ")
     )
     .unwrap();
-    // The thermal step (benches/thermal.rs): its twin, and its cost over the mechanical step.
-    let (mut cells, mut ratios) = (Vec::new(), Vec::new());
+    // The thermal step (benches/thermal.rs): its twins, and its cost over the mechanical step.
+    let mut ratios = Vec::new();
+    let thermal_twins = [
+        (
+            "`block_tridiag_fast::TwistedBlockLdlt`",
+            "`block_tridiag::BlockLdlt`",
+            "plain-solve",
+        ),
+        (
+            "`thermal::energy_fast::interior_sums`",
+            "the energy terms node by node",
+            "plain-energy",
+        ),
+    ];
+    for (twin, plain, variant) in thermal_twins {
+        let mut cells = Vec::new();
+        for j in &SIZES[..2] {
+            let thermal = read(format!("thermal/thermal/{j}"))?;
+            let p = read(format!("thermal/thermal-{variant}/{j}"))?;
+            cells.push(format!("{:.2}x", p / thermal));
+        }
+        writeln!(
+            rows,
+            "| {twin} | {plain} | thermal | {} | not measured |",
+            cells.join(" | ")
+        )
+        .unwrap();
+    }
     for j in &SIZES[..2] {
         let thermal = read(format!("thermal/thermal/{j}"))?;
-        let plain = read(format!("thermal/thermal-plain-solve/{j}"))?;
-        let mechanical = read(format!("thermal/mechanical/{j}"))?;
-        cells.push(format!("{:.2}x", plain / thermal));
-        ratios.push(thermal / mechanical);
+        ratios.push(thermal / read(format!("thermal/mechanical/{j}"))?);
     }
-    writeln!(
-        rows,
-        "| `block_tridiag_fast::TwistedBlockLdlt` | `block_tridiag::BlockLdlt` | thermal | {} | \
-         not measured |",
-        cells.join(" | ")
-    )
-    .unwrap();
     let worst = ratios.iter().copied().fold(0.0f64, f64::max);
     let thermal_line = format!(
         "\nThe thermal step over the mechanical step (`thermal/thermal` over `thermal/mechanical`): \

@@ -9,6 +9,7 @@
 //! [`crate::bar`].
 
 pub mod body;
+mod energy_fast;
 pub mod matrices;
 pub mod setup;
 pub mod solver;

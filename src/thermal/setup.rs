@@ -21,7 +21,8 @@ impl Scheme<ThermalBody> {
     }
 
     /// [`ThermalSimulation::new`] with the coupled block solve by the twisted twin or by the
-    /// plain sweep as `kernels.twisted_solve` says (the same answers to round-off).
+    /// plain sweep as `kernels.twisted_solve` says, and the energy terms by the four-lane twin
+    /// or node by node as `kernels.uniform_energy` says (the same answers to round-off).
     pub fn with_kernels(scene: &Scene, kernels: Kernels) -> Result<Self, RunError> {
         Self::prepare_with(scene, kernels)?.start()
     }
@@ -60,7 +61,19 @@ impl Scheme<ThermalBody> {
             expressions.clone(),
             &constraints,
         )?;
+        let mut body = body;
+        body.uniform_energy = kernels.uniform_energy;
         let m = body.matrices().clone();
+        if m.n_t == 0 {
+            return Err(SceneError::Invalid {
+                field: "mesh.elements".into(),
+                value: scene.mesh.elements.to_string(),
+                allowed: "at least 2 with a fixed temperature at both ends (a node whose \
+                          temperature is unknown)"
+                    .into(),
+            }
+            .into());
+        }
         // [u^0 | θ^0] and [u_1 | 0].
         let mut displacement = bar.displacement;
         let mut velocity = bar.velocity;
