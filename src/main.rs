@@ -1,5 +1,25 @@
 //! The `viscobar` command line.
 
+/// `println!` and `print!` that end the process quietly when standard output is closed
+/// (`viscobar scenes | head`): a reader that stops early is not a failure, and the runs' files
+/// are already whole.
+macro_rules! println {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        if writeln!(std::io::stdout(), $($t)*).is_err() {
+            std::process::exit(0);
+        }
+    }};
+}
+macro_rules! print {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        if write!(std::io::stdout(), $($t)*).is_err() {
+            std::process::exit(0);
+        }
+    }};
+}
+
 use clap::{Parser, Subcommand};
 use std::io::IsTerminal;
 use std::path::PathBuf;

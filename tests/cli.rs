@@ -723,3 +723,20 @@ fn converge_mass_runs_one_study_per_variant() {
         assert!(!bad.exists(), "{args:?}: nothing written");
     }
 }
+
+/// A reader that closes standard output before the listing is written (`viscobar scenes |
+/// head -0`) ends the command quietly: exit 0, no panic on the broken pipe.
+#[test]
+fn a_closed_standard_output_ends_the_command_quietly() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_viscobar"))
+        .arg("scenes")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+}
