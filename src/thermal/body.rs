@@ -12,8 +12,8 @@ use crate::scene::SceneError;
 use crate::scene::heat::{EndHeat, HeatExpressions};
 use crate::scheme::body::{Body, EnergySums, FullMassRows, HeatTerms};
 use crate::scheme::{RunError, in_contact};
-use crate::thermal::energy_fast;
 use crate::thermal::matrices::ThermalMatrices;
+use crate::thermal::{energy_fast, heat_rows};
 
 /// An exchange end: its node, constraint, unknown, gap and coefficient `h`, `θ_obs(t)`.
 #[derive(Clone, Debug)]
@@ -417,32 +417,24 @@ impl ThermalBody {
         } else {
             &self.q[rows.clone()]
         };
-        let (a, c, n) = (-s * kappa, 0.5 * gamma, b.len());
-        let (th, w) = (&theta[..n + 2], &w[..n + 2]);
-        // `−sκ (K_θ θ)_j − γ/2 (Gᵀ w)_j`, with `s Q_j` between them when there is a source.
-        let heat = |j: usize| a * (kd * th[j + 1] + ko * th[j] + ko * th[j + 2]);
-        let coupled = |j: usize| c * (0.5 * (w[j + 1] - w[j]) + 0.5 * (w[j + 2] - w[j + 1]));
-        // One loop per case, so that each runs without a test per row.
-        match (q.is_empty(), c == 0.0) {
-            (true, true) => b
-                .iter_mut()
-                .enumerate()
-                .for_each(|(j, bj)| *bj = sign * heat(j)),
-            (true, false) => {
-                (b.iter_mut().enumerate()).for_each(|(j, bj)| *bj = sign * (heat(j) - coupled(j)))
-            }
-            (false, true) => (b.iter_mut().zip(q).enumerate())
-                .for_each(|(j, (bj, qj))| *bj = sign * (heat(j) + s * qj)),
-            (false, false) => (b.iter_mut().zip(q).enumerate())
-                .for_each(|(j, (bj, qj))| *bj = sign * ((heat(j) + s * qj) - coupled(j))),
-        }
-        // `+= γ (G φ)_i` on the same nodes.
-        if let Some(bu) = coupling {
-            let bu = &mut bu[interior.start - m.u_first..interior.end - m.u_first][..n];
-            for (i, bi) in bu.iter_mut().enumerate() {
-                *bi += gamma * (0.5 * (th[i] + th[i + 1]) - 0.5 * (th[i + 1] + th[i + 2]));
-            }
-        }
+        let n = b.len();
+        let bu = coupling.map(|bu| &mut bu[interior.start - m.u_first..interior.end - m.u_first]);
+        crate::linalg::dispatch::run(heat_rows::HeatRows {
+            row: heat_rows::HeatRow {
+                a: -s * kappa,
+                kd,
+                ko,
+                c: 0.5 * gamma,
+            },
+            s,
+            gamma,
+            sign,
+            th: &theta[..n + 2],
+            w: &w[..n + 2],
+            q,
+            b,
+            bu,
+        });
     }
 }
 

@@ -10,6 +10,7 @@
 
 pub mod body;
 mod energy_fast;
+mod heat_rows;
 pub mod matrices;
 pub mod setup;
 pub mod solver;
