@@ -1,23 +1,32 @@
 //! The `viscobar` command line.
 
 /// `println!` and `print!` that end the process quietly when standard output is closed
-/// (`viscobar scenes | head`): a reader that stops early is not a failure, and the runs' files
-/// are already whole.
+/// (`viscobar scenes | head`: a reader that stops early is not a failure, and the runs' files
+/// are already whole); any other failure to write is an error ([`stdout_failed`]).
 macro_rules! println {
     ($($t:tt)*) => {{
         use std::io::Write as _;
-        if writeln!(std::io::stdout(), $($t)*).is_err() {
-            std::process::exit(0);
+        if let Err(e) = writeln!(std::io::stdout(), $($t)*) {
+            stdout_failed(e)
         }
     }};
 }
 macro_rules! print {
     ($($t:tt)*) => {{
         use std::io::Write as _;
-        if write!(std::io::stdout(), $($t)*).is_err() {
-            std::process::exit(0);
+        if let Err(e) = write!(std::io::stdout(), $($t)*) {
+            stdout_failed(e)
         }
     }};
+}
+
+/// Exit 0 on a closed pipe, else exit 1 naming the failure.
+fn stdout_failed(e: std::io::Error) -> ! {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        std::process::exit(0);
+    }
+    eprintln!("error: writing to standard output: {e}");
+    std::process::exit(1)
 }
 
 use clap::{Parser, Subcommand};

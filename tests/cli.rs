@@ -740,3 +740,25 @@ fn a_closed_standard_output_ends_the_command_quietly() {
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_eq!(o.status.code(), Some(0), "{stderr}");
 }
+
+/// Any other failure to write standard output is an error: exit 1, named on stderr (a full
+/// device, `/dev/full`).
+#[cfg(target_os = "linux")]
+#[test]
+fn a_failed_write_to_standard_output_exits_1() {
+    let full = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_viscobar"))
+        .arg("scenes")
+        .stdout(full)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("standard output") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
+}

@@ -301,7 +301,10 @@ pub fn twins_markdown() -> Result<String, String> {
     )
     .unwrap();
     // The thermal step (benches/thermal.rs): its twins, and its cost over the mechanical step.
-    let mut ratios = Vec::new();
+    let mut thermal = Vec::new();
+    for j in &SIZES[..2] {
+        thermal.push(read(format!("thermal/thermal/{j}"))?);
+    }
     let thermal_twins = [
         (
             "`block_tridiag_fast::TwistedBlockLdlt`",
@@ -316,10 +319,9 @@ pub fn twins_markdown() -> Result<String, String> {
     ];
     for (twin, plain, variant) in thermal_twins {
         let mut cells = Vec::new();
-        for j in &SIZES[..2] {
-            let thermal = read(format!("thermal/thermal/{j}"))?;
+        for (j, t) in SIZES[..2].iter().zip(&thermal) {
             let p = read(format!("thermal/thermal-{variant}/{j}"))?;
-            cells.push(format!("{:.2}x", p / thermal));
+            cells.push(format!("{:.2}x", p / t));
         }
         writeln!(
             rows,
@@ -328,9 +330,9 @@ pub fn twins_markdown() -> Result<String, String> {
         )
         .unwrap();
     }
-    for j in &SIZES[..2] {
-        let thermal = read(format!("thermal/thermal/{j}"))?;
-        ratios.push(thermal / read(format!("thermal/mechanical/{j}"))?);
+    let mut ratios = Vec::new();
+    for (j, t) in SIZES[..2].iter().zip(&thermal) {
+        ratios.push(t / read(format!("thermal/mechanical/{j}"))?);
     }
     let worst = ratios.iter().copied().fold(0.0f64, f64::max);
     let thermal_line = format!(

@@ -130,6 +130,15 @@ impl ThermalBody {
             is_fixed,
             exchange.iter().map(|e| (e.node, e.coefficient)).collect(),
         );
+        if m.n_t == 0 {
+            return Err(SceneError::Invalid {
+                field: "mesh.elements".into(),
+                value: (nodes - 1).to_string(),
+                allowed: "at least 2 with a fixed temperature at both ends (a node whose \
+                          temperature is unknown)"
+                    .into(),
+            });
+        }
         let with_source = source.is_some();
         Ok(Self {
             bar,
@@ -310,10 +319,9 @@ impl ThermalBody {
         }
         let end = (x_ends[1], y_ends[1]);
         add_element(&mut s, (d, mo, ko), q.get(j), prev, end);
-        prev = end;
-        s[0] += mass.diag[last] * prev.0 * prev.0;
+        s[0] += mass.diag[last] * end.0 * end.0;
         if let Some(q) = q.get(last) {
-            s[2] += q * prev.1;
+            s[2] += q * end.1;
         }
         s
     }

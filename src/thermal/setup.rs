@@ -55,25 +55,14 @@ impl Scheme<ThermalBody> {
         let constraints: Vec<(usize, f64)> =
             disc.constraints.iter().map(|c| (c.node, c.gap)).collect();
         let dx = disc.dx;
-        let body = ThermalBody::new(
+        let mut body = ThermalBody::new(
             bar.body,
             (heat.diffusivity, heat.coupling),
             expressions.clone(),
             &constraints,
         )?;
-        let mut body = body;
         body.uniform_energy = kernels.uniform_energy;
         let m = body.matrices().clone();
-        if m.n_t == 0 {
-            return Err(SceneError::Invalid {
-                field: "mesh.elements".into(),
-                value: scene.mesh.elements.to_string(),
-                allowed: "at least 2 with a fixed temperature at both ends (a node whose \
-                          temperature is unknown)"
-                    .into(),
-            }
-            .into());
-        }
         // [u^0 | θ^0] and [u_1 | 0].
         let mut displacement = bar.displacement;
         let mut velocity = bar.velocity;
