@@ -1,22 +1,17 @@
-//! The plane body's step against one solve with the factor of `C`, at 1e3 … 1e5 unknowns (and
-//! 1e6 with `VISCOBAR_BENCH_PLANE_1E6=1`: about 5 s of set-up and 1 GB for the factor).
-//!
-//! A cantilever-like body on `nx × nx/2` cells of `(0, 2) × (0, 1)`, left edge clamped,
-//! `λ = 1`, `μ = ½`, `α = 0.02`, `Δt = h`, under a constant load (as the probe of
-//! `docs/sparse-cholesky.md`). `plane-step/N` is a whole step (right-hand side, solve, energy
-//! balance), `plane-solve/N` one solve with a factor of the same `C`; after criterion's groups
-//! the bench prints the ratio step / solve from medians of its own timings.
+//! The plane body's step against one solve with the factor of `C`, at 1e3 … 1e5 unknowns (1e6
+//! with `VISCOBAR_BENCH_PLANE_1E6=1`: about 5 s of set-up and 1 GB for the factor): a body on
+//! `nx × nx/2` cells of `(0, 2) × (0, 1)`, left edge clamped, `λ = 1`, `μ = ½`, `α = 0.02`,
+//! `Δt = h`, constant load (`docs/sparse-cholesky.md`); `plane-step/N` a whole step,
+//! `plane-solve/N` one solve; the bench prints step / solve from medians of its own timings.
 //!
 //! `plane-contact`: a block resting on a Signorini floor (every bottom node in contact), the
-//! exact step against the unconstrained step of the same body with a free bottom, at 1e4 …
-//! 2e5 unknowns with up to 200 contact normals and at 1e5 with 500; it prints the ratio, the
-//! set-up cost of `S` (the contact run's set-up minus the free one's) and OSQP's step over the
-//! exact one (up to 5e4 unknowns). `plane-contact/kratos-block-30x15-200-steps` is the built-in
-//! `plane-block-drop` end to end in memory, the size of a Kratos comparison run (`bench_kratos`).
+//! exact step against the free-bottom step of the same body, 1e4 … 2e5 unknowns with up to 200
+//! normals and 1e5 with 500; it prints the ratio, the set-up of `S` and OSQP's step over the
+//! exact one (up to 5e4 unknowns). `plane-contact/kratos-block-30x15-200-steps`: the built-in
+//! `plane-block-drop` end to end in memory, the size of a Kratos comparison run.
 //!
-//! `plane-scale`: the resting block at 1e5 unknowns with 1000 contact normals (the exact step)
-//! and with 5000 (the penalty law's sparse Newton iteration), against its free step
-//! (`cargo bench --bench plane -- plane-scale`).
+//! `plane-scale`: the resting block at 1e5 unknowns with 1000 normals (exact step) and 5000
+//! (the penalty law's sparse Newton iteration), against its free step.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use std::time::Instant;

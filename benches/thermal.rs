@@ -3,8 +3,7 @@
 //! gap 0 (contact active at every step), `mechanical` without `[heat]`, `thermal` with a
 //! coupled temperature (γ = 0.1, κ = 0.05, an exchange with the obstacle at the left end, the
 //! right end insulated), `thermal-plain-solve` with the coupled solve by the plain block sweep
-//! instead of its twisted twin, and `thermal-plain-energy` with the energy terms summed node by
-//! node instead of in four lanes; `paired` times the thermal and the mechanical step one after
+//! instead of its twisted twin; `paired` times the thermal and the mechanical step one after
 //! the other in each sample and writes each sample's two times per step to `pairs.csv` beside
 //! criterion's estimates. Target (benches/README.md): thermal <= 3x mechanical at J = 1e4 …
 //! 1e5, the median of the samples' ratios; the factors are in the twins block
@@ -49,17 +48,12 @@ fn bench_thermal(c: &mut Criterion) {
             twisted_solve: false,
             ..Kernels::TWINS
         };
-        let plain_energy = Kernels {
-            uniform_energy: false,
-            ..Kernels::TWINS
-        };
-        let (mut plain, mut plain_sums) = (with(plain_solve).unwrap(), with(plain_energy).unwrap());
+        let mut plain = with(plain_solve).unwrap();
         // Settle into contact before timing.
         for _ in 0..50 {
             bar.step().unwrap();
             thermal.step().unwrap();
             plain.step().unwrap();
-            plain_sums.step().unwrap();
         }
         group.bench_with_input(
             BenchmarkId::new("mechanical", elements),
@@ -71,8 +65,6 @@ fn bench_thermal(c: &mut Criterion) {
         });
         let id = BenchmarkId::new("thermal-plain-solve", elements);
         group.bench_with_input(id, &elements, |b, _| b.iter(|| plain.step().unwrap()));
-        let id = BenchmarkId::new("thermal-plain-energy", elements);
-        group.bench_with_input(id, &elements, |b, _| b.iter(|| plain_sums.step().unwrap()));
         // Both steps in each sample: a drift of the machine's speed reaches both of its times.
         let mut pairs: Vec<[f64; 2]> = Vec::new();
         let id = BenchmarkId::new("paired", elements);

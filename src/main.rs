@@ -49,8 +49,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Run a scene, bar or plane (built-in name or TOML file), and write summary.json,
-    /// history.csv and displacement.csv (a bar scene with `[output] format = "npy"`:
-    /// displacement.npy).
+    /// history.csv and displacement.csv (with `[output] format = "npy"`: displacement.npy).
     Run {
         /// A built-in scene (a name from `viscobar scenes`) or the path of a TOML scene file.
         scene: String,

@@ -307,18 +307,11 @@ pub fn twins_markdown() -> Result<String, String> {
     for j in &SIZES[..2] {
         thermal.push(read(format!("thermal/thermal/{j}"))?);
     }
-    let thermal_twins = [
-        (
-            "`block_tridiag_fast::TwistedBlockLdlt`",
-            "`block_tridiag::BlockLdlt`",
-            "plain-solve",
-        ),
-        (
-            "`thermal::energy_fast::interior_sums`",
-            "the energy terms node by node",
-            "plain-energy",
-        ),
-    ];
+    let thermal_twins = [(
+        "`block_tridiag_fast::TwistedBlockLdlt`",
+        "`block_tridiag::BlockLdlt`",
+        "plain-solve",
+    )];
     for (twin, plain, variant) in thermal_twins {
         let mut cells = Vec::new();
         for (j, t) in SIZES[..2].iter().zip(&thermal) {

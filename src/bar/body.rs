@@ -34,8 +34,7 @@ pub struct Kernels {
     pub warm_start: bool,
     /// On a uniform mesh, the right-hand side by [`rhs_into_uniform`].
     pub uniform_rhs: bool,
-    /// On a uniform mesh, the energy sums by [`energy_sums_uniform`] (and a thermal bar's
-    /// energy terms by their four-lane twin, `thermal::energy_fast`).
+    /// On a uniform mesh, the energy sums by [`energy_sums_uniform`].
     pub uniform_energy: bool,
 }
 

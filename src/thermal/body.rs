@@ -12,8 +12,8 @@ use crate::scene::SceneError;
 use crate::scene::heat::{EndHeat, HeatExpressions};
 use crate::scheme::body::{Body, EnergySums, FullMassRows, HeatTerms};
 use crate::scheme::{RunError, in_contact};
+use crate::thermal::heat_rows;
 use crate::thermal::matrices::ThermalMatrices;
-use crate::thermal::{energy_fast, heat_rows};
 
 /// An exchange end: its node, constraint, unknown, gap and coefficient `h`, `θ_obs(t)`.
 #[derive(Clone, Debug)]
@@ -52,8 +52,6 @@ pub struct ThermalBody {
     /// `θ_obs(t_n)` of each exchange end.
     mask: usize,
     theta_obs: [f64; 2],
-    /// The energy terms' interior sums by the four-lane twin ([`crate::thermal::energy_fast`]).
-    pub(crate) uniform_energy: bool,
 }
 
 /// `name(t)` finite, or the scene error naming `key`.
@@ -158,7 +156,6 @@ impl ThermalBody {
             },
             mask: 0,
             theta_obs: [0.0; 2],
-            uniform_energy: true,
         })
     }
 
@@ -319,38 +316,6 @@ impl ThermalBody {
         }
         let end = (x_ends[1], y_ends[1]);
         add_element(&mut s, (d, mo, ko), q.get(j), prev, end);
-        s[0] += mass.diag[last] * end.0 * end.0;
-        if let Some(q) = q.get(last) {
-            s[2] += q * end.1;
-        }
-        s
-    }
-
-    /// [`Self::quads`] of `x = θ` and `y = θ̄ = θ − ½ dθ`, with the interior elements' sums by
-    /// the four-lane twin ([`energy_fast::interior_sums`]; `theta`, `dtheta` at the interior
-    /// nodes `1..last`): the same terms to round-off.
-    fn quads_uniform(
-        &self,
-        (x_ends, y_ends): ([f64; 2], [f64; 2]),
-        (theta, dtheta): (&[f64], &[f64]),
-    ) -> [f64; 3] {
-        let [md, mo, ko] = self.interior_entries();
-        let (mass, q) = (&self.m.mass, &self.q[..]);
-        let last = mass.diag.len() - 1;
-        let mut s = [0.0; 3];
-        let (mut prev, mut d, end) = ((x_ends[0], y_ends[0]), mass.diag[0], (x_ends[1], y_ends[1]));
-        let at = |k: usize| (theta[k], theta[k] - 0.5 * dtheta[k]);
-        // The first element, those between interior nodes (the twin), the last.
-        if let Some(l) = theta.len().checked_sub(1) {
-            add_element(&mut s, (d, mo, ko), q.first(), prev, at(0));
-            let q_interior = if q.is_empty() { q } else { &q[1..last] };
-            let [xx, xy, dy, qy] = energy_fast::interior_sums(theta, dtheta, q_interior);
-            s[0] += md * xx + 2.0 * mo * xy;
-            s[1] += -ko * dy;
-            s[2] += qy;
-            (prev, d) = (at(l), md);
-        }
-        add_element(&mut s, (d, mo, ko), q.get(last - 1), prev, end);
         s[0] += mass.diag[last] * end.0 * end.0;
         if let Some(q) = q.get(last) {
             s[2] += q * end.1;
@@ -704,14 +669,10 @@ impl Body for ThermalBody {
         let interior = 1 - m.t_first..m.nodes - 1 - m.t_first;
         let (theta, dtheta) = (&u[n_u..][interior.clone()], &z[n_u..][interior]);
         let ends = (self.ends(|k| self.theta(u, k)), self.ends(bar_theta));
-        let [mass, stiffness, source] = if self.uniform_energy {
-            self.quads_uniform(ends, (theta, dtheta))
-        } else {
-            self.quads(
-                (ends.0, theta.iter().copied()),
-                (ends.1, theta.iter().zip(dtheta).map(|(t, dt)| t - 0.5 * dt)),
-            )
-        };
+        let [mass, stiffness, source] = self.quads(
+            (ends.0, theta.iter().copied()),
+            (ends.1, theta.iter().zip(dtheta).map(|(t, dt)| t - 0.5 * dt)),
+        );
         let energy = 0.5 * mass;
         let dissipation = dt * m.kappa * stiffness;
         let mut exchange = 0.0;
@@ -756,17 +717,17 @@ mod tests {
     use crate::scheme::Body;
     use crate::thermal::ThermalSimulation;
 
-    /// Two summation orders of `n` terms of one sign: each sum carries at most about `n ε`
-    /// of itself.
+    /// Two summation orders of `n` terms: each sum carries at most about `n ε` of the sum of
+    /// its terms' magnitudes.
     fn sum_tol(n: usize) -> f64 {
         4.0 * n as f64 * f64::EPSILON
     }
 
-    /// The energy terms' four-lane twin agrees with the node-by-node sums, on meshes of 1 to
-    /// 60 elements (every tail of the lanes), insulated, fixed and exchanging ends, with and
-    /// without a source (positive data: terms of one sign).
+    /// The energy terms' element sums (`quads`, in difference form) equal the matrix products
+    /// `θ·Mθ`, `θ̄·Kθ̄` and `Q·θ̄` computed row by row from the assembled matrices, on meshes of 1
+    /// to 60 elements, insulated, fixed and exchanging ends, with and without a source.
     #[test]
-    fn the_energy_terms_twin_agrees_with_the_plain_sums() {
+    fn the_energy_terms_are_the_matrix_products() {
         for elements in [1usize, 2, 3, 4, 5, 6, 7, 8, 9, 60] {
             for (left, source) in [
                 (
@@ -806,14 +767,24 @@ mod tests {
                 let interior = 1 - m.t_first..m.nodes - 1 - m.t_first;
                 let (theta, dtheta) = (&u[n_u..][interior.clone()], &z[n_u..][interior]);
                 let ends = (body.ends(|k| body.theta(&u, k)), body.ends(bar_theta));
-                let twin = body.quads_uniform(ends, (theta, dtheta));
                 let plain = body.quads(
                     (ends.0, theta.iter().copied()),
                     (ends.1, theta.iter().zip(dtheta).map(|(t, dt)| t - 0.5 * dt)),
                 );
-                for (a, b) in twin.into_iter().zip(plain) {
+                let x: Vec<f64> = (0..m.nodes).map(|k| body.theta(&u, k)).collect();
+                let y: Vec<f64> = (0..m.nodes).map(bar_theta).collect();
+                let (mut mx, mut ky) = (vec![0.0; m.nodes], vec![0.0; m.nodes]);
+                m.mass.mul_into(&x, &mut mx);
+                m.stiffness.mul_into(&y, &mut ky);
+                // The product and the sum of its terms' magnitudes.
+                let dot = |a: &[f64], b: &[f64]| {
+                    let terms = a.iter().zip(b).map(|(a, b)| a * b);
+                    (terms.clone().sum::<f64>(), terms.map(f64::abs).sum::<f64>())
+                };
+                let products = [dot(&x, &mx), dot(&y, &ky), dot(&body.q, &y)];
+                for (a, (b, magnitude)) in plain.into_iter().zip(products) {
                     assert!(
-                        (a - b).abs() <= sum_tol(m.nodes) * b.abs(),
+                        (a - b).abs() <= sum_tol(m.nodes) * magnitude,
                         "{elements} elements, left {left}, source {source}: {a} vs {b}"
                     );
                 }

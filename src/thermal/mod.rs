@@ -9,7 +9,6 @@
 //! [`crate::bar`].
 
 pub mod body;
-mod energy_fast;
 mod heat_rows;
 pub mod matrices;
 pub mod setup;

@@ -21,8 +21,7 @@ impl Scheme<ThermalBody> {
     }
 
     /// [`ThermalSimulation::new`] with the coupled block solve by the twisted twin or by the
-    /// plain sweep as `kernels.twisted_solve` says, and the energy terms by the four-lane twin
-    /// or node by node as `kernels.uniform_energy` says (the same answers to round-off).
+    /// plain sweep as `kernels.twisted_solve` says (the same answers to round-off).
     pub fn with_kernels(scene: &Scene, kernels: Kernels) -> Result<Self, RunError> {
         Self::prepare_with(scene, kernels)?.start()
     }
@@ -55,13 +54,12 @@ impl Scheme<ThermalBody> {
         let constraints: Vec<(usize, f64)> =
             disc.constraints.iter().map(|c| (c.node, c.gap)).collect();
         let dx = disc.dx;
-        let mut body = ThermalBody::new(
+        let body = ThermalBody::new(
             bar.body,
             (heat.diffusivity, heat.coupling),
             expressions.clone(),
             &constraints,
         )?;
-        body.uniform_energy = kernels.uniform_energy;
         let m = body.matrices().clone();
         // [u^0 | θ^0] and [u_1 | 0].
         let mut displacement = bar.displacement;

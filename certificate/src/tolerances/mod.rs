@@ -441,7 +441,7 @@ pub fn measured() -> Result<Vec<Measured>, RunError> {
         note: "KKT residuals against their per-case round-off bound, and each answer's distance \
                to the minimiser bounded from its own residuals (oracle_distance_bound: \
                λ_min(C), feasibility and complementarity), which checks the oracle and the bound \
-               rather than the solver; replaces AGREEMENT_TOL = 1e-9 (ratio 8.5e-7)",
+               rather than the solver",
     });
     let (kkt_worst_ratio, _) = random_kkt_worst()?;
     v.push(Measured {
@@ -450,7 +450,7 @@ pub fn measured() -> Result<Vec<Measured>, RunError> {
         tolerance: 1.0,
         worst: kkt_worst_ratio,
         note: "per case: the solver's accepted tie slack plus a backward-stable LDLᵀ solve and \
-               the residual's roundings (replaces AGREEMENT_TOL and EXACT_KKT_TOL = 1e-9 on KKT)",
+               the residual's roundings",
     });
     let (eig, kappa) = kappa_reference_worst();
     v.push(Measured {
@@ -465,7 +465,7 @@ pub fn measured() -> Result<Vec<Measured>, RunError> {
         used_in: "src/linalg/spectrum.rs (tests)",
         tolerance: 1.0,
         worst: kappa,
-        note: "κ up to 4e11; the former bound 64 ε κ was about 600 %",
+        note: "κ up to 4e11; the eigenvalues' bound (Weyl) at both ends of the spectrum",
     });
     Ok(v)
 }
