@@ -11,6 +11,9 @@
 //! so each answer is placed by a fixed-point iteration and its ratio re-measured before it is
 //! audited. Constraints push in both directions, `s = +1` and `s = −1`.
 
+mod common;
+
+use common::{amax, inf_norm, ratio};
 use nalgebra::{DMatrix, DVector};
 use viscobar::linalg::SymTridiag;
 use viscobar::linalg::sparse::Pattern;
@@ -121,12 +124,6 @@ struct Body<S> {
     soft: Vec<f64>,
     stiff: Vec<f64>,
     system: fn() -> S,
-}
-
-fn inf_norm(a: &DMatrix<f64>) -> f64 {
-    a.row_iter()
-        .map(|row| row.iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
 }
 
 impl<S: SpdSystem> Body<S> {
@@ -369,14 +366,6 @@ impl Eval {
         let (value, tolerance) = self.checks[check as usize];
         ratio(value, tolerance)
     }
-}
-
-fn ratio(value: f64, tolerance: f64) -> f64 {
-    if value == 0.0 { 0.0 } else { value / tolerance }
-}
-
-fn amax(v: &[f64]) -> f64 {
-    v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
 /// The audit's checks of `a` under `law`, computed independently (see the module doc).

@@ -12,6 +12,9 @@
 //! The bounds depend on the answer's norms, so each answer is placed by a fixed-point iteration
 //! and its ratio re-measured before it is audited. Normals push both ways, `s = ±1`.
 
+mod common;
+
+use common::{amax, inf_norm, ratio};
 use nalgebra::{DMatrix, DVector};
 use viscobar::linalg::sparse::Pattern;
 use viscobar::linalg::system::{SparseSystem, inverse_norm_estimate};
@@ -220,20 +223,6 @@ fn matrix() -> (Pattern, Vec<f64>) {
 fn system() -> SparseSystem {
     let (pattern, values) = matrix();
     SparseSystem::new(&pattern, &values, "C").expect("C is positive definite")
-}
-
-fn inf_norm(a: &DMatrix<f64>) -> f64 {
-    a.row_iter()
-        .map(|row| row.iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
-}
-
-fn amax(v: &[f64]) -> f64 {
-    v.iter().fold(0.0, |m, x| m.max(x.abs()))
-}
-
-fn ratio(value: f64, tolerance: f64) -> f64 {
-    if value == 0.0 { 0.0 } else { value / tolerance }
 }
 
 /// The step matrix with its independent dense copies, the rows `E` and the base `z`.

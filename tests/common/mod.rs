@@ -103,3 +103,22 @@ pub fn round_to_digits(x: f64, scale: f64, digits: i32) -> f64 {
         .unwrap();
     r + 0.0
 }
+
+// ---- the audits' bounds at their edges (audit_bounds.rs, friction_audit_bounds.rs) ----------
+
+/// `‖a‖∞` of a dense matrix: the largest row sum of magnitudes.
+pub fn inf_norm(a: &nalgebra::DMatrix<f64>) -> f64 {
+    a.row_iter()
+        .map(|row| row.iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
+/// `‖v‖∞`.
+pub fn amax(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+/// A checked value over its tolerance, as the audits report it (0 for a value of 0).
+pub fn ratio(value: f64, tolerance: f64) -> f64 {
+    if value == 0.0 { 0.0 } else { value / tolerance }
+}
