@@ -2,13 +2,16 @@
 //! factorisation, `L D Lᵀ` from the first block and from the last, joined at a middle twist
 //! block, so that a solve runs two independent chains at once (the plain sweep is one chain,
 //! bound by the latency of its 2 × 2 products); on a uniform interior each half's factor rows
-//! settle bitwise on a fixed point and are read once. Solutions agree with the plain
+//! settle bitwise on a fixed point, are read once, and each link of a chain covers two rows
+//! (`y_{i+1} = (b_{i+1} − L b_i) + L² y_{i−1}`: one step of odd–even reduction, as the bar's
+//! [`TwistedLdlt`](super::ldlt_fast::TwistedLdlt) takes). Solutions agree with the plain
 //! [`BlockLdlt`] to round-off, not bit for bit; what it buys on a thermal step is measured in
 //! benches/README.md, "Plain kernels and their twins".
 
 use crate::linalg::block_tridiag::{
     Block, BlockLdlt, BlockTridiag, SingularBlock, d_inv_mul, mul, mul_transposed,
 };
+use crate::linalg::dispatch;
 use std::ops::Range;
 
 /// `A` factorised from both ends: `top` the block `LDLᵀ` of `A` (rows `0..m` used), `bottom`
@@ -32,6 +35,8 @@ struct Half {
     factor: BlockLdlt,
     still: Range<usize>,
     row: (Block, [f64; 3]),
+    /// `L²` of that row, the stretch's link over two rows.
+    square: Block,
 }
 
 impl Half {
@@ -58,7 +63,13 @@ impl Half {
             row.0.copied().unwrap_or_default(),
             row.1.copied().unwrap_or_default(),
         );
-        Self { factor, still, row }
+        let square = product(&row.0, &row.0);
+        Self {
+            factor,
+            still,
+            row,
+            square,
+        }
     }
 
     /// `L_i`.
@@ -80,6 +91,11 @@ impl Half {
             &self.factor.inv_d()[i]
         }
     }
+}
+
+/// `A B`.
+fn product(a: &Block, b: &Block) -> Block {
+    [0, 1].map(|r| [0, 1].map(|c| a[r][0] * b[0][c] + a[r][1] * b[1][c]))
 }
 
 fn transpose(b: &Block) -> Block {
@@ -134,8 +150,18 @@ impl TwistedBlockLdlt {
     /// every block but possibly the first and the last has its entries in both fields). The
     /// two chains run inward (`y_i = b_i − L_i y_{i−1}`, kept in the fields), meet at the twist
     /// (`x_m = T_m⁻¹ (b_m − L_m y_{m−1} − L'_k y'_{k−1})`) and run outward
-    /// (`x_i = D_i⁻¹ y_i − L_{i+1}ᵀ x_{i+1}`). Allocates nothing.
-    pub fn solve_fields(&self, [(u, fu), (t, ft)]: [(&mut [f64], usize); 2]) {
+    /// (`x_i = D_i⁻¹ y_i − L_{i+1}ᵀ x_{i+1}`). Allocates nothing. Compiled for AVX where the
+    /// CPU has it ([`dispatch::run`]: the same operations, the same bits).
+    pub fn solve_fields(&self, fields: [(&mut [f64], usize); 2]) {
+        dispatch::run(Solve {
+            factor: self,
+            fields,
+        })
+    }
+
+    /// The sweeps of [`TwistedBlockLdlt::solve_fields`].
+    #[inline(always)]
+    fn sweeps(&self, [(u, fu), (t, ft)]: [(&mut [f64], usize); 2]) {
         let n = self.n;
         if n < 3 {
             let mut y = [[0.0; 2]; 2];
@@ -174,7 +200,8 @@ impl TwistedBlockLdlt {
         let rows = |j: usize| (top.l(1 + j), bottom.l(1 + j));
         let (lt, lb) = (top.row.0, bottom.row.0);
         inward(&mut fields, 0..still.start, &mut y, rows);
-        inward(&mut fields, still.clone(), &mut y, |_| (&lt, &lb));
+        let squares = (&top.square, &bottom.square);
+        inward_in_pairs(&mut fields, still.clone(), &mut y, (&lt, &lb), squares);
         inward(&mut fields, still.end..common, &mut y, rows);
         let [u_top, t_top, u_bottom, t_bottom] = fields;
         let [mut yt, mut yb] = y;
@@ -208,9 +235,8 @@ impl TwistedBlockLdlt {
         };
         let (rt, rb) = (top.row, bottom.row);
         outward(&mut fields, 0..still.start, &mut x, rows);
-        outward(&mut fields, still.clone(), &mut x, |_| {
-            ((&rt.1, &rt.0), (&rb.1, &rb.0))
-        });
+        let rows_still = ((&rt.1, &rt.0), (&rb.1, &rb.0));
+        outward_in_pairs(&mut fields, still.clone(), &mut x, rows_still, squares);
         outward(&mut fields, still.end..common, &mut x, rows);
         let [u_top, t_top, u_bottom, t_bottom] = fields;
         let [mut xt, mut xb] = x;
@@ -240,6 +266,20 @@ impl TwistedBlockLdlt {
                 *v = x[1];
             }
         }
+    }
+}
+
+/// A solve's sweeps with their arguments, for [`dispatch::run`].
+struct Solve<'a> {
+    factor: &'a TwistedBlockLdlt,
+    fields: [(&'a mut [f64], usize); 2],
+}
+
+impl dispatch::Kernel for Solve<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn call(self) {
+        self.factor.sweeps(self.fields)
     }
 }
 
@@ -287,6 +327,88 @@ fn meet_descending(
     a.start.max(b.start).min(end)..end
 }
 
+/// [`outward`] over a stretch where both halves' rows are constant, two rows per link of each
+/// chain ([`pair_out`]); an odd last row by [`outward`].
+#[inline(always)]
+fn outward_in_pairs<'a>(
+    fields: &mut [&mut [f64]; 4],
+    js: Range<usize>,
+    x: &mut [[f64; 2]; 2],
+    (rt, rb): (OutRow<'a>, OutRow<'a>),
+    (st, sb): (&Block, &Block),
+) {
+    let [u_top, t_top, u_bottom, t_bottom] = fields;
+    let [xt, xb] = x;
+    let nt = u_top.len();
+    let pairs = js.start..js.start + js.len() / 2 * 2;
+    for j in pairs.clone().step_by(2) {
+        let top = [nt - 1 - j, nt - 2 - j];
+        *xt = pair_out((u_top, t_top), top, rt, st, *xt);
+        *xb = pair_out((u_bottom, t_bottom), [j, j + 1], rb, sb, *xb);
+    }
+    outward(fields, pairs.end..js.end, x, |_| (rt, rb));
+}
+
+/// Rows `a` then `b` of the outward sweep with constant rows `(D⁻¹, L)`: with `e = D⁻¹ y`,
+/// `x_a = e_a − Lᵀ x` hangs off the chain and `x_b = (e_b − Lᵀ e_a) + (L²)ᵀ x` carries it.
+#[inline(always)]
+fn pair_out(
+    (u, t): (&mut [f64], &mut [f64]),
+    [a, b]: [usize; 2],
+    (inv_d, l): OutRow<'_>,
+    square: &Block,
+    x: [f64; 2],
+) -> [f64; 2] {
+    let (ea, eb) = (
+        d_inv_mul(inv_d, [u[a], t[a]]),
+        d_inv_mul(inv_d, [u[b], t[b]]),
+    );
+    let xa = sub(ea, mul_transposed(l, x));
+    let xb = add(sub(eb, mul_transposed(l, ea)), mul_transposed(square, x));
+    (u[a], t[a], u[b], t[b]) = (xa[0], xa[1], xb[0], xb[1]);
+    xb
+}
+
+/// [`inward`] over a stretch where both halves' rows are constant, two rows per link of each
+/// chain ([`pair_in`]): a chain waits on one 2 × 2 product per two rows. An odd last row by
+/// [`inward`].
+#[inline(always)]
+fn inward_in_pairs(
+    fields: &mut [&mut [f64]; 4],
+    js: Range<usize>,
+    y: &mut [[f64; 2]; 2],
+    (lt, lb): (&Block, &Block),
+    (st, sb): (&Block, &Block),
+) {
+    let [u_top, t_top, u_bottom, t_bottom] = fields;
+    let [yt, yb] = y;
+    let nb = u_bottom.len();
+    let pairs = js.start..js.start + js.len() / 2 * 2;
+    for j in pairs.clone().step_by(2) {
+        *yt = pair_in((u_top, t_top), [j, j + 1], lt, st, *yt);
+        let bottom = [nb - 1 - j, nb - 2 - j];
+        *yb = pair_in((u_bottom, t_bottom), bottom, lb, sb, *yb);
+    }
+    inward(fields, pairs.end..js.end, y, |_| (lt, lb));
+}
+
+/// Rows `a` then `b` of the inward sweep with a constant `L`: `y_a = b_a − L y` hangs off the
+/// chain and `y_b = (b_b − L b_a) + L² y` carries it.
+#[inline(always)]
+fn pair_in(
+    (u, t): (&mut [f64], &mut [f64]),
+    [a, b]: [usize; 2],
+    l: &Block,
+    square: &Block,
+    y: [f64; 2],
+) -> [f64; 2] {
+    let (ba, bb) = ([u[a], t[a]], [u[b], t[b]]);
+    let ya = sub(ba, mul(l, y));
+    let yb = add(sub(bb, mul(l, ba)), mul(square, y));
+    (u[a], t[a], u[b], t[b]) = (ya[0], ya[1], yb[0], yb[1]);
+    yb
+}
+
 /// `y ← [u, t] − L y`, written back to `(u, t)`.
 #[inline(always)]
 fn step_in(u: &mut f64, t: &mut f64, l: &Block, y: [f64; 2]) -> [f64; 2] {
@@ -329,6 +451,11 @@ fn meet_ascending(top: &Range<usize>, bottom: &Range<usize>, common: usize) -> R
 #[inline(always)]
 fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     [a[0] - b[0], a[1] - b[1]]
+}
+
+#[inline(always)]
+fn add(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    [a[0] + b[0], a[1] + b[1]]
 }
 
 #[cfg(test)]
@@ -386,7 +513,17 @@ mod tests {
                     let (mut ut, mut tt) = (up.clone(), tp.clone());
                     let mut y = vec![[0.0; 2]; n];
                     plain.solve_fields([(&mut up, fu), (&mut tp, ft)], &mut y);
+                    let (mut ub, mut tb) = (ut.clone(), tt.clone());
                     twisted.solve_fields([(&mut ut, fu), (&mut tt, ft)]);
+                    // Dispatched (AVX where the CPU has it) and called directly (the
+                    // baseline): the same bits.
+                    let fields = [(&mut ub[..], fu), (&mut tb[..], ft)];
+                    dispatch::Kernel::call(Solve {
+                        factor: &twisted,
+                        fields,
+                    });
+                    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                    assert_eq!((bits(&ub), bits(&tb)), (bits(&ut), bits(&tt)), "n {n}");
                     let scale = up.iter().chain(&tp).fold(1.0f64, |m, v| m.max(v.abs()));
                     for (p, q) in up.iter().chain(&tp).zip(ut.iter().chain(&tt)) {
                         assert!(
