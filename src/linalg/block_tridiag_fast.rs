@@ -151,7 +151,7 @@ impl TwistedBlockLdlt {
     /// two chains run inward (`y_i = b_i − L_i y_{i−1}`, kept in the fields), meet at the twist
     /// (`x_m = T_m⁻¹ (b_m − L_m y_{m−1} − L'_k y'_{k−1})`) and run outward
     /// (`x_i = D_i⁻¹ y_i − L_{i+1}ᵀ x_{i+1}`). Allocates nothing. Compiled for AVX where the
-    /// CPU has it ([`dispatch::run`]: the same operations, the same bits).
+    /// CPU has it (`dispatch::run`: the same operations, the same bits).
     pub fn solve_fields(&self, fields: [(&mut [f64], usize); 2]) {
         dispatch::run(Solve {
             factor: self,
