@@ -70,6 +70,11 @@ enum Command {
         /// [heat] also θ(x, t). A figure that cannot be drawn after the run exits 1.
         #[arg(long)]
         figure: bool,
+        /// Write a run that breaks its certificate (an energy-identity residual over its bound
+        /// at some step) instead of exiting 1 without output; a warning on stderr names the
+        /// step, and summary.json says `"certified": false`.
+        #[arg(long)]
+        uncertified: bool,
     },
     /// Run the talk's scenes and draw their figures (PNG and SVG): one per scene (colour map of
     /// u(x, t) and contact history) and one per talk figure (l = 0 beside forced).
@@ -148,6 +153,10 @@ enum Command {
         /// Override a scene key, e.g. --set time.step=0.001 (repeatable).
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        /// Output folder of comparison.md, the table also printed [default:
+        /// out/compare-<scene>].
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// List the built-in scenes.
     Scenes,
@@ -217,7 +226,8 @@ fn main() {
             scene,
             solvers,
             set,
-        } => match compare(&scene, &solvers, &set) {
+            out,
+        } => match compare(&scene, &solvers, &set, out) {
             Ok(()) => 0,
             Err(e) => {
                 eprintln!("error: {e}");
@@ -230,11 +240,17 @@ fn main() {
             solver,
             mut set,
             figure,
+            uncertified,
         } => {
             if let Some(s) = solver {
                 set.push(format!("solver.method=\"{s}\""));
             }
-            match run_any(&name, out, &set, figure) {
+            let certify = if uncertified {
+                viscobar::output::Certify::Record
+            } else {
+                viscobar::output::Certify::Strict
+            };
+            match run_any(&name, out, &set, figure, certify) {
                 Ok(()) => 0,
                 Err(code) => code,
             }
@@ -354,19 +370,42 @@ fn all_builtin_names() -> Vec<&'static str> {
 }
 
 /// `viscobar run` of a bar or plane scene; the exit code on failure.
-fn run_any(name: &str, out: Option<PathBuf>, set: &[String], figure: bool) -> Result<(), i32> {
-    let fail = |message: String, code: i32| {
-        eprintln!("error: {message}");
-        code
+fn run_any(
+    name: &str,
+    out: Option<PathBuf>,
+    set: &[String],
+    figure: bool,
+    certify: viscobar::output::Certify,
+) -> Result<(), i32> {
+    let fail = |e: viscobar::RunError| {
+        let hint = if matches!(e, viscobar::RunError::Uncertified(_)) {
+            " (nothing written; `--uncertified` writes such a run anyway)"
+        } else {
+            ""
+        };
+        eprintln!("error: {e}{hint}");
+        e.exit_code()
     };
-    let (scene_name, any) = scene::load_any(name, set).map_err(|e| fail(e.to_string(), 2))?;
+    let (scene_name, any) = scene::load_any(name, set).map_err(|e| {
+        eprintln!("error: {e}");
+        2
+    })?;
+    let options = viscobar::output::RunOptions {
+        progress: std::io::stderr().is_terminal(),
+        certify,
+    };
     match any {
         scene::AnyScene::Bar(bar) => {
             let out = out.unwrap_or_else(|| PathBuf::from("out").join(&scene_name));
-            run(&scene_name, &bar, &out).map_err(|e| fail(e.to_string(), e.exit_code()))?;
+            let summary = viscobar::output::run_to_dir_with(&scene_name, &bar, &out, options)
+                .map_err(fail)?;
+            report(&summary, &out);
             if figure {
                 let files = viscobar::study::figures::write_scene_figure(&scene_name, &bar, &out)
-                    .map_err(|e| fail(e.to_string(), FIGURE_FAILED))?;
+                    .map_err(|e| {
+                    eprintln!("error: {e}");
+                    FIGURE_FAILED
+                })?;
                 for f in &files {
                     println!("wrote {}", f.display());
                 }
@@ -375,9 +414,9 @@ fn run_any(name: &str, out: Option<PathBuf>, set: &[String], figure: bool) -> Re
         }
         scene::AnyScene::Plane(plane) => {
             let out = out.unwrap_or_else(|| PathBuf::from("out").join(&scene_name));
-            let progress = std::io::stderr().is_terminal();
-            let summary = viscobar::output::run_plane_to_dir(&scene_name, &plane, &out, progress)
-                .map_err(|e| fail(e.to_string(), e.exit_code()))?;
+            let summary =
+                viscobar::output::run_plane_to_dir_with(&scene_name, &plane, &out, options)
+                    .map_err(fail)?;
             report(&summary, &out);
             if figure {
                 plane_figure(&scene_name, &plane, &out)?;
@@ -408,17 +447,6 @@ fn plane_figure(name: &str, scene: &scene::PlaneScene, out: &std::path::Path) ->
     }
 }
 
-fn run(
-    scene_name: &str,
-    scene: &viscobar::Scene,
-    out: &std::path::Path,
-) -> Result<(), viscobar::RunError> {
-    let summary =
-        viscobar::output::run_to_dir(scene_name, scene, out, std::io::stderr().is_terminal())?;
-    report(&summary, out);
-    Ok(())
-}
-
 /// The closing lines of `run`, either body: what ran, how fast, the identity residual, one
 /// line of contact episodes per group of constraints, and a warning for inaccurate OSQP steps.
 fn report(summary: &viscobar::Summary, out: &std::path::Path) {
@@ -440,6 +468,12 @@ fn report(summary: &viscobar::Summary, out: &std::path::Path) {
     }
     if let Some(d) = summary.friction_dissipation {
         println!("  friction dissipation {d:.3e}");
+    }
+    if let Some(f) = &summary.certificate.first_failure {
+        eprintln!(
+            "warning: the run is not certified: {f}; written because of --uncertified \
+             (summary.json: \"certified\": false)"
+        );
     }
     if let Some(n) = summary.inaccurate_steps.filter(|n| *n > 0) {
         eprintln!(
@@ -565,40 +599,62 @@ fn parse_methods(list: &str) -> Result<Vec<SolverMethod>, SceneError> {
 }
 
 /// `viscobar compare`: each solver after the first run side by side with the first, one row
-/// of the Markdown table per pair, printed as soon as it is measured. A solver that cannot
+/// of the Markdown table per pair, printed and written to `comparison.md` in `out`. A solver that cannot
 /// handle the scene (the bar's penalty solver on an obstacle) gets a row saying why.
-fn compare(name: &str, solvers: &str, set: &[String]) -> Result<(), viscobar::RunError> {
+fn compare(
+    name: &str,
+    solvers: &str,
+    set: &[String],
+    out: Option<PathBuf>,
+) -> Result<(), viscobar::RunError> {
     let methods = parse_methods(solvers)?;
-    match scene::load_any(name, set)? {
-        (scene_name, scene::AnyScene::Bar(s)) => compare_on(&scene_name, s.as_ref(), &methods),
-        (scene_name, scene::AnyScene::Plane(s)) => compare_on(&scene_name, s.as_ref(), &methods),
-    }
+    let (scene_name, table) = match scene::load_any(name, set)? {
+        (n, scene::AnyScene::Bar(s)) => (n.clone(), compare_on(&n, s.as_ref(), &methods)?),
+        (n, scene::AnyScene::Plane(s)) => (n.clone(), compare_on(&n, s.as_ref(), &methods)?),
+    };
+    let out = out.unwrap_or_else(|| PathBuf::from("out").join(format!("compare-{scene_name}")));
+    let path = out.join("comparison.md");
+    let written = std::fs::create_dir_all(&out)
+        .and_then(|()| viscobar::output::files::write_atomically(&path, table.as_bytes()));
+    written.map_err(|source| viscobar::RunError::Write {
+        path: path.clone(),
+        source,
+    })?;
+    print!("{table}");
+    println!("\nwrote {}", path.display());
+    Ok(())
 }
 
-/// [`compare`] on a scene of either body.
+/// [`compare`]'s table (Markdown) on a scene of either body.
 fn compare_on<S: viscobar::study::refine::StudyScene>(
     scene_name: &str,
     scene: &S,
     methods: &[SolverMethod],
-) -> Result<(), viscobar::RunError> {
+) -> Result<String, viscobar::RunError> {
+    use std::fmt::Write as _;
     use viscobar::study::compare::{compare, with_solver};
     let reference = with_solver(scene, methods[0]);
     // Refused here (exit 2) if the reference itself cannot handle the scene.
     let groups = reference.simulation()?.contact().groups().len();
     let dash = || "–".to_string();
-    println!(
+    let mut table = String::new();
+    writeln!(
+        table,
         "{scene_name}: {} steps of dt = {}, {} elements; each solver against `{}`\n",
         scene.steps(),
         scene.dt(),
         scene.elements(),
         methods[0].name()
-    );
-    println!(
+    )
+    .expect("a String takes writes");
+    writeln!(
+        table,
         "| solvers | steps | max \\|Δu\\| | at step | max \\|Δu\\| / max \\|u\\| \
          | max \\|Δreaction\\| (per group) | max \\|Δreaction\\| / max \\|reaction\\| \
          | max violation | iterations mean / max | wall time (s) |"
-    );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    )
+    .expect("a String takes writes");
+    table.push_str("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for &method in &methods[1..] {
         let pair = format!("{} vs {}", method.name(), methods[0].name());
         let other = with_solver(scene, method);
@@ -607,7 +663,9 @@ fn compare_on<S: viscobar::study::refine::StudyScene>(
             Err(viscobar::RunError::Scene(SceneError::Invalid { field, allowed, .. }))
                 if field == "solver.method" =>
             {
-                println!("| {pair} | does not apply: {allowed} |{}", " |".repeat(8));
+                let cells = " |".repeat(8);
+                writeln!(table, "| {pair} | does not apply: {allowed} |{cells}")
+                    .expect("a String takes writes");
                 continue;
             }
             Err(e) => return Err(e),
@@ -628,7 +686,8 @@ fn compare_on<S: viscobar::study::refine::StudyScene>(
         } else {
             (dash(), dash())
         };
-        println!(
+        writeln!(
+            table,
             "| {pair} | {} | {:.3e} | {} | {} | {dr} | {dr_rel} | {:.1e} | {:.1} / {} | {:.3} |",
             a.steps,
             a.max_difference,
@@ -638,9 +697,10 @@ fn compare_on<S: viscobar::study::refine::StudyScene>(
             s.solver_iterations.mean,
             s.solver_iterations.max,
             s.wall_time_s
-        );
+        )
+        .expect("a String takes writes");
     }
-    Ok(())
+    Ok(table)
 }
 
 /// The contact episodes of one end (or of the obstacle) in one line: when, impulse and the

@@ -25,11 +25,9 @@ pub const SELECTIVE_BAND: (f64, f64) = (0.963, 1.003);
 /// Full integration at `ν = 0.4999` locks: its deflection is below this share of Timoshenko's
 /// (measured VERIFICATION.md's last row).
 pub const LOCKED_BELOW: f64 = 0.1;
-/// The energy identity's round-off grows with `λ/μ` (either rule): the solve's backward error
-/// `ε ‖C‖ |z|` lies partly along the stiff volumetric directions, which the energy weighs by
-/// `λ`; measured 15–35 `ε λ/μ` on the cantilever up to `λ/μ = 5000`. The bound is
-/// `PLANE_IDENTITY_TOL + LAMBDA_IDENTITY_ULPS ε λ/μ`.
-pub const LAMBDA_IDENTITY_ULPS: f64 = 64.0;
+/// The energy identity's growth with `λ/μ`: the run's own bound
+/// (`viscobar::scheme::certify`), measured here.
+pub use viscobar::scheme::certify::LAMBDA_IDENTITY_ULPS;
 /// Steps of the identity runs of the cantilever (`time.end = 4`, 80 steps).
 pub const IDENTITY_RUN_END: f64 = 4.0;
 /// The patch test: interior nodes reproduce a linear field to round-off, relative to its

@@ -15,6 +15,7 @@ use crate::linalg::tridiag::Uniform;
 use crate::scene::expr::Expression;
 use crate::scene::{Condition, Scene, SceneError, SolverMethod};
 use crate::scheme::body::{Body, EnergySums, FullMassRows};
+use crate::scheme::certify::{IDENTITY_TOL, MAX_IDENTITY_BOUND, conditioned_bound};
 use crate::scheme::contact::{ContactSet, Group, Positions};
 use crate::scheme::{Load, RunError, Scheme, Setup, Unstarted};
 use crate::step::{BlockPivotSolver, ExactSolver, OsqpSolver, PenaltySolver, StepSolver};
@@ -70,9 +71,16 @@ pub struct BarBody {
     c_w: f64,
     /// `u_0` and `u_1`, evaluated again on request rather than kept (2 × J doubles).
     initial: InitialData,
+    /// `κ(C)` (Sturm bisection, [`crate::linalg::spectrum`]), for the identity's bound.
+    condition: f64,
 }
 
 impl BarBody {
+    /// `κ(C)`, the step matrix's condition number.
+    pub fn condition(&self) -> f64 {
+        self.condition
+    }
+
     pub fn discretisation(&self) -> &Discretisation {
         &self.disc
     }
@@ -86,6 +94,11 @@ impl BarBody {
 }
 
 impl Body for BarBody {
+    /// [`conditioned_bound`] of the bar's `C`.
+    fn identity_tolerance(&self) -> f64 {
+        conditioned_bound(IDENTITY_TOL, self.disc.unknowns(), self.condition)
+    }
+
     const NAME: &'static str = "bar";
 
     fn unknowns(&self) -> usize {
@@ -220,6 +233,29 @@ impl Body for BarBody {
     }
 }
 
+/// `κ(C)` of the step matrix (infinite where it is numerically singular); a scene so stiff
+/// that the identity's bound would exceed [`MAX_IDENTITY_BOUND`] is refused naming
+/// `time.step`.
+fn condition_of(disc: &Discretisation) -> Result<f64, SceneError> {
+    let condition =
+        crate::linalg::spectrum::condition_number(&disc.step_matrix).unwrap_or(f64::INFINITY);
+    let bound = conditioned_bound(IDENTITY_TOL, disc.unknowns(), condition);
+    if bound > MAX_IDENTITY_BOUND {
+        return Err(SceneError::Invalid {
+            field: "time.step".into(),
+            value: disc.dt.to_string(),
+            allowed: format!(
+                "a step matrix with condition number {condition:.1e} (bar.viscosity = {}, \
+                 Δt/Δx = {:.1e}) holds the energy identity only to {bound:.1e}, above \
+                 {MAX_IDENTITY_BOUND:e}: take a smaller step or viscosity",
+                disc.alpha,
+                disc.dt / disc.dx
+            ),
+        });
+    }
+    Ok(condition)
+}
+
 /// Builds the step solver a scene asks for, for `disc`'s step matrix and constrained nodes.
 pub fn make_solver(scene: &Scene, disc: &Discretisation) -> Result<Box<dyn StepSolver>, RunError> {
     make_solver_with(scene, disc, Kernels::TWINS)
@@ -306,13 +342,19 @@ fn setup(
     let mut u0_full = vec![0.0; nodes];
     let mut v0_full = vec![0.0; nodes];
     initial.eval_into(&disc, &mut u0_full, &mut v0_full)?;
+    let ends = scene.signorini_ends();
     for c in &disc.constraints {
         if u0_full[c.node] < -c.gap {
+            // The key whose gap bounds the node: an end's own, or the obstacle's where it is
+            // the smaller one under that end.
+            let end_gap = |side| ends.iter().find(|(s, _)| *s == side).map(|e| e.1);
+            let gap_field = match c.side {
+                Some(side) if end_gap(side) == Some(c.gap) => format!("{}.gap", side.name()),
+                _ => "obstacle.gap".to_string(),
+            };
             return Err(SceneError::Inadmissible {
                 field: "initial.displacement".into(),
-                gap_field: c
-                    .side
-                    .map_or("obstacle.gap".to_string(), |s| format!("{}.gap", s.name())),
+                gap_field,
                 node: c.node,
                 x: disc.x(c.node),
                 value: u0_full[c.node],
@@ -330,7 +372,9 @@ fn setup(
     };
     let (displacement, velocity) = (restrict(u0_full), restrict(v0_full));
     let contact = contact_set(&disc).with_motion(disc.motion.clone());
+    let condition = condition_of(&disc)?;
     let body = BarBody {
+        condition,
         kernels,
         uniform: disc.mass.uniform().zip(disc.stiffness.uniform()),
         inv_dt2: 1.0 / (dt * dt),

@@ -16,6 +16,7 @@ pub mod text;
 pub mod vtk;
 
 pub use run::{
-    run_in_memory, run_plane_in_memory, run_plane_to_dir, run_thermal_in_memory, run_to_dir,
+    Certify, RunOptions, run_in_memory, run_plane_in_memory, run_plane_to_dir,
+    run_plane_to_dir_with, run_thermal_in_memory, run_to_dir, run_to_dir_with,
 };
 pub use summary::{ContactEpisode, Summary, Tracker};

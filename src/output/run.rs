@@ -16,19 +16,49 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+/// What a run does with a step that breaks its certificate ([`crate::scheme::certify`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Certify {
+    /// End the run at that step with [`RunError::Uncertified`]; a run to a folder writes
+    /// nothing.
+    #[default]
+    Strict,
+    /// Finish the run; its summary says `certified: false` and names the first failure.
+    Record,
+}
+
+/// The records of a run so far, checked against its certificate as `certify` asks.
+fn observe(tracker: &mut Tracker, r: &StepRecord, certify: Certify) -> Result<(), RunError> {
+    match tracker.observe(r) {
+        Some(failure) if certify == Certify::Strict => Err(RunError::Uncertified(failure)),
+        _ => Ok(()),
+    }
+}
+
 /// Steps `sim` to step `steps`, keeping every record (the start-up step first); returns them
-/// with the summary and the finished simulation.
+/// with the summary and the finished simulation. A step that breaks the run's certificate
+/// ends it ([`Certify::Strict`]).
 pub fn run_scheme_in_memory<B: Body>(
+    name: &str,
+    sim: Scheme<B>,
+    steps: usize,
+) -> Result<(Vec<StepRecord>, Summary, Scheme<B>), RunError> {
+    run_scheme_in_memory_with(name, sim, steps, Certify::Strict)
+}
+
+/// [`run_scheme_in_memory`], with a certificate failure handled as `certify` says.
+pub fn run_scheme_in_memory_with<B: Body>(
     name: &str,
     mut sim: Scheme<B>,
     steps: usize,
+    certify: Certify,
 ) -> Result<(Vec<StepRecord>, Summary, Scheme<B>), RunError> {
     let start = Instant::now();
     let mut tracker = Tracker::new(&sim, !sim.is_forced());
     let mut records = vec![sim.first_record()];
     for _ in 1..steps {
         let r = sim.step()?;
-        tracker.observe(&r);
+        observe(&mut tracker, &r, certify)?;
         records.push(r);
     }
     let summary = tracker.finish(name, &sim, start.elapsed().as_secs_f64());
@@ -114,6 +144,36 @@ pub fn run_to_dir(
     out: &Path,
     progress: bool,
 ) -> Result<Summary, RunError> {
+    run_to_dir_with(name, scene, out, RunOptions::strict(progress))
+}
+
+/// How a run to a folder reports itself.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RunOptions {
+    /// A progress bar on stderr for long runs (with the `progress` feature).
+    pub progress: bool,
+    /// What a step that breaks the run's certificate does.
+    pub certify: Certify,
+}
+
+impl RunOptions {
+    /// A run that ends at a step breaking its certificate.
+    pub fn strict(progress: bool) -> Self {
+        Self {
+            progress,
+            certify: Certify::Strict,
+        }
+    }
+}
+
+/// [`run_to_dir`] with `options`: with [`Certify::Record`] a run that breaks its certificate
+/// is written whole, its summary saying so.
+pub fn run_to_dir_with(
+    name: &str,
+    scene: &Scene,
+    out: &Path,
+    options: RunOptions,
+) -> Result<Summary, RunError> {
     let start = Instant::now();
     // Again here: a scene's fields are public, so this one may not have been validated.
     scene.output.format.check_available()?;
@@ -122,7 +182,7 @@ pub fn run_to_dir(
         steps: scene.steps(),
         output: &scene.output,
         sampling: scene.output_sampling(),
-        progress,
+        options,
     };
     if scene.heat.is_some() {
         return run.write(ThermalSimulation::prepare(scene)?, start, out);
@@ -137,6 +197,16 @@ pub fn run_plane_to_dir(
     out: &Path,
     progress: bool,
 ) -> Result<Summary, RunError> {
+    run_plane_to_dir_with(name, scene, out, RunOptions::strict(progress))
+}
+
+/// [`run_plane_to_dir`] with `options`, as [`run_to_dir_with`].
+pub fn run_plane_to_dir_with(
+    name: &str,
+    scene: &PlaneScene,
+    out: &Path,
+    options: RunOptions,
+) -> Result<Summary, RunError> {
     let start = Instant::now();
     scene.output.format.check_available()?;
     let prepared = PlaneSimulation::prepare(scene)?;
@@ -145,7 +215,7 @@ pub fn run_plane_to_dir(
         steps: scene.steps(),
         output: &scene.output,
         sampling: scene.output_sampling(),
-        progress,
+        options,
     };
     run.write(prepared, start, out)
 }
@@ -156,7 +226,7 @@ struct Run<'a> {
     steps: usize,
     output: &'a OutputSpec,
     sampling: OutputSampling,
-    progress: bool,
+    options: RunOptions,
 }
 
 impl Run<'_> {
@@ -220,7 +290,7 @@ impl Run<'_> {
         write_row(&mut hist, &sim.first_record()).map_err(io(&hist_path))?;
         let (steps, every) = (self.steps, self.output.every as usize);
         let keep = |n: usize| n.is_multiple_of(every) || n == steps;
-        let bar = Progress::new(self.progress, steps, sim.body().unknowns());
+        let bar = Progress::new(self.options.progress, steps, sim.body().unknowns());
         fn kept<B: Body>(sim: &Scheme<B>) -> Kept<'_, B> {
             (sim.body(), sim.contact(), sim.reactions())
         }
@@ -229,7 +299,7 @@ impl Run<'_> {
         }
         for _ in 1..steps {
             let r = sim.step()?;
-            tracker.observe(&r);
+            observe(&mut tracker, &r, self.options.certify)?;
             write_row(&mut hist, &r).map_err(io(&hist_path))?;
             if keep(r.step) {
                 disp.write(r.step, sim.time(), sim.state(), kept(&sim))?;
@@ -297,5 +367,46 @@ impl Progress {
         if let Some(b) = self.bar {
             b.finish_and_clear();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A record over its bound ends a strict run with the failure named, and is recorded by a
+    /// run that goes on; the summary then says `certified: false` with the first failure. (No
+    /// valid scene breaks its certificate, so the record's residual is set here.)
+    #[test]
+    fn a_step_over_its_bound_ends_a_strict_run_and_marks_a_recording_one() {
+        let (_, scene) = crate::scene::load("impact", &["time.end=0.05".into()]).unwrap();
+        let mut sim = Simulation::new(&scene).unwrap();
+        let mut tracker = Tracker::new(&sim, true);
+        let mut r = sim.step().unwrap();
+        assert!(observe(&mut tracker, &r, Certify::Strict).is_ok());
+        r.identity_residual = 2.0 * r.identity_bound;
+        match observe(&mut tracker.clone(), &r, Certify::Strict) {
+            Err(RunError::Uncertified(f)) => {
+                assert_eq!(
+                    (f.step, f.value, f.bound),
+                    (2, r.identity_residual, r.identity_bound)
+                );
+                let message = RunError::Uncertified(f).to_string();
+                assert!(message.contains("step 2") && message.contains("energy identity"));
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(observe(&mut tracker, &r, Certify::Record).is_ok());
+        let summary = tracker.finish("impact", &sim, 1.0);
+        assert!(!summary.certificate.certified);
+        assert_eq!(summary.certificate.measured_steps, 3);
+        let json = serde_json::to_value(&summary).unwrap();
+        assert_eq!(json["certified"], false);
+        assert_eq!(json["first_failure"]["step"], 2);
+        assert_eq!(RunError::Uncertified(json_failure(&summary)).exit_code(), 1);
+    }
+
+    fn json_failure(s: &Summary) -> crate::scheme::CertificateFailure {
+        s.certificate.first_failure.clone().unwrap()
     }
 }

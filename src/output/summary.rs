@@ -4,7 +4,7 @@
 
 use crate::output::text::output_time;
 use crate::scheme::clock::PhaseTimes;
-use crate::scheme::{Body, Scheme, StepRecord};
+use crate::scheme::{Body, Certificate, CertificateFailure, Scheme, StepRecord};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -80,6 +80,11 @@ pub struct Summary {
     /// without load (where the scheme cannot gain energy), `null` otherwise.
     pub max_energy_rise: Option<f64>,
     pub max_identity_residual: f64,
+    /// The run's certificate: `certified` (every measured step's identity residual within its
+    /// bound), `measured_steps`, and on failure `first_failure` (step, time, check, value,
+    /// bound); [`crate::scheme::certify`].
+    #[serde(flatten)]
+    pub certificate: Certificate,
     /// Largest `|gap · reaction|` over steps and constraints.
     pub max_complementarity: f64,
     /// Largest penetration `max(0, −gap)`.
@@ -111,9 +116,10 @@ pub struct Summary {
 
 /// Where the time of the steps goes, as fractions of the timed phases of the sampled steps
 /// (one in [`crate::scheme::clock::TIMING_SAMPLE_EVERY`]): `rhs` (load and right-hand side),
-/// `solver` (the step solver and `u += z`), `diagnostics` (energy identity and contact state).
-/// `stepping` is the sampled phases' share of the wall time (the rest is set-up, start-up and
-/// writing the outputs), extrapolated from the sample.
+/// `solver` (the step solver and `u += z`), `diagnostics` (energy identity and contact state);
+/// the three add up to 1. `stepping` is the step loop's share of the wall time, measured from
+/// the first step after the start-up to the last (with the rows it writes); the rest is set-up,
+/// start-up and closing the outputs. It is at most 1.
 #[derive(Clone, Copy, Debug, Default, Serialize)]
 pub struct TimeShares {
     pub solver: f64,
@@ -124,19 +130,19 @@ pub struct TimeShares {
 }
 
 impl TimeShares {
-    /// The shares of `p`, measured on the steps `1 → 2 … n − 1 → n` of a run that reached
-    /// `u^n` (`n = steps`; the start-up step is not timed) in `wall_time_s`.
-    pub fn from_phases(p: PhaseTimes, steps: usize, wall_time_s: f64) -> Self {
+    /// The shares of `p`, sampled on the steps `1 → 2 … n − 1 → n` of a run, whose step loop
+    /// took `stepping_s` of its `wall_time_s` (0 when the run's wall time is not known).
+    pub fn from_phases(p: PhaseTimes, stepping_s: f64, wall_time_s: f64) -> Self {
         let total = p.total_ns() as f64;
         let share = |x: u64| if total > 0.0 { x as f64 / total } else { 0.0 };
-        let steps = steps.saturating_sub(1) as f64;
-        let per_step = total / p.sampled_steps.max(1) as f64;
         Self {
             solver: share(p.solve_ns),
             rhs: share(p.rhs_ns),
             diagnostics: share(p.diagnostics_ns),
+            // Both intervals measured, the loop's inside the run's: the `min` only absorbs the
+            // nanoseconds between the two clock reads.
             stepping: if wall_time_s > 0.0 {
-                per_step * steps / (wall_time_s * 1e9)
+                (stepping_s / wall_time_s).min(1.0)
             } else {
                 0.0
             },
@@ -175,6 +181,9 @@ pub struct Tracker {
     records: usize,
     /// `Σ D_f` so far, with friction.
     friction: Option<f64>,
+    certificate: Certificate,
+    /// When the step loop began (the tracker is made after the start-up step).
+    started: std::time::Instant,
 }
 
 impl Tracker {
@@ -202,16 +211,21 @@ impl Tracker {
             iterations_max: 0,
             records: 0,
             friction: (!sim.contact().friction().is_empty()).then_some(0.0),
+            certificate: Certificate::new(),
+            started: std::time::Instant::now(),
         };
+        t.certify(&first);
         t.observe_contact(&first);
         t.last_energy = Some(first.energy);
         t
     }
 
-    /// Takes the record of the next step. With thinned diagnostics, the energy statistics
-    /// cover the measured steps: a rise is then over the steps since the last measured one
-    /// (the identity telescopes, so without load that rise is still ≤ 0 up to round-off).
-    pub fn observe(&mut self, r: &StepRecord) {
+    /// Takes the record of the next step; returns the run's first certificate failure when
+    /// this step is it. With thinned diagnostics, the energy statistics cover the measured
+    /// steps: a rise is then over the steps since the last measured one (the identity
+    /// telescopes, so without load that rise is still ≤ 0 up to round-off).
+    pub fn observe(&mut self, r: &StepRecord) -> Option<CertificateFailure> {
+        let failure = self.certify(r);
         if r.measured {
             self.max_rise = self.max_rise.max(r.energy - self.energy_prev);
             self.energy_prev = r.energy;
@@ -226,6 +240,22 @@ impl Tracker {
         self.records += 1;
         self.observe_contact(r);
         self.last_energy = r.measured.then_some(r.energy);
+        failure
+    }
+
+    /// The certificate's check of a measured record.
+    fn certify(&mut self, r: &StepRecord) -> Option<CertificateFailure> {
+        if !r.measured {
+            return None;
+        }
+        (self.certificate)
+            .observe(r.step, r.time, r.identity_residual, r.identity_bound)
+            .cloned()
+    }
+
+    /// The run's certificate so far.
+    pub fn certificate(&self) -> &Certificate {
+        &self.certificate
     }
 
     fn observe_contact(&mut self, r: &StepRecord) {
@@ -278,12 +308,17 @@ impl Tracker {
             final_time: sim.time(),
             wall_time_s,
             ns_per_unknown_step: wall_time_s * 1e9 / (steps as f64 * unknowns.max(1) as f64),
-            time_shares: TimeShares::from_phases(sim.phase_times(), steps, wall_time_s),
+            time_shares: TimeShares::from_phases(
+                sim.phase_times(),
+                self.started.elapsed().as_secs_f64(),
+                wall_time_s,
+            ),
             energy_initial: self.energy_initial,
             energy_final: self.energy_final,
             max_energy_rise: (self.unforced && self.records > 0)
                 .then(|| self.max_rise / self.energy_initial.max(f64::MIN_POSITIVE)),
             max_identity_residual: self.max_residual,
+            certificate: self.certificate.clone(),
             max_complementarity: self.max_comp,
             max_violation: self.max_violation,
             min_reaction: self.min_reaction,

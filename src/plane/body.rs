@@ -18,6 +18,7 @@ use crate::scene::expr::Expression;
 use crate::scene::plane::PENALTY_CONDENSED_MAX_NORMALS;
 use crate::scene::plane::{EDGE_NAMES, PlaneScene};
 use crate::scheme::body::{Body, EnergySums, FullMassRows};
+use crate::scheme::certify::{LAMBDA_IDENTITY_ULPS, PLANE_IDENTITY_TOL, conditioned_bound};
 use crate::scheme::contact::{ContactSet, Group, Positions};
 use crate::scheme::{Load, RunError, Scheme, Setup, Unstarted};
 use crate::step::{CondensedSolver, OsqpSolver, SparsePenaltySolver, StepSolver};
@@ -148,6 +149,15 @@ impl PlaneBody {
 
 impl Body for PlaneBody {
     const NAME: &'static str = "plane";
+
+    /// `PLANE_IDENTITY_TOL + LAMBDA_IDENTITY_ULPS ε λ/μ + ε n`: the volumetric energy weighs
+    /// the solve's round-off by `λ` ([`crate::scheme::certify::LAMBDA_IDENTITY_ULPS`]), and the
+    /// energy sums over `n` unknowns round by `γ_n`.
+    fn identity_tolerance(&self) -> f64 {
+        let m = self.disc.material;
+        let volumetric = LAMBDA_IDENTITY_ULPS * f64::EPSILON * m.lambda / m.mu;
+        conditioned_bound(PLANE_IDENTITY_TOL + volumetric, self.unknowns(), 0.0)
+    }
 
     fn unknowns(&self) -> usize {
         self.disc.unknowns()

@@ -195,11 +195,7 @@ impl ThermalEnd {
                     value: "missing".into(),
                     allowed: "a `temperature` end needs its temperature, an expression in t".into(),
                 })?;
-                Ok(EndHeat::Temperature(Expression::parse(
-                    &key("value"),
-                    text,
-                    true,
-                )?))
+                Ok(EndHeat::Temperature(in_t_only(&key("value"), text)?))
             }
             ThermalCondition::Exchange => {
                 if !mechanical.1 {
@@ -228,11 +224,27 @@ impl ThermalEnd {
                 let text = self.obstacle.as_deref().unwrap_or("0");
                 Ok(EndHeat::Exchange {
                     coefficient: h,
-                    obstacle: Expression::parse(&key("obstacle"), text, true)?,
+                    obstacle: in_t_only(&key("obstacle"), text)?,
                 })
             }
         }
     }
+}
+
+/// An end's temperature, `θ_end(t)` or `θ_obs(t)`: an expression in `t` alone (an end is a
+/// point, so an `x` in it would be read at one node only); one in `x` is refused naming `key`.
+fn in_t_only(key: &str, text: &str) -> Result<Expression, SceneError> {
+    let e = Expression::parse(key, text, true)?;
+    if e.depends_on_x() {
+        return Err(SceneError::Invalid {
+            field: key.into(),
+            value: format!("\"{text}\""),
+            allowed: "an end's temperature is an expression in t alone (the end is a point): \
+                      write it without x"
+                .into(),
+        });
+    }
+    Ok(e)
 }
 
 /// A scene table (after overrides, before it is read) whose `[left]` or `[right]` holds a

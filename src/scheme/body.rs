@@ -88,6 +88,11 @@ pub trait Body {
     fn nodal_stress(&self, _u: &[f64], _v: &[f64]) -> Option<Vec<[f64; 4]>> {
         None
     }
+    /// The relative round-off bound of a step's energy identity for a solver exact to
+    /// round-off ([`crate::scheme::certify`]).
+    fn identity_tolerance(&self) -> f64 {
+        crate::scheme::certify::IDENTITY_TOL
+    }
 
     // A body with a temperature (the thermal bar) supplies the hooks below; the defaults are
     // those of a body without one, and leave its steps as they are.
@@ -95,9 +100,11 @@ pub trait Body {
     /// Whether the body has a temperature (its outputs gain the thermal columns).
     const TEMPERATURE: bool = false;
     /// Brings the body's data to the step from `t_n` (boundary temperatures at `t_{n+1/2}`,
-    /// which ends exchange heat with `u^n`), before the step's right-hand side; `n = 0` before
-    /// the start-up step. Allocates nothing.
-    fn prepare_step(&mut self, _n: usize, _u: &[f64]) -> Result<(), RunError> {
+    /// which ends exchange heat), before the step's right-hand side; `n = 0` before the
+    /// start-up step. `lower` are the step's bounds `lo_k = −g_k − s_k u^n_{i_k}`, the
+    /// obstacles already moved to `t_{n+1}` ([`crate::scheme::ContactSet::lower_bounds_into`]):
+    /// a body reads contact off them, never off gaps of its own. Allocates nothing.
+    fn prepare_step(&mut self, _n: usize, _lower: &[f64]) -> Result<(), RunError> {
         Ok(())
     }
     /// Completes the start-up increment `u^1 − u^0` that the scheme has put in `increment`

@@ -26,6 +26,9 @@ pub enum RunError {
     Factor(#[from] FactorError),
     #[error("solver `{solver}` cannot be set up: {reason}")]
     SolverSetup { solver: String, reason: String },
+    /// A step broke the run's certificate ([`crate::scheme::certify`]).
+    #[error("the run is not certified: {0}")]
+    Uncertified(crate::scheme::CertificateFailure),
     #[error("cannot write {path}: {source}")]
     Write {
         path: PathBuf,

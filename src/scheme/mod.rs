@@ -8,6 +8,7 @@
 //! Imports [`crate::linalg`], [`crate::step`] and [`crate::scene`].
 
 pub mod body;
+pub mod certify;
 pub mod clock;
 pub mod contact;
 pub mod error;
@@ -16,6 +17,7 @@ pub mod load;
 pub mod stepper;
 
 pub use body::{Body, EnergySums, HeatTerms};
+pub use certify::{Certificate, CertificateFailure};
 pub use contact::{CONTACT_GAP_TOL, ContactSet, ContactState, GroupState, in_contact};
 pub use error::RunError;
 pub use friction::{FrictionState, SLIP_TOL, is_slipping};

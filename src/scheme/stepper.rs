@@ -29,8 +29,12 @@ pub struct StepRecord {
     pub contact_dissipation: f64,
     /// `|E^{n+1/2} − E^{n−1/2} − work − obstacle_work + viscous + D + D_f|` over the largest
     /// of those terms (with a temperature: `+ thermal dissipation + exchange − supply`,
-    /// [`HeatTerms`]).
+    /// [`HeatTerms`]), or over the run's energy resolution [`ENERGY_RESOLUTION`] times the
+    /// largest term measured so far where that is larger.
     pub identity_residual: f64,
+    /// The bound the run's certificate holds `identity_residual` to on a measured step: the
+    /// body's round-off tolerance plus the step solver's allowance ([`crate::scheme::certify`]).
+    pub identity_bound: f64,
     /// `W = −½ Σ_k r_k (g_k^{n+1} − g_k^{n−1})`, the work of moving obstacles (0 when none
     /// moves; of either sign).
     pub obstacle_work: f64,
@@ -64,13 +68,21 @@ pub struct Setup<B> {
     pub diagnostics_every: usize,
 }
 
-/// `E^{n−1/2}` and `|u^n|²_K`, valid when `measured` (the last step was measured).
+/// `E^{n−1/2}` and `|u^n|²_K`, valid when `measured` (the last step was measured), and the
+/// largest term of any identity measured so far (`E^{1/2}` at first).
 #[derive(Clone, Copy, Debug)]
 struct Balance {
     energy: f64,
     potential: f64,
     measured: bool,
+    largest: f64,
 }
+
+/// The energy resolution of a run, in units of the largest term its identity has held: the
+/// terms are sums rounded to `ε` of their size, so a step whose terms have all fallen below
+/// `ε` times that size (a body brought to rest, its increments the rounding of its
+/// displacement) is measured against it, not against its own rounding noise.
+pub const ENERGY_RESOLUTION: f64 = f64::EPSILON;
 
 /// A running simulation of a body: holds `u^n` and `w = u^n − u^{n−1}`; [`Scheme::step`]
 /// advances one step and allocates nothing.
@@ -122,6 +134,7 @@ impl<B: Body> Scheme<B> {
                 energy: 0.0,
                 potential: 0.0,
                 measured: true,
+                largest: 0.0,
             },
             diagnostics_every: setup.diagnostics_every.max(1),
             last_step: setup.steps,
@@ -146,7 +159,9 @@ impl<B: Body> Scheme<B> {
     /// `u^1` is admissible. `z`, `w` and `b` serve as its work space.
     fn start_up(&mut self, v0: &[f64]) -> Result<(), RunError> {
         let (dt, alpha) = (self.body.dt(), self.body.viscosity());
-        self.body.prepare_step(0, &self.u)?;
+        self.contact.advance_gaps(dt)?;
+        self.contact.lower_bounds_into(&self.u, &mut self.lower);
+        self.body.prepare_step(0, &self.lower)?;
         // a = M⁻¹ (F^0 − K u^0 − α K u_1), in z.
         let (acc, kv) = (&mut self.z, &mut self.b);
         self.body.stiffness_mul(&self.u, acc);
@@ -164,8 +179,6 @@ impl<B: Body> Scheme<B> {
         }
         self.body.complete_start_up(&self.u, v0, &mut self.w)?;
         self.body.step_matrix_mul(&self.w, &mut self.b);
-        self.contact.advance_gaps(dt)?;
-        self.contact.lower_bounds_into(&self.u, &mut self.lower);
         let info = (self.solver)
             .solve(&self.b, &self.lower, &mut self.z, &mut self.reactions)
             .map_err(|failure| self.failure(1, failure))?;
@@ -189,12 +202,14 @@ impl<B: Body> Scheme<B> {
             energy,
             potential,
             measured: true,
+            largest: energy.abs(),
         };
         let mut record = StepRecord {
             step: 1,
             time: dt,
             measured: true,
             energy,
+            identity_bound: self.identity_bound(),
             heat,
             iterations: info.iterations,
             ..Default::default()
@@ -221,10 +236,12 @@ impl<B: Body> Scheme<B> {
     /// that is `u^{n+1} = argmin over K_h of ½ uᵀCu − F̃ⁿᵀu`, `C = M/Δt² + K/2 + αK/(2Δt)`. It is
     /// solved for the increment `z = u^{n+1} − u^n`, `w = u^n − u^{n−1}`:
     ///
-    /// 1. `F^n` ([`Load`]) and `b = F^n + M w/Δt² + K((½ − α/(2Δt)) w − u^n)` ([`Body::rhs_into`]):
+    /// 1. `K_h` in the increment: `s_k z_{i_k} >= lo_k = −g_k − s_k u^n_{i_k}`, the one place
+    ///    where a moving obstacle's gap `g_k(t_{n+1})` is read ([`Body::prepare_step`] takes
+    ///    these bounds);
+    /// 2. `F^n` ([`Load`]) and `b = F^n + M w/Δt² + K((½ − α/(2Δt)) w − u^n)` ([`Body::rhs_into`]):
     ///    algebraically `F̃^n − C u^n`, but without the `O(|u|/Δt²)` terms that cancel there, so
     ///    the round-off in `z` is relative to the increment, not to the displacement;
-    /// 2. `K_h` in the increment: `s_k z_{i_k} >= lo_k = −g_k − s_k u^n_{i_k}`;
     /// 3. `z = argmin ½ zᵀCz − bᵀz` over those bounds, with the reactions `r_k` its multipliers,
     ///    by the run's step solver, then `u^{n+1} = u^n + z`;
     /// 4. the contact state of `u^{n+1}` and, on measured steps, the energy identity
@@ -253,15 +270,16 @@ impl<B: Body> Scheme<B> {
         if measure && !self.balance.measured {
             self.restart_balance();
         }
-        // 1. F^n and b.
-        self.body.prepare_step(n, &self.u)?;
+        // 1. The bounds of the increment (moving obstacles first moved to t_{n+1}): every
+        //    consumer of contact (the body's data, the solver, the measures) reads them.
+        self.contact.advance_gaps((n + 1) as f64 * self.body.dt())?;
+        self.contact.lower_bounds_into(&self.u, &mut self.lower);
+        // 2. F^n and b.
+        self.body.prepare_step(n, &self.lower)?;
         self.load.update(&self.body, n)?;
         let force = self.load.force();
         self.body.rhs_into(&self.u, &self.w, force, &mut self.b);
         let clock = clock.lap(&mut self.timing.rhs_ns);
-        // 2. The bounds of the increment (moving obstacles first moved to t_{n+1}).
-        self.contact.advance_gaps((n + 1) as f64 * self.body.dt())?;
-        self.contact.lower_bounds_into(&self.u, &mut self.lower);
         // 3. The constrained minimisation, and u^{n+1} = u^n + z.
         self.solver.set_previous_increment(&self.w);
         let info = (self.solver)
@@ -359,6 +377,8 @@ impl<B: Body> Scheme<B> {
         if !(energy.is_finite() && residual.is_finite()) {
             return Err(self.failure(record.step, StepFailure::NonFinite));
         }
+        self.balance.largest = self.balance.largest.max(scale);
+        let scale = scale.max(ENERGY_RESOLUTION * self.balance.largest);
         record.energy = energy;
         record.work = work;
         record.viscous_dissipation = viscous;
@@ -370,9 +390,16 @@ impl<B: Body> Scheme<B> {
         } else {
             0.0
         };
+        record.identity_bound = self.identity_bound();
         self.balance.potential = sums.potential;
         self.balance.energy = energy;
         Ok(())
+    }
+
+    /// The bound of this step's identity residual: the body's round-off tolerance and what the
+    /// solver's law allows its answers ([`crate::scheme::certify`]).
+    fn identity_bound(&self) -> f64 {
+        self.body.identity_tolerance() + self.solver.identity_allowance()
     }
 
     fn failure(&self, step: usize, failure: StepFailure) -> RunError {

@@ -14,7 +14,7 @@
 
 use crate::linalg::system::{Csc, SpdSystem, TridiagSystem};
 use crate::linalg::tridiag::SymTridiag;
-use crate::step::audit::{INACCURATE_FACTOR, KktAudit, Law};
+use crate::step::audit::{AUDIT_MARGIN, INACCURATE_FACTOR, KktAudit, Law};
 use crate::step::solver::Constraints;
 use crate::step::{
     OsqpStatus, SettingsError, SetupError, SolveInfo, SolverReport, StepFailure, StepSolver,
@@ -183,6 +183,18 @@ pub fn raw_problem(
     .map_err(|e| SetupError::Osqp(e.to_string()))
 }
 
+/// An OSQP solver's identity allowance: `½ ρ·δ` with the audited stationarity `ρ` at its worst
+/// `ratio` to the audit's tolerance `AUDIT_MARGIN · eps_rel` (`INACCURATE_FACTOR` more once an
+/// inaccurate answer was taken, `inaccurate_steps > 0`).
+pub(crate) fn identity_allowance(ratio: f64, inaccurate_steps: u64, eps_rel: f64) -> f64 {
+    let factor = if inaccurate_steps > 0 {
+        INACCURATE_FACTOR
+    } else {
+        1.0
+    };
+    ratio * AUDIT_MARGIN * factor * eps_rel
+}
+
 /// OSQP's answer and whether it was only `SolvedInaccurate` (accepted when
 /// `accept_inaccurate`); any other status is a failure naming it, as OSQP's C library spells
 /// it, and the iterations run.
@@ -323,5 +335,10 @@ impl<S: SpdSystem> StepSolver for OsqpSolver<S> {
             audit: self.audit.report().clone(),
             inaccurate_steps: Some(self.inaccurate_steps),
         })
+    }
+
+    fn identity_allowance(&self) -> f64 {
+        let ratio = self.audit.report().stationarity.max_over_tolerance;
+        identity_allowance(ratio, self.inaccurate_steps, self.settings.eps_rel)
     }
 }

@@ -125,6 +125,14 @@ pub trait StepSolver {
     fn report(&self) -> Option<SolverReport> {
         None
     }
+
+    /// The relative error of the energy identity that the solver's law lets its answers carry
+    /// beyond round-off, from its audit so far: 0 for a solver exact to round-off (exact,
+    /// penalty, Lemke); an iterative solver's stationarity residual `ρ` enters the identity as
+    /// `½ ρ·δ` (the certificate's scaling, [`crate::scheme::certify`]).
+    fn identity_allowance(&self) -> f64 {
+        0.0
+    }
 }
 
 /// `u += z`, compiled for AVX when the CPU has it ([`dispatch`]; the same additions).

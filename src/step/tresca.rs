@@ -18,7 +18,7 @@ use crate::linalg::system::{Csc, SpdSystem};
 use crate::step::audit::{AUDIT_MARGIN, INACCURATE_FACTOR};
 use crate::step::condensed::condensed_matrix;
 use crate::step::friction_audit::{FrictionAudit, FrictionLaw, Thresholds};
-use crate::step::osqp::{OSQP_INFTY, OsqpSettings, accepted, osqp_csc};
+use crate::step::osqp::{OSQP_INFTY, OsqpSettings, accepted, identity_allowance, osqp_csc};
 use crate::step::solver::{Constraints, Friction};
 use crate::step::{SetupError, SolveInfo, SolverReport, StepFailure, StepSolver};
 use osqp::Problem;
@@ -253,5 +253,10 @@ impl<S: SpdSystem> StepSolver for TrescaSolver<S> {
             audit: self.audit.report().clone(),
             inaccurate_steps: Some(self.inaccurate_steps),
         })
+    }
+
+    fn identity_allowance(&self) -> f64 {
+        let ratio = self.audit.report().stationarity.max_over_tolerance;
+        identity_allowance(ratio, self.inaccurate_steps, self.settings.eps_rel)
     }
 }

@@ -10,19 +10,20 @@ use crate::bar::BarBody;
 use crate::linalg::ldlt::Ldlt;
 use crate::scene::SceneError;
 use crate::scene::heat::{EndHeat, HeatExpressions};
+use crate::scheme::RunError;
 use crate::scheme::body::{Body, EnergySums, FullMassRows, HeatTerms};
-use crate::scheme::{RunError, in_contact};
+use crate::scheme::certify::{MAX_IDENTITY_BOUND, THERMAL_IDENTITY_TOL, conditioned_bound};
 use crate::thermal::heat_rows;
 use crate::thermal::matrices::ThermalMatrices;
+use crate::thermal::solver::exchange_state;
 
-/// An exchange end: its node, constraint, unknown, gap and coefficient `h`, `θ_obs(t)`.
+/// An exchange end: its node, constraint, coefficient `h` and `θ_obs(t)`. Its gap is the
+/// contact set's (moved with its obstacle), read off the step's bounds.
 #[derive(Clone, Debug)]
 pub struct ExchangeEnd {
     pub node: usize,
     /// Index into the bar's constraints (the order of the step's bounds).
     pub constraint: usize,
-    pub unknown: usize,
-    pub gap: f64,
     pub coefficient: f64,
     pub obstacle: crate::scene::expr::Expression,
 }
@@ -110,8 +111,6 @@ impl ThermalBody {
                     exchange.push(ExchangeEnd {
                         node,
                         constraint,
-                        unknown: node - first,
-                        gap: constraints[constraint].1,
                         coefficient,
                         obstacle,
                     });
@@ -137,6 +136,19 @@ impl ThermalBody {
                     .into(),
             });
         }
+        let ratio = kappa * dt / (dx * dx);
+        let bound = conditioned_bound(THERMAL_IDENTITY_TOL, n_u + m.n_t, ratio);
+        if bound > MAX_IDENTITY_BOUND {
+            return Err(SceneError::Invalid {
+                field: "heat.diffusivity".into(),
+                value: kappa.to_string(),
+                allowed: format!(
+                    "the heat step's ratio κΔt/Δx² = {ratio:.1e} holds the energy identity only \
+                     to {bound:.1e}, above {MAX_IDENTITY_BOUND:e}: take a smaller diffusivity \
+                     or time.step"
+                ),
+            });
+        }
         let with_source = source.is_some();
         Ok(Self {
             bar,
@@ -157,6 +169,12 @@ impl ThermalBody {
             mask: 0,
             theta_obs: [0.0; 2],
         })
+    }
+
+    /// `κΔt/Δx²`: the heat step's stiffness ratio, which its round-off follows.
+    pub fn diffusion_ratio(&self) -> f64 {
+        let d = self.bar.discretisation();
+        self.m.kappa * d.dt / (d.dx * d.dx)
     }
 
     /// The bar's body.
@@ -468,6 +486,13 @@ fn interior_coefficients(a: &crate::linalg::tridiag::SymTridiag) -> [f64; 2] {
 }
 
 impl Body for ThermalBody {
+    /// [`conditioned_bound`] of the mechanical `C` and of the heat step, whose stiffness ratio
+    /// is `κΔt/Δx²` ([`ThermalBody::diffusion_ratio`]).
+    fn identity_tolerance(&self) -> f64 {
+        let condition = self.bar.condition() + self.diffusion_ratio();
+        conditioned_bound(THERMAL_IDENTITY_TOL, self.unknowns(), condition)
+    }
+
     const NAME: &'static str = "bar";
     const TEMPERATURE: bool = true;
 
@@ -588,17 +613,14 @@ impl Body for ThermalBody {
         self.bar.unknown_of(dof)
     }
 
-    /// The exchange state from the gaps of `u^n` (as the step's bounds give them), `θ_obs(t_n)`,
-    /// the fixed ends' `θ_end(t_{n∓1/2})` and the source's `Q^n`. Allocates nothing.
-    fn prepare_step(&mut self, n: usize, u: &[f64]) -> Result<(), RunError> {
+    /// The exchange state read off the step's bounds by [`exchange_state`], as the step solver
+    /// reads it (the gaps of `u^n` against the obstacles where the step puts them),
+    /// `θ_obs(t_n)`, the fixed ends' `θ_end(t_{n∓1/2})` and the source's `Q^n`. Allocates
+    /// nothing.
+    fn prepare_step(&mut self, n: usize, lower: &[f64]) -> Result<(), RunError> {
         let dt = self.dt();
         let t = n as f64 * dt;
-        let mut mask = 0;
         for (e, x) in self.exchange.iter().enumerate() {
-            let lower = -x.gap - 1.0 * u[x.unknown];
-            if in_contact(-lower) {
-                mask |= 1 << e;
-            }
             let key = if x.node == 0 {
                 "heat.left.obstacle"
             } else {
@@ -606,7 +628,7 @@ impl Body for ThermalBody {
             };
             self.theta_obs[e] = eval_t(&x.obstacle, 0.0, t, key)?;
         }
-        self.mask = mask;
+        self.mask = exchange_state(lower, self.exchange.iter().map(|x| x.constraint));
         let (t_old, t_new) = if n == 0 {
             (0.0, 0.5 * dt)
         } else {

@@ -11,14 +11,16 @@ use crate::linalg::ldlt::Ldlt;
 use crate::scheme::in_contact;
 use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
 
-/// The exchange state of a step: bit `e` set when the constraint `exchange[e]` is in contact
-/// with `u^n`, its gap `−lower[k]` at most [`crate::scheme::CONTACT_GAP_TOL`].
+/// The exchange state of a step: bit `e` set when the `e`-th constraint of `exchange` is in
+/// contact with `u^n`, its gap `−lower[k]` at most [`crate::scheme::CONTACT_GAP_TOL`]. The one
+/// reading of the state: the solver's matrix and the body's right-hand side and heat terms
+/// both take it from the step's bounds, where a moving obstacle has been put.
 #[inline]
-pub fn exchange_state(lower: &[f64], exchange: &[usize]) -> usize {
+pub fn exchange_state(lower: &[f64], exchange: impl IntoIterator<Item = usize>) -> usize {
     exchange
-        .iter()
+        .into_iter()
         .enumerate()
-        .filter(|(_, k)| in_contact(-lower[**k]))
+        .filter(|&(_, k)| in_contact(-lower[k]))
         .fold(0, |mask, (e, _)| mask | (1 << e))
 }
 
@@ -53,7 +55,7 @@ impl DecoupledSolver {
         for (zi, b) in zt.iter_mut().zip(&rhs[n_u..]) {
             *zi = -b;
         }
-        self.heat[exchange_state(lower, &self.exchange)].solve_in_place(zt);
+        self.heat[exchange_state(lower, self.exchange.iter().copied())].solve_in_place(zt);
     }
 }
 
@@ -77,6 +79,10 @@ impl StepSolver for DecoupledSolver {
 
     fn report(&self) -> Option<SolverReport> {
         self.mechanical.report()
+    }
+
+    fn identity_allowance(&self) -> f64 {
+        self.mechanical.identity_allowance()
     }
 }
 
@@ -106,7 +112,7 @@ impl StepSolver for CoupledSolver {
         z: &mut [f64],
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
-        let mask = exchange_state(lower, &self.exchange);
+        let mask = exchange_state(lower, self.exchange.iter().copied());
         self.variants[mask].solve(rhs, lower, z, reactions)
     }
 
@@ -115,5 +121,11 @@ impl StepSolver for CoupledSolver {
         (self.variants.iter())
             .filter_map(|v| v.report())
             .max_by_key(|r| r.audit.steps)
+    }
+
+    fn identity_allowance(&self) -> f64 {
+        (self.variants.iter())
+            .map(|v| v.identity_allowance())
+            .fold(0.0, f64::max)
     }
 }

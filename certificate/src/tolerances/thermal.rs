@@ -5,9 +5,9 @@ use super::Measured;
 use crate::thermal::{closing_temperature, identity_worst, steady_deviation};
 use viscobar::scheme::RunError;
 
-/// Relative residual of the total-energy identity on the thermal scenes: exact algebra given
-/// the coupled solve, so round-off only (sums of a few hundred terms; measured about 1e-14).
-pub const THERMAL_IDENTITY_TOL: f64 = 1e-12;
+/// The thermal bar's total-energy identity bound: the run's own
+/// (`viscobar::scheme::certify`), measured here.
+pub use viscobar::scheme::certify::THERMAL_IDENTITY_TOL;
 /// Deviation from the closed-form steady state at t = 40: the transient left after 40 time
 /// units of the slowest damped mode (measured about 1e-8); the discrete steady state is the
 /// closed form itself (P1 is exact for linear u and constant θ), a wrong reaction or closing
