@@ -11,7 +11,7 @@ use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::block_pivot::BlockPivotSolver;
-use viscobar_certificate::oracle::brute_force;
+use viscobar_certificate::solvers::oracle::brute_force;
 
 fn solve(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64]) -> (Vec<f64>, Vec<f64>, u32) {
     let mut s = BlockPivotSolver::new(c, nodes).unwrap();

@@ -6,7 +6,7 @@
 //! by rerunning the command). The timing block is machine-dependent and not checked.
 
 use viscobar::study::converge::{SolverSetting, StudyOptions, study_with};
-use viscobar_certificate::timings::{CASES, ERRORS_ID, errors_markdown, settings_for};
+use viscobar_certificate::performance::timings::{CASES, ERRORS_ID, errors_markdown, settings_for};
 
 #[test]
 fn error_against_run_time_error_rows_of_exact_and_penalty_are_current() {

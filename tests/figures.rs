@@ -302,7 +302,7 @@ fn docs_figures_are_the_pngs_the_command_writes() {
         .map(|(n, _)| n)
         .filter(|n| n.ends_with(".png"))
         .collect();
-    let diagrams: Vec<String> = viscobar_certificate::timings::CASES
+    let diagrams: Vec<String> = viscobar_certificate::performance::timings::CASES
         .iter()
         .map(|c| format!("work-precision-{}.png", c.scene))
         .collect();

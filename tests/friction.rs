@@ -5,8 +5,8 @@
 //! point, and the frictional drop's convergence against a finer exact run. Run in release;
 //! the full convergence study is `#[ignore]`d (README, "Friction").
 
+use viscobar_certificate::friction::rigid::*;
 use viscobar_certificate::friction::*;
-use viscobar_certificate::friction_rigid::*;
 
 // The tolerances of this file: in the registry (viscobar_certificate::tolerances), which measures
 // their worst values (`viscobar-certificate verify --tolerances`).
@@ -111,7 +111,7 @@ const FRICTION_ORDER_BAND: (f64, f64) = (1.47, 1.97);
 #[test]
 fn the_frictional_drop_converges_against_a_finer_exact_run() {
     let levels = convergence().unwrap();
-    let orders = viscobar_certificate::plane_contact::orders(&levels);
+    let orders = viscobar_certificate::plane::contact::orders(&levels);
     assert_eq!(orders.len(), 1);
     for p in orders {
         assert!(
@@ -129,7 +129,7 @@ const FRICTION_ORDER_FULL_BAND: (f64, f64) = (0.8, 1.67);
 #[ignore = "about 25 s: cargo test --release --test friction -- --ignored"]
 fn the_frictional_drop_converges_on_three_levels_against_level_3() {
     let levels = full_convergence().unwrap();
-    for p in viscobar_certificate::plane_contact::orders(&levels) {
+    for p in viscobar_certificate::plane::contact::orders(&levels) {
         assert!(
             (FRICTION_ORDER_FULL_BAND.0..=FRICTION_ORDER_FULL_BAND.1).contains(&p),
             "order {p}: {levels:?}"

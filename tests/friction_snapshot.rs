@@ -11,7 +11,7 @@
 use insta::with_settings;
 use serde::Serialize;
 use viscobar::plane::PlaneSimulation;
-use viscobar_certificate::plane_contact::plane_scene;
+use viscobar_certificate::plane::contact::plane_scene;
 
 mod common;
 

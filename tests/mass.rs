@@ -10,7 +10,7 @@ use common::viscobar;
 use viscobar::bar::Discretisation;
 use viscobar::scene::MassVariant;
 use viscobar::study::mass_variants::run_with_mass;
-use viscobar_certificate::mass_study::{MassRow, group_order, groups, mass_study};
+use viscobar_certificate::bar::mass_study::{MassRow, group_order, groups, mass_study};
 
 /// The refused combinations exit 2 with a message naming both keys, and write nothing.
 #[test]

@@ -4,7 +4,7 @@
 use viscobar::output::{run_in_memory, run_plane_in_memory};
 use viscobar::scene::plane::{PlaneScene, plane_builtin_text};
 use viscobar::scene::{Scene, builtin_text};
-use viscobar_certificate::moving::{galilean_bar, galilean_plane};
+use viscobar_certificate::plane::moving::{galilean_bar, galilean_plane};
 use viscobar_certificate::tolerances::{IDENTITY_TOL, PLANE_GAP_TOL, PLANE_IDENTITY_TOL};
 
 /// The body at rest under an approaching obstacle is the moving body shifted by `v t` onto the

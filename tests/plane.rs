@@ -1,10 +1,10 @@
 //! The plane body: the energy identity at every step, the bar as an exact special case, and the
 //! observed order of the manufactured solution, on the computations of
-//! `viscobar_certificate::plane_checks` (which also writes VERIFICATION.md's "Plane body" tables).
+//! `viscobar_certificate::plane` (which also writes VERIFICATION.md's "Plane body" tables).
 //! Run in release (the sparse factorisation is ~150x slower in debug).
 
 use viscobar::output::run_plane_in_memory;
-use viscobar_certificate::plane_checks::{
+use viscobar_certificate::plane::{
     MANUFACTURED_LEVELS, bar_case, bar_case_scenes, identity_scenes, manufactured_level,
     observed_order,
 };

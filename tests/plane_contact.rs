@@ -2,8 +2,8 @@
 //! and the contact conditions and energy identity at every node and step of every built-in
 //! plane scene. Run in release.
 
-use viscobar_certificate::plane_checks::{bar_case, bar_contact_case_scenes, identity_scenes};
-use viscobar_certificate::plane_contact::checked_run;
+use viscobar_certificate::plane::contact::checked_run;
+use viscobar_certificate::plane::{bar_case, bar_contact_case_scenes, identity_scenes};
 
 // The tolerances of this file: in the registry (viscobar_certificate::tolerances), which measures
 // their worst values over these scenes (`viscobar-certificate verify --tolerances`).
@@ -103,7 +103,7 @@ fn contact_conditions_and_energy_identity_hold_at_every_node_and_step_of_every_p
 
 #[test]
 fn exact_and_osqp_agree_on_the_two_dimensional_contact_scenes() {
-    use viscobar_certificate::plane_contact::{
+    use viscobar_certificate::plane::contact::{
         CONTACT_SCENES, agreement, osqp_method, plane_scene,
     };
     for name in CONTACT_SCENES {
@@ -137,7 +137,7 @@ const ORDER_BAND: (f64, f64) = (1.6, 2.38);
 
 #[test]
 fn the_tilted_drop_converges_against_a_finer_exact_run() {
-    use viscobar_certificate::plane_contact::*;
+    use viscobar_certificate::plane::contact::*;
     let scene = plane_scene(
         "plane-tilted-drop",
         &[format!("time.end={CONVERGENCE_END}")],
@@ -160,8 +160,8 @@ const PENALTY_MIN_RATIO: f64 = 10.0;
 
 #[test]
 fn the_penalty_tends_to_the_exact_solution_as_epsilon_decreases() {
-    use viscobar_certificate::plane_contact::Method;
-    use viscobar_certificate::plane_contact::*;
+    use viscobar_certificate::plane::contact::Method;
+    use viscobar_certificate::plane::contact::*;
     let scene = plane_scene("plane-tilted-drop", &[]).unwrap();
     let [a, b] =
         PENALTY_EPSILONS.map(|epsilon| agreement(&scene, Method::Penalty { epsilon }).unwrap());

@@ -5,7 +5,7 @@
 
 use viscobar::plane::matrices::{Integration, Material, assemble_with};
 use viscobar::plane::mesh::Grid;
-use viscobar_certificate::locking::{
+use viscobar_certificate::plane::locking::{
     LOCKED_BELOW, PATCH_TOL, SELECTIVE_BAND, cantilever_table, identity_ratio, patch_worst,
 };
 
@@ -77,7 +77,7 @@ fn the_energy_identity_holds_with_selective_integration() {
 /// plane scenes of the bar cases, every displacement and energy of every step.
 #[test]
 fn the_bar_cases_run_bitwise_the_same_with_selective_integration() {
-    use viscobar_certificate::plane_checks::{BAR_CASE_BODY, bar_case_scenes, plane_of_bar};
+    use viscobar_certificate::plane::{BAR_CASE_BODY, bar_case_scenes, plane_of_bar};
     for (name, bar) in bar_case_scenes() {
         let (height, ny, grading) = BAR_CASE_BODY;
         let full = plane_of_bar(&bar, height, ny, grading).unwrap();

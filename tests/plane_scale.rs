@@ -5,7 +5,7 @@
 
 use viscobar::output::run_plane_in_memory;
 use viscobar::scene::plane::{PENALTY_CONDENSED_MAX_NORMALS, PlaneScene, plane_builtin_text};
-use viscobar_certificate::scale::{EPSILONS, sparse_penalty_agreement};
+use viscobar_certificate::solvers::scale::{EPSILONS, sparse_penalty_agreement};
 use viscobar_certificate::tolerances::{PLANE_IDENTITY_TOL, SPARSE_PENALTY_AGREEMENT_TOL};
 
 fn strip(overrides: &[&str]) -> PlaneScene {

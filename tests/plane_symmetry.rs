@@ -9,7 +9,7 @@
 //! included, and the corner normals of two Signorini edges; for the exact method (α > 0 and
 //! α = 0), the penalty and OSQP.
 
-use viscobar_certificate::plane_symmetry::{
+use viscobar_certificate::plane::symmetry::{
     Case, Runs, Suite, between_walls_suite, check, corner_suite, end_contact, falling_block_suite,
     solver_suites,
 };

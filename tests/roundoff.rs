@@ -4,7 +4,7 @@
 //! scheme reproduces exactly in exact arithmetic (`R·1 = 0`, `C·1 = M·1/Δt²`): what remains is
 //! round-off. An independent implementation measured drifts of 7.9e-7 (talk form) and 2.7e-10
 //! (increment form) after 26 000 steps at J = 8192. See
-//! `viscobar_certificate::roundoff::rigid_mode_drift`.
+//! `viscobar_certificate::bar::roundoff::rigid_mode_drift`.
 
 use viscobar_certificate::tolerances::INCREMENT_DRIFT_TOL;
 // The run of VERIFICATION.md's round-off table and of the registry's INCREMENT_DRIFT_TOL row.

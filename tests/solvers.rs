@@ -21,8 +21,8 @@ use viscobar::step::penalty::PenaltySettings;
 use viscobar::step::{StepFailure, StepSolver};
 use viscobar::study::accuracy::observed_order;
 use viscobar::study::compare::compare;
-use viscobar_certificate::agreement::start_up_problem;
-use viscobar_certificate::agreement::stiff_impact_overrides;
+use viscobar_certificate::solvers::agreement::start_up_problem;
+use viscobar_certificate::solvers::agreement::stiff_impact_overrides;
 
 // ---- tolerances -------------------------------------------------------------------------
 

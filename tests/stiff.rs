@@ -4,8 +4,8 @@
 //! The exact solver must complete every case but the overflowing ones, which every solver must
 //! refuse.
 
-use viscobar_certificate::stiff::{Family, Size, cases, verdict};
-use viscobar_certificate::stiff_runs::run_case;
+use viscobar_certificate::bar::stiff::{Family, Size, cases, verdict};
+use viscobar_certificate::bar::stiff_runs::run_case;
 
 #[test]
 fn every_stiff_case_is_correct_or_reported() {

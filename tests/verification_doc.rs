@@ -1,8 +1,8 @@
 //! VERIFICATION.md's generated tables must be what the certificate's `verify` computes now:
 //! the certificate cannot drift from the code.
 
-use viscobar_certificate::bench_compare::{COMPARE_COMMAND, RATIO_LIMIT};
-use viscobar_certificate::bench_table::UPDATE_COMMAND;
+use viscobar_certificate::performance::bench_compare::{COMPARE_COMMAND, RATIO_LIMIT};
+use viscobar_certificate::performance::bench_table::UPDATE_COMMAND;
 use viscobar_certificate::verify;
 
 #[test]

@@ -6,7 +6,7 @@
 mod common;
 use common::{MODAL_ORDER, MODAL_ORDER_TOL};
 use viscobar::bar::closed_form::{self, ClosedForm, ViscousContact};
-use viscobar_certificate::viscous_contact::{self, L2_BOUND, REACTION_INTERIOR_BOUND, Row};
+use viscobar_certificate::bar::viscous_contact::{self, L2_BOUND, REACTION_INTERIOR_BOUND, Row};
 
 fn exact() -> ViscousContact {
     viscous_contact::closed_form(&common::builtin("viscous-contact", &[]))

@@ -1,40 +1,26 @@
-//! # viscobar-certificate: the certificate of [`viscobar`]: the studies that recompute the generated tables of
-//! VERIFICATION.md ([`verify`]), the tolerance registry that measures every tolerance of the
-//! tests against the worst value it guards ([`tolerances`]), the stiff and extreme case matrix
-//! ([`stiff`], [`stiff_runs`]), the step solvers' agreement ([`agreement`]) with the dense
-//! brute-force [`oracle`], the rigid mode's round-off ([`roundoff`]), the mass variants side by
-//! side ([`mass_study`]), the plane body's checks ([`plane_checks`], [`plane_contact`],
-//! [`plane_symmetry`], [`locking`], [`moving`]), its friction ([`friction`], [`friction_rigid`]),
-//! the manufactured viscous contact ([`viscous_contact`]), error against run time ([`timings`]);
-//! the measured blocks of the READMEs ([`bench_table`], [`bench_compare`], [`peak_memory`]).
+//! # viscobar-certificate: the certificate of [`viscobar`], in folders by topic
+//!
+//! - [`verify`]: VERIFICATION.md's generated tables, with the bar's matrices, scenes, closed forms;
+//! - [`bar`]: the stiff case matrix, the rigid mode's round-off, mass variants, viscous contact;
+//! - [`plane`]: the plane body, its contact, symmetry, locking, moving obstacles (both bodies);
+//! - [`friction`]: plane friction and its rigid-limit closed forms; [`thermal`]: the thermal bar;
+//! - [`solvers`]: the step solvers' agreement, the dense brute-force oracle, contact at scale;
+//! - [`tolerances`]: the registry, every tolerance of the tests against the worst value it guards;
+//! - [`performance`]: error against run time, the READMEs' benches and peak memory.
 //!
 //! A member crate of the viscobar workspace, beside the library and not part of its API: it
 //! imports `viscobar`, and the integration tests of `viscobar` import it (a dev-dependency),
 //! so that a test and the registry share one constant. Its commands:
 //! `cargo run --release -p viscobar-certificate -- --help`.
 
-pub mod agreement;
-pub mod bench_compare;
-pub mod bench_table;
+pub mod bar;
 pub mod friction;
-pub mod friction_rigid;
-pub mod locking;
-pub mod mass_study;
-pub mod moving;
-pub mod oracle;
-pub mod peak_memory;
-pub mod plane_checks;
-pub mod plane_contact;
-pub mod plane_symmetry;
-pub mod roundoff;
-pub mod scale;
-pub mod stiff;
-pub mod stiff_runs;
+pub mod performance;
+pub mod plane;
+pub mod solvers;
 pub mod thermal;
-pub mod timings;
 pub mod tolerances;
 pub mod verify;
-pub mod viscous_contact;
 
 /// The workspace's root folder (the `viscobar` package): the base of the paths the certificate
 /// reads and names (`tests/`, `target/criterion/`).

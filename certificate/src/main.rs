@@ -5,10 +5,11 @@
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
-use viscobar_certificate::peak_memory::Ends;
-use viscobar_certificate::{
-    agreement, bench_compare, bench_table, peak_memory, stiff, stiff_runs, timings, verify,
-};
+use viscobar_certificate::bar::{stiff, stiff_runs};
+use viscobar_certificate::performance::peak_memory::Ends;
+use viscobar_certificate::performance::{bench_compare, bench_table, peak_memory, timings};
+use viscobar_certificate::solvers::agreement;
+use viscobar_certificate::verify;
 
 #[derive(Parser)]
 #[command(

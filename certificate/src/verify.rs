@@ -4,7 +4,9 @@
 //! (`verify --update VERIFICATION.md`), never hand-edited.
 //! Every figure here is deterministic (no timings), so a test checks the document is current.
 
-use crate::roundoff::rigid_mode_drift;
+use crate::bar::roundoff::rigid_mode_drift;
+use crate::bar::{stiff, stiff_runs};
+use crate::solvers::agreement;
 use std::fmt::Write;
 use std::sync::OnceLock;
 use viscobar::bar::closed_form;
@@ -71,28 +73,26 @@ pub fn sections() -> Result<Vec<Section>, ConvergeError> {
     let jobs: Vec<Job> = vec![
         // The longest first.
         job("plane-friction", crate::friction::markdown),
-        job("plane", crate::plane_checks::markdown),
-        keep(&stiff, || {
-            Ok(crate::stiff_runs::run_all(crate::stiff::Size::Full))
-        }),
+        job("plane", crate::plane::markdown),
+        keep(&stiff, || Ok(stiff_runs::run_all(stiff::Size::Full))),
         keep(&registry[0], || Ok(crate::tolerances::measured()?)),
         keep(&registry[1], || Ok(crate::tolerances::plane_measured()?)),
         keep(&registry[2], || Ok(crate::tolerances::friction_measured()?)),
         keep(&registry[3], || Ok(crate::tolerances::thermal_measured()?)),
-        job("solver-agreement", || Ok(crate::agreement::markdown()?)),
-        job("plane-contact", crate::plane_contact::markdown),
+        job("solver-agreement", || Ok(agreement::markdown()?)),
+        job("plane-contact", crate::plane::contact::markdown),
         Box::new(|| Ok(vec![convergence_section()?, falling_bar_section()?])),
         keep(&drift, || Ok(rigid_drift()?)),
         job("viscous-contact", || {
-            let study = crate::viscous_contact::study(CONVERGENCE_LEVELS)?;
-            Ok(crate::viscous_contact::markdown(&study))
+            let study = crate::bar::viscous_contact::study(CONVERGENCE_LEVELS)?;
+            Ok(crate::bar::viscous_contact::markdown(&study))
         }),
         Box::new(|| Ok(vec![viscosity_section()?])),
         Box::new(|| Ok(vec![mass_variants_section()?])),
         keep(&backward, || Ok(backward_ulps())),
         Box::new(|| Ok(vec![matrices_section(), solve_section(), scenes_section()?])),
-        job("locking", || Ok(crate::locking::markdown()?)),
-        job("moving", || Ok(crate::moving::markdown()?)),
+        job("locking", || Ok(crate::plane::locking::markdown()?)),
+        job("moving", || Ok(crate::plane::moving::markdown()?)),
         job("thermal", || Ok(crate::thermal::markdown()?)),
     ];
     let mut out = run_jobs(jobs)?;
@@ -468,24 +468,24 @@ fn viscosity_section() -> Result<Section, viscobar::study::converge::ConvergeErr
 
 /// The stiff and extreme case matrix from its runs (full size: about 40 s on 2 cores; alone:
 /// `verify --stiff`); `tests/stiff.rs` runs the reduced size.
-pub fn stiff_section(results: &[crate::stiff::CaseResult]) -> Section {
+pub fn stiff_section(results: &[crate::bar::stiff::CaseResult]) -> Section {
     Section {
         id: "stiff",
-        markdown: crate::stiff::markdown(results),
+        markdown: crate::bar::stiff::markdown(results),
     }
 }
 
 /// The mass variants on `impact` and `falling-bar` (`study::mass_variants`; a few seconds).
 fn mass_variants_section() -> Result<Section, viscobar::study::converge::ConvergeError> {
-    use crate::mass_study::{MassStudyError, mass_study};
+    use crate::bar::mass_study::{MassStudyError, mass_study};
     use viscobar::study::converge::ConvergeError;
     let rows = mass_study().map_err(|e| match e {
         MassStudyError::Run(r) => ConvergeError::Run(r),
         other => ConvergeError::BadInput(other.to_string()),
     })?;
-    let mut markdown = crate::mass_study::certificate_markdown()?;
+    let mut markdown = crate::bar::mass_study::certificate_markdown()?;
     markdown.push('\n');
-    markdown.push_str(&crate::mass_study::markdown(&rows));
+    markdown.push_str(&crate::bar::mass_study::markdown(&rows));
     Ok(Section {
         id: "mass-variants",
         markdown,
@@ -496,7 +496,7 @@ fn mass_variants_section() -> Result<Section, viscobar::study::converge::Converg
 /// matrix's checks read from `results` and the rigid-mode drift `increment_drift` of
 /// [`rigid_drift`].
 pub fn tolerances_section(
-    results: &[crate::stiff::CaseResult],
+    results: &[crate::bar::stiff::CaseResult],
     increment_drift: f64,
 ) -> Result<Section, RunError> {
     Ok(Section {

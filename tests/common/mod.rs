@@ -5,7 +5,7 @@ use proptest::prelude::*;
 use viscobar::Scene;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::scene;
-use viscobar_certificate::agreement::{MAX_MARGIN, diagonally_dominant};
+use viscobar_certificate::solvers::agreement::{MAX_MARGIN, diagonally_dominant};
 
 // ---- tolerances shared by several test files -----------------------------------------------
 
@@ -32,7 +32,7 @@ pub fn builtin(name: &str, overrides: &[&str]) -> Scene {
 
 /// Smallest diagonal-dominance margin of [`spd_tridiag`] (shared with the agreement study's
 /// random problems).
-pub use viscobar_certificate::agreement::MIN_MARGIN;
+pub use viscobar_certificate::solvers::agreement::MIN_MARGIN;
 
 /// Random SPD tridiagonal matrices of size `2..=max_n`: diagonally dominant by a random margin
 /// of at least [`MIN_MARGIN`], off-diagonals of either sign (the step matrix C is not an

@@ -1,9 +1,9 @@
 //! The friction tolerances (`tests/friction.rs`), each beside the measurement of what it
-//! guards ([`crate::friction`], [`crate::friction_rigid`]).
+//! guards ([`crate::friction`], [`crate::friction::rigid`]).
 
 use super::{AGREEMENT_ULPS_PER_STEP, Measured};
+use crate::friction::rigid::{RigidRow, STIFFNESSES, closed_form_self_test, rigid_table};
 use crate::friction::{FrictionAgreement, osqp_agreements, scene_checks};
-use crate::friction_rigid::{RigidRow, STIFFNESSES, closed_form_self_test, rigid_table};
 use viscobar::scheme::RunError;
 use viscobar::step::tresca::FIXED_POINT_TOL;
 

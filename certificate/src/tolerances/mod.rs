@@ -1,5 +1,5 @@
 //! The tolerance registry (`verify --tolerances`): for the tolerances of `tests/` and
-//! `certificate/src/stiff.rs`, the measured worst value of what each guards and the ratio
+//! `certificate/src/bar/stiff.rs`, the measured worst value of what each guards and the ratio
 //! worst / tolerance, so that a check that cannot fail shows (target: no ratio below
 //! [`RATIO_FLOOR`] without a reason). The tolerances measured here live here, each in the
 //! module of its subject beside its measurement (or in the study that measures them), and the
@@ -23,8 +23,8 @@ pub use scenes::*;
 pub use solvers::*;
 pub use thermal::*;
 
-use crate::stiff::{CaseResult, checks};
-use crate::viscous_contact;
+use crate::bar::stiff::{CaseResult, checks};
+use crate::bar::viscous_contact;
 use std::fmt::Write;
 use viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS;
 use viscobar::scene::{self, MassVariant};
@@ -549,7 +549,7 @@ pub fn markdown(measured: &[Measured], stiff: &[StiffCheck], uncovered: &[Uncove
         );
     }
     md.push_str(
-        "\nStiff case matrix (`certificate/src/stiff.rs`, tolerances per case; ratio value / tolerance over the completed runs):\n\n\
+        "\nStiff case matrix (`certificate/src/bar/stiff.rs`, tolerances per case; ratio value / tolerance over the completed runs):\n\n\
          | check | solver | runs | max ratio | min nonzero ratio | runs below 1e-3 | runs at exactly 0 |\n|---|---|---|---|---|---|---|\n",
     );
     for c in stiff {
@@ -622,8 +622,8 @@ pub fn registry_markdown_of(
     });
     // The stiff matrix's constants enter its per-case tolerances, measured by the checks above.
     let covered = [
-        ("OSQP_AGREEMENT_REL", "certificate/src/stiff.rs"),
-        ("OSQP_STEP_ABS", "certificate/src/stiff.rs"),
+        ("OSQP_AGREEMENT_REL", "certificate/src/bar/stiff.rs"),
+        ("OSQP_STEP_ABS", "certificate/src/bar/stiff.rs"),
     ];
     markdown(
         &measured,

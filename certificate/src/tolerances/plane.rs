@@ -43,7 +43,7 @@ pub const PLANE_SYMMETRY_REACTION_TOL: f64 = 1e-13;
 /// the step's active-set system differ by [`AGREEMENT_ULPS_PER_STEP`] ε relative (the bar's
 /// constant; OSQP polished), accumulated linearly over the steps; the worst of the
 /// displacement (relative to max |u|) and the reaction (relative to max r).
-pub fn plane_osqp_agreement_ratio(a: &crate::plane_contact::Agreement) -> f64 {
+pub fn plane_osqp_agreement_ratio(a: &crate::plane::contact::Agreement) -> f64 {
     let bound = a.steps as f64 * AGREEMENT_ULPS_PER_STEP * f64::EPSILON;
     let relative = |d: f64, scale: f64| if scale > 0.0 { d / scale } else { d };
     relative(a.max_u_deviation, a.max_u).max(relative(a.max_reaction_deviation, a.max_reaction))
@@ -52,7 +52,7 @@ pub fn plane_osqp_agreement_ratio(a: &crate::plane_contact::Agreement) -> f64 {
 
 /// Plane normal compliance at `epsilon` against exact: `max |u − u_exact|` over
 /// `PLANE_PENALTY_FACTOR ε r_max` (`r_max` of the exact run).
-pub fn plane_penalty_ratio(a: &crate::plane_contact::Agreement, epsilon: f64) -> f64 {
+pub fn plane_penalty_ratio(a: &crate::plane::contact::Agreement, epsilon: f64) -> f64 {
     let bound = PLANE_PENALTY_FACTOR * epsilon * a.max_reaction;
     if bound > 0.0 {
         a.max_u_deviation / bound
@@ -93,12 +93,10 @@ fn plane_run_error(e: viscobar::study::converge::ConvergeError) -> RunError {
 
 /// [`PlaneWorst`] over the scenes of `tests/plane.rs` and `tests/plane_contact.rs`.
 pub fn plane_worst() -> Result<PlaneWorst, RunError> {
-    use crate::plane_checks::{
-        bar_case, bar_case_scenes, bar_contact_case_scenes, identity_scenes,
-    };
-    use crate::plane_contact::{
+    use crate::plane::contact::{
         CONTACT_SCENES, Method, PENALTY_EPSILONS, agreement, checked_run, osqp_method, plane_scene,
     };
+    use crate::plane::{bar_case, bar_case_scenes, bar_contact_case_scenes, identity_scenes};
     let mut w = PlaneWorst::default();
     for (name, scene) in identity_scenes() {
         let (records, summary, checks) = checked_run(&name, &scene).map_err(plane_run_error)?;
@@ -167,7 +165,7 @@ pub fn plane_worst() -> Result<PlaneWorst, RunError> {
 /// The registry's rows of the plane tolerances.
 pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
     let w = plane_worst()?;
-    let symmetry = crate::plane_symmetry::worst_deviation()?;
+    let symmetry = crate::plane::symmetry::worst_deviation()?;
     let rows = [
         (
             "PLANE_IDENTITY_TOL",
@@ -235,19 +233,19 @@ pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
             "the reactions from nearly closed gaps times S⁻¹ (every mirror and turn of the tests)",
         ),
     ];
-    let galilean = crate::moving::galilean_plane()?
+    let galilean = crate::plane::moving::galilean_plane()?
         .ratio()
-        .max(crate::moving::galilean_bar()?.ratio());
-    let [patch_full, patch_selective] = crate::locking::patch_worst()?;
-    let table = crate::locking::cantilever_table()?;
+        .max(crate::plane::moving::galilean_bar()?.ratio());
+    let [patch_full, patch_selective] = crate::plane::locking::patch_worst()?;
+    let table = crate::plane::locking::cantilever_table()?;
     let selective =
         |f: fn(f64, f64) -> f64, init: f64| table.iter().map(|r| r.selective).fold(init, f);
     let (low, high) = (selective(f64::min, f64::INFINITY), selective(f64::max, 0.0));
     let locked = table.last().map_or(f64::INFINITY, |r| r.full);
-    let identity = crate::locking::identity_ratio(0.4999, Integration::Full)?.max(
-        crate::locking::identity_ratio(0.4999, Integration::Selective)?,
+    let identity = crate::plane::locking::identity_ratio(0.4999, Integration::Full)?.max(
+        crate::plane::locking::identity_ratio(0.4999, Integration::Selective)?,
     );
-    use crate::locking::{LOCKED_BELOW, PATCH_TOL, SELECTIVE_BAND};
+    use crate::plane::locking::{LOCKED_BELOW, PATCH_TOL, SELECTIVE_BAND};
     let locking = [
         (
             "locking::PATCH_TOL",
@@ -285,9 +283,9 @@ pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
             "cantilever at ν = 0.4999, both rules, 80 steps",
         ),
     ];
-    let sparse = crate::scale::EPSILONS
+    let sparse = crate::solvers::scale::EPSILONS
         .iter()
-        .map(|&e| crate::scale::sparse_penalty_agreement(e))
+        .map(|&e| crate::solvers::scale::sparse_penalty_agreement(e))
         .collect::<Result<Vec<f64>, RunError>>()?
         .into_iter()
         .fold(0.0, f64::max);

@@ -25,7 +25,7 @@ pub fn stream(seed: u64) -> impl FnMut() -> f64 {
 /// The tests' `common::spd_tridiag(max_n)` distribution drawn from `rnd`: size `2..=max_n`,
 /// off-diagonals in (−1, 1), diagonal-dominance margins in `[MIN_MARGIN, MAX_MARGIN)`.
 pub fn sample_spd_tridiag(max_n: usize, rnd: &mut impl FnMut() -> f64) -> SymTridiag {
-    use crate::agreement::{MAX_MARGIN, MIN_MARGIN, diagonally_dominant};
+    use crate::solvers::agreement::{MAX_MARGIN, MIN_MARGIN, diagonally_dominant};
     let n = 2 + ((rnd() * (max_n - 1) as f64) as usize).min(max_n - 2);
     let off: Vec<f64> = (0..n - 1).map(|_| 2.0 * rnd() - 1.0).collect();
     let margin: Vec<f64> = (0..n)
@@ -228,7 +228,7 @@ pub fn oracle_agreement(
     r: &[f64],
 ) -> f64 {
     let zscale = 1.0 + viscobar::linalg::norms::max_abs(z);
-    let Ok(Some(oracle)) = crate::oracle::brute_force(
+    let Ok(Some(oracle)) = crate::solvers::oracle::brute_force(
         &c.to_dense(),
         b,
         nodes,

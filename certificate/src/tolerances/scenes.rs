@@ -319,7 +319,7 @@ pub fn impact_contact_errors() -> Result<(usize, f64, f64), RunError> {
 pub const DROP_TOL: f64 = 1e-12;
 
 /// The mass study's rows on `impact` at α = 0: the worst `|energy drop − contact term|`.
-pub fn drop_worst(rows: &[crate::mass_study::MassRow]) -> f64 {
+pub fn drop_worst(rows: &[crate::bar::mass_study::MassRow]) -> f64 {
     rows.iter()
         .filter(|r| r.scene == "impact" && r.alpha == 0.0)
         .map(|r| (r.energy_drop - r.contact_dissipation).abs())
@@ -328,7 +328,7 @@ pub fn drop_worst(rows: &[crate::mass_study::MassRow]) -> f64 {
 
 /// [`drop_worst`] of a fresh mass study (a few seconds).
 pub fn mass_study_drop_worst() -> Result<f64, RunError> {
-    use crate::mass_study::{MassStudyError, mass_study};
+    use crate::bar::mass_study::{MassStudyError, mass_study};
     let rows = mass_study().map_err(|e| match e {
         MassStudyError::Run(r) => r,
         other => invalid(

@@ -2,11 +2,13 @@
 //! frictionless runs bit for bit, the energy identity with `D_f`, `D_f >= 0`, the momentum
 //! balance along the tangent and the audit at every step of the built-in friction scenes, the
 //! exact solver against OSQP's Tresca fixed point, the rigid-limit closed forms
-//! ([`crate::friction_rigid`]) and the frictional drop's convergence against a finer exact run.
+//! ([`crate::friction::rigid`]) and the frictional drop's convergence against a finer exact run.
 //! The tests (`tests/friction.rs`) assert on the same computations.
 
-use crate::friction_rigid::{RigidRow, closed_form_self_test, rigid_table};
-use crate::plane_contact::{Method, plane_error, plane_scene};
+pub mod rigid;
+
+use crate::friction::rigid::{RigidRow, closed_form_self_test, rigid_table};
+use crate::plane::contact::{Method, plane_error, plane_scene};
 use std::fmt::Write;
 use viscobar::plane::PlaneSimulation;
 use viscobar::scene::plane::{EdgeCondition, PLANE_BUILTIN, PlaneScene};
@@ -296,7 +298,7 @@ pub fn osqp_agreements() -> Result<Vec<FrictionAgreement>, ConvergeError> {
 }
 
 /// The frictional drop's convergence study (as the frictionless drop's,
-/// [`crate::plane_contact`]): its end time; the test's levels and reference (within seconds)
+/// [`crate::plane::contact`]): its end time; the test's levels and reference (within seconds)
 /// and the document's (the reference one level finer, about 25 s).
 pub const CONVERGENCE_END: f64 = 0.6;
 pub const CONVERGENCE_LEVELS: [u32; 2] = [0, 1];
@@ -308,21 +310,21 @@ pub const FULL_CONVERGENCE_REFERENCE: u32 = 3;
 fn drop_convergence(
     levels: &[u32],
     reference: u32,
-) -> Result<Vec<crate::plane_contact::ContactLevel>, ConvergeError> {
+) -> Result<Vec<crate::plane::contact::ContactLevel>, ConvergeError> {
     let scene = plane_scene(
         "plane-friction-tilted-drop",
         &[format!("time.end={CONVERGENCE_END}")],
     )?;
-    crate::plane_contact::convergence(&scene, levels, reference)
+    crate::plane::contact::convergence(&scene, levels, reference)
 }
 
 /// The test's study: [`CONVERGENCE_LEVELS`] against [`CONVERGENCE_REFERENCE`].
-pub fn convergence() -> Result<Vec<crate::plane_contact::ContactLevel>, ConvergeError> {
+pub fn convergence() -> Result<Vec<crate::plane::contact::ContactLevel>, ConvergeError> {
     drop_convergence(&CONVERGENCE_LEVELS, CONVERGENCE_REFERENCE)
 }
 
 /// The document's study: [`FULL_CONVERGENCE_LEVELS`] against [`FULL_CONVERGENCE_REFERENCE`].
-pub fn full_convergence() -> Result<Vec<crate::plane_contact::ContactLevel>, ConvergeError> {
+pub fn full_convergence() -> Result<Vec<crate::plane::contact::ContactLevel>, ConvergeError> {
     drop_convergence(&FULL_CONVERGENCE_LEVELS, FULL_CONVERGENCE_REFERENCE)
 }
 
@@ -417,7 +419,7 @@ pub fn markdown() -> Result<String, ConvergeError> {
         (convergence()?, CONVERGENCE_REFERENCE),
         (full_convergence()?, FULL_CONVERGENCE_REFERENCE),
     ] {
-        md.push_str(&crate::plane_contact::convergence_markdown(
+        md.push_str(&crate::plane::contact::convergence_markdown(
             &levels,
             reference,
             CONVERGENCE_END,

@@ -9,7 +9,7 @@
 //! The scheme's start-up step is frictionless, so friction acts from `t_{1/2}` on: times and
 //! distances of the runs are measured from there.
 
-use crate::plane_contact::{plane_error, plane_scene};
+use crate::plane::contact::{plane_error, plane_scene};
 use viscobar::plane::PlaneSimulation;
 use viscobar::scene::plane::PlaneScene;
 use viscobar::study::converge::ConvergeError;

@@ -12,7 +12,7 @@
 //! each against a tolerance computed a posteriori from what the step formed ([`StepTerms`],
 //! [`Worst`]), derived in `docs/stiff-tolerances.md`. This file holds what is checked: the
 //! cases, the tolerances, the verdict and the table of VERIFICATION.md; running the cases is
-//! [`crate::stiff_runs`].
+//! [`crate::bar::stiff_runs`].
 
 use std::fmt::Write;
 use viscobar::scene::Scene;
@@ -635,7 +635,7 @@ pub fn sum_rounding(k: f64, abs_sum: f64) -> f64 {
 }
 
 /// The a-posteriori quantities of one step of one run, all computed by
-/// [`crate::stiff_runs`] from the vectors the step formed (the solver's `b̂`, `z`, `r`, the
+/// [`crate::bar::stiff_runs`] from the vectors the step formed (the solver's `b̂`, `z`, `r`, the
 /// previous increment `w`, the stored `û^{n−1}, û^n, û^{n+1}`), with `δ = z + w`, `ρ̂` the
 /// computed `C z − b̂ − Σ r_j e_j` and `f_i` the entrywise bound on its rounding and on the
 /// rounding of `b̂` (see [`StepTerms::identity_tolerance`]).

@@ -1,5 +1,5 @@
 //! The plane contact certificate (VERIFICATION.md, "Plane contact"): the bar with contact as
-//! an exact special case ([`crate::plane_checks::bar_case`]), the contact conditions and
+//! an exact special case ([`crate::plane::bar_case`]), the contact conditions and
 //! the energy identity on the built-in contact scenes, the exact solver against OSQP and the
 //! penalty, and the observed convergence of the tilted drop. The tests
 //! (`tests/plane_contact.rs`) assert on the same computations.
@@ -328,7 +328,7 @@ pub fn scene_checks() -> Result<Vec<SceneCheck>, ConvergeError> {
 
 /// The generated block of VERIFICATION.md's "Plane contact" section (id `plane-contact`).
 pub fn markdown() -> Result<String, ConvergeError> {
-    use crate::plane_checks::{BAR_CASE_BODY, bar_case, bar_contact_case_scenes};
+    use crate::plane::{BAR_CASE_BODY, bar_case, bar_contact_case_scenes};
     use std::fmt::Write;
     let mut md = String::from(
         "| bar scene | steps | steps in contact | plane rows (y_grading) | max abs(ux − u) / max abs(u) | max abs(uy) / max abs(u) | max abs(r_k − ω_k r) / max r |\n|---|---|---|---|---|---|---|\n",

@@ -14,7 +14,7 @@
 //! on older code. `--update` also refuses a group measured more than `STALE_AFTER_S` before
 //! the newest group.
 
-use crate::timings::{cpu_model, utc_date_time_at};
+use crate::performance::timings::{cpu_model, utc_date_time_at};
 use crate::verify::{Section, update_document};
 use std::collections::BTreeMap;
 use std::fmt::Write;

@@ -1,14 +1,14 @@
-//! Running the stiff and extreme case matrix of [`crate::stiff`]: each case's solvers step in
+//! Running the stiff and extreme case matrix of [`crate::bar::stiff`]: each case's solvers step in
 //! lockstep with the exact one and are compared with it after every step, while each run's
 //! identity residual, penetration, energy drift and (exact solver) KKT audit at round-off
 //! floors are recorded into a [`CaseResult`]. A failing solver is stopped and its error kept;
 //! the others go on.
 //!
-//! Apart from the case list, the tolerances and the table ([`crate::stiff`]), which say what is
+//! Apart from the case list, the tolerances and the table ([`crate::bar::stiff`]), which say what is
 //! checked and why; this file only produces the numbers they are checked on.
 
-use crate::roundoff::rigid_drift;
-use crate::stiff::{
+use crate::bar::roundoff::rigid_drift;
+use crate::bar::stiff::{
     COMBINATION_ROUNDINGS, Case, CaseResult, Family, GAP_ROUNDINGS, RESIDUAL_ROUNDINGS, Size,
     SolverRun, StepTerms, UNIT_ROUNDOFF, Worst, cases, sum_rounding, violation_law,
 };

@@ -9,7 +9,7 @@
 //! `--update FILE`, the block between `<!-- generated:bench-compare -->` and
 //! `<!-- end:bench-compare -->` is rewritten, stamped with the dates, machine and commands.
 
-use crate::timings::{cpu_model, utc_date_time_at};
+use crate::performance::timings::{cpu_model, utc_date_time_at};
 use crate::verify::{Section, update_document};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};

@@ -2,6 +2,15 @@
 //! energy identity on every built-in plane scene and the manufactured one, the bar as an exact
 //! special case, and the observed order of the manufactured solution. The tests
 //! (`tests/plane.rs`, `src/plane/*`) assert on the same computations.
+//!
+//! The plane's other certificates, each a section of VERIFICATION.md: [`contact`] ("Plane
+//! contact"), [`symmetry`] (mirrored and turned scenes), [`locking`] ("No locking") and
+//! [`moving`] ("Moving obstacles", on both bodies). Its friction is [`crate::friction`].
+
+pub mod contact;
+pub mod locking;
+pub mod moving;
+pub mod symmetry;
 
 use std::fmt::Write;
 use viscobar::bar::Simulation;

@@ -3,7 +3,7 @@
 //! the reaction and the contact times against the closed form, `dx` and `dt` halved together;
 //! and the closed form's self-checks by finite differences. Shared by
 //! `tests/viscous_contact.rs`, the tolerance registry and the generated table of
-//! VERIFICATION.md; derivation in [docs/viscous-contact.md](../../docs/viscous-contact.md).
+//! VERIFICATION.md; derivation in [docs/viscous-contact.md](../../../docs/viscous-contact.md).
 
 use std::fmt::Write;
 use viscobar::bar::closed_form::{self, ClosedForm};
