@@ -452,7 +452,7 @@ fn plane_figure(name: &str, scene: &scene::PlaneScene, out: &std::path::Path) ->
 fn report(summary: &viscobar::Summary, out: &std::path::Path) {
     println!(
         "{}: {} steps of {} unknowns ({} nodes) with `{}` in {:.3} s ({:.1} ns per \
-         unknown-step); max identity residual {:.1e}; results in {}",
+         unknown-step); max identity residual {:.1e} (bound {:.1e}); results in {}",
         summary.scene,
         summary.steps,
         summary.unknowns,
@@ -461,6 +461,7 @@ fn report(summary: &viscobar::Summary, out: &std::path::Path) {
         summary.wall_time_s,
         summary.ns_per_unknown_step,
         summary.max_identity_residual,
+        summary.max_identity_bound,
         out.display()
     );
     for (group, episodes) in &summary.contact_episodes {

@@ -380,6 +380,7 @@ fn row<'a>(table: &'a str, pair: &str) -> Vec<&'a str> {
 
 #[test]
 fn compare_prints_the_agreement_of_each_solver_with_the_first() {
+    let out = tmpdir("compare");
     let (code, table, err) = outcome(&[
         "compare",
         "impact",
@@ -387,8 +388,14 @@ fn compare_prints_the_agreement_of_each_solver_with_the_first() {
         "exact,osqp,penalty",
         "--set",
         "time.end=0.5",
+        "--out",
+        out.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
+    // The table printed is the one written (`--out`), before the line naming the file.
+    let written = std::fs::read_to_string(out.join("comparison.md")).unwrap();
+    assert!(table.starts_with(&written), "{table}\n---\n{written}");
+    let _ = std::fs::remove_dir_all(&out);
     let header = table
         .lines()
         .find(|l| l.starts_with("| solvers |"))
@@ -437,6 +444,7 @@ fn compare_prints_the_agreement_of_each_solver_with_the_first() {
         assert!(number(&penalty, i) > number(&osqp, i), "{table}");
     }
     // A scene file and --set, with the penalty on a distributed obstacle: a row, not a crash.
+    let out = tmpdir("compare-distributed");
     let (code, table, err) = outcome(&[
         "compare",
         concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/distributed.toml"),
@@ -444,7 +452,10 @@ fn compare_prints_the_agreement_of_each_solver_with_the_first() {
         "exact,penalty,osqp",
         "--set",
         "time.end=0.1",
+        "--out",
+        out.to_str().unwrap(),
     ]);
+    let _ = std::fs::remove_dir_all(&out);
     assert_eq!(code, 0, "{err}");
     assert!(
         row(&table, "penalty vs exact")[1].starts_with("does not apply"),

@@ -4,7 +4,7 @@
 //! identity measured against the run's energy resolution once every term is rounding noise),
 //! a run's own certificate in `summary.json`, and the refusal of scenes too stiff to certify.
 
-use viscobar::output::{Certify, RunOptions, run_thermal_in_memory, run_to_dir_with};
+use viscobar::output::{RunOptions, run_thermal_in_memory, run_to_dir_with};
 use viscobar::scheme::{RunError, StepRecord};
 use viscobar::{Scene, SceneError};
 use viscobar_certificate::tolerances::{IDENTITY_TOL, THERMAL_IDENTITY_TOL};
@@ -154,13 +154,11 @@ fn fresh_dir(name: &str) -> std::path::PathBuf {
     dir
 }
 
-/// A run that breaks its certificate (here a bound forced to a value no run meets: the
-/// impact with `α` large enough that its conditioning dominates the bound is not needed; a
-/// zero allowance is not settable, so the test uses the stiffest certified scene's identity at
-/// a diagnostics stride) ends with the failure named and nothing written, and with
-/// `Certify::Record` is written whole with `certified: false` and the first failure.
+/// A written run carries its certificate in `summary.json`: `certified`, the measured steps,
+/// and no failure (a run over its bound is tested in `output::run`'s unit tests: no valid
+/// scene breaks its certificate).
 #[test]
-fn a_run_that_breaks_its_certificate_writes_nothing_unless_asked() {
+fn a_written_run_carries_its_certificate_in_summary_json() {
     // A thermal run at κΔt/Δx² = 5e7: certified by its conditioned bound (the residual
     // measured about 1e-9), whose summary carries the verdict and the measured steps.
     let s = scene(
@@ -177,7 +175,6 @@ fn a_run_that_breaks_its_certificate_writes_nothing_unless_asked() {
     assert_eq!(json["measured_steps"], summary.steps);
     assert!(json.get("first_failure").is_none());
     let _ = std::fs::remove_dir_all(&out);
-    let _ = Certify::Record;
 }
 
 /// Too stiff to certify: a heat step whose conditioning would let the identity drift by more
@@ -196,5 +193,36 @@ fn scenes_too_stiff_to_certify_are_refused_naming_the_key() {
     match viscobar::run_in_memory("tiny", &s).map(|_| ()) {
         Err(RunError::Scene(SceneError::Invalid { field, .. })) => assert_eq!(field, "time.step"),
         other => panic!("{other:?}"),
+    }
+}
+
+/// The run's own bound follows the conditioning as the stiff case matrix measures it: every
+/// case of the reduced matrix (impact, gap-0 and resting bars over `α` up to 1e6 and `Δt/Δx`
+/// up to 1e4, `κ(C)` up to 4e11; meshes to 1e5 elements; the long rigid and bouncing runs)
+/// runs certified with the exact and the penalty solvers, none refused; the overflowing load
+/// stops at its first step.
+#[test]
+fn every_stiff_case_certifies_itself_with_the_exact_and_penalty_solvers() {
+    use viscobar_certificate::bar::stiff::{Size, cases};
+    for case in cases(Size::Reduced) {
+        for solver in ["exact", "penalty"] {
+            let scene = case.scene(solver).unwrap();
+            let run = viscobar::run_in_memory("stiff", &scene);
+            if case.exact_must_fail {
+                assert!(
+                    matches!(run, Err(RunError::Step { step: 1, .. })),
+                    "{}",
+                    case.id()
+                );
+                continue;
+            }
+            match run {
+                Ok((_, summary, _)) => assert!(summary.certificate.certified, "{}", case.id()),
+                // The bar's penalty solver handles the ends only: an obstacle is refused.
+                Err(RunError::Scene(SceneError::Invalid { field, .. }))
+                    if solver == "penalty" && field == "solver.method" => {}
+                Err(e) => panic!("{} with {solver}: {e}", case.id()),
+            }
+        }
     }
 }

@@ -179,6 +179,17 @@ fn bad_thermal_input_exits_2_naming_the_key_and_writes_nothing() {
             &["heat.left.obstacle=\"1/0\""],
             "heat.left.obstacle",
         ),
+        // An end is a point: a temperature in x would be read at one node only.
+        (
+            "obstacle temperature in x",
+            &["heat.left.obstacle=\"x\""],
+            "heat.left.obstacle",
+        ),
+        (
+            "diffusivity too stiff to certify",
+            &["heat.diffusivity=1e12"],
+            "heat.diffusivity",
+        ),
         ("unknown key", &["heat.conductivity=1"], "conductivity"),
         ("osqp", &["solver.method=osqp"], "solver.method"),
         ("penalty", &["solver.method=penalty"], "solver.method"),
@@ -193,6 +204,11 @@ fn bad_thermal_input_exits_2_naming_the_key_and_writes_nothing() {
         (
             "non-finite end temperature",
             &["heat.right.value=\"1/t\""],
+            "heat.right.value",
+        ),
+        (
+            "end temperature in x",
+            &["heat.right.value=\"x\""],
             "heat.right.value",
         ),
         (

@@ -80,6 +80,9 @@ pub struct Summary {
     /// without load (where the scheme cannot gain energy), `null` otherwise.
     pub max_energy_rise: Option<f64>,
     pub max_identity_residual: f64,
+    /// The largest bound a measured step's `identity_residual` was held to (it follows the
+    /// step's conditioning, [`crate::scheme::certify`]).
+    pub max_identity_bound: f64,
     /// The run's certificate: `certified` (every measured step's identity residual within its
     /// bound), `measured_steps`, and on failure `first_failure` (step, time, check, value,
     /// bound); [`crate::scheme::certify`].
@@ -168,6 +171,7 @@ pub struct Tracker {
     energy_final: f64,
     max_rise: f64,
     max_residual: f64,
+    max_bound: f64,
     max_comp: f64,
     max_violation: f64,
     min_reaction: f64,
@@ -200,6 +204,7 @@ impl Tracker {
             energy_final: first.energy,
             max_rise: f64::NEG_INFINITY,
             max_residual: 0.0,
+            max_bound: 0.0,
             max_comp: 0.0,
             max_violation: 0.0,
             min_reaction: 0.0,
@@ -248,6 +253,7 @@ impl Tracker {
         if !r.measured {
             return None;
         }
+        self.max_bound = self.max_bound.max(r.identity_bound);
         (self.certificate)
             .observe(r.step, r.time, r.identity_residual, r.identity_bound)
             .cloned()
@@ -318,6 +324,7 @@ impl Tracker {
             max_energy_rise: (self.unforced && self.records > 0)
                 .then(|| self.max_rise / self.energy_initial.max(f64::MIN_POSITIVE)),
             max_identity_residual: self.max_residual,
+            max_identity_bound: self.max_bound,
             certificate: self.certificate.clone(),
             max_complementarity: self.max_comp,
             max_violation: self.max_violation,
