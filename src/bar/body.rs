@@ -71,12 +71,13 @@ pub struct BarBody {
     c_w: f64,
     /// `u_0` and `u_1`, evaluated again on request rather than kept (2 × J doubles).
     initial: InitialData,
-    /// `κ(C)` (Sturm bisection, [`crate::linalg::spectrum`]), for the identity's bound.
+    /// An upper bound on `κ(C)` ([`crate::linalg::spectrum::condition_bound`]), for the
+    /// identity's bound.
     condition: f64,
 }
 
 impl BarBody {
-    /// `κ(C)`, the step matrix's condition number.
+    /// An upper bound on `κ(C)`, the step matrix's condition number (at most 6 times it).
     pub fn condition(&self) -> f64 {
         self.condition
     }
@@ -233,12 +234,13 @@ impl Body for BarBody {
     }
 }
 
-/// `κ(C)` of the step matrix (infinite where it is numerically singular); a scene so stiff
+/// An upper bound on `κ(C)` (at most 6 times it; infinite where `C` is numerically singular,
+/// [`crate::linalg::spectrum::condition_bound`]); a scene so stiff
 /// that the identity's bound would exceed [`MAX_IDENTITY_BOUND`] is refused naming
 /// `time.step`.
 fn condition_of(disc: &Discretisation) -> Result<f64, SceneError> {
     let condition =
-        crate::linalg::spectrum::condition_number(&disc.step_matrix).unwrap_or(f64::INFINITY);
+        crate::linalg::spectrum::condition_bound(&disc.step_matrix).unwrap_or(f64::INFINITY);
     let bound = conditioned_bound(IDENTITY_TOL, disc.unknowns(), condition);
     if bound > MAX_IDENTITY_BOUND {
         return Err(SceneError::Invalid {
