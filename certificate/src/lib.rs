@@ -31,6 +31,7 @@ pub mod scale;
 pub mod stiff;
 pub mod stiff_runs;
 pub mod thermal;
+pub mod thermal_boundary;
 pub mod timings;
 pub mod tolerances;
 pub mod verify;
