@@ -80,6 +80,12 @@ pub struct Lemke {
     work: Vec<f64>,
     order: Vec<usize>,
     pivots_since_inversion: usize,
+    /// Per run of Lemke's method, the bases it visited as sets (tests only).
+    #[cfg(test)]
+    visited: Vec<Vec<Vec<usize>>>,
+    /// The most rows tied at a ratio test (tests only).
+    #[cfg(test)]
+    most_ties: usize,
 }
 
 impl Lemke {
@@ -110,6 +116,10 @@ impl Lemke {
             work: vec![0.0; n * n],
             order: vec![0; n],
             pivots_since_inversion: 0,
+            #[cfg(test)]
+            visited: Vec::new(),
+            #[cfg(test)]
+            most_ties: 0,
         };
         this.reset();
         this
@@ -226,6 +236,10 @@ impl Lemke {
         let n = self.n;
         let ulp = LEMKE_ULPS * f64::EPSILON;
         let mut ties = std::mem::take(&mut self.ties);
+        #[cfg(test)]
+        {
+            self.most_ties = self.most_ties.max(ties.len());
+        }
         let y = |i: usize| if unit { 1.0 } else { self.y[i] };
         for k in 0..n {
             if ties.len() <= 1 {
@@ -291,6 +305,11 @@ impl Lemke {
         self.y.fill(-1.0);
         let mut leaving = self.basis[r];
         self.pivot(r, x0);
+        #[cfg(test)]
+        {
+            self.visited.push(Vec::new());
+            self.record();
+        }
         let mut pivots = 1u32;
         loop {
             if leaving == x0 {
@@ -334,8 +353,18 @@ impl Lemke {
             };
             leaving = self.basis[r];
             self.pivot(r, entering);
+            #[cfg(test)]
+            self.record();
             pivots += 1;
         }
+    }
+
+    /// The current basis, as a set, into the current run's list of visited bases (tests only).
+    #[cfg(test)]
+    fn record(&mut self) {
+        let mut basis = self.basis.clone();
+        basis.sort_unstable();
+        self.visited.last_mut().expect("a run").push(basis);
     }
 
     /// `B` of the stored basis into `work` (row-major), then `B⁻¹` into `binv` by Gauss–Jordan
@@ -700,5 +729,98 @@ mod tests {
         Lemke::new(&f, 4).solve(&q, &mut x).unwrap();
         check(&f, &q, &x);
         assert!(x[0] > 0.0);
+    }
+
+    /// Solves `q` with `lemke` (warm from its stored basis): no run of the call visits a basis
+    /// twice, and the call ends on a solution; returns the most rows tied at a ratio test.
+    fn solve_without_revisiting(lemke: &mut Lemke, m: &[f64], q: &[f64]) -> usize {
+        lemke.visited.clear();
+        lemke.most_ties = 0;
+        let mut x = vec![0.0; q.len()];
+        let outcome = lemke.solve(q, &mut x);
+        for (k, run) in lemke.visited.iter().enumerate() {
+            for (i, basis) in run.iter().enumerate() {
+                let again = run[..i].iter().position(|b| b == basis);
+                assert!(
+                    again.is_none(),
+                    "run {k} visits the basis {basis:?} at pivots {} and {} (q = {q:?})",
+                    again.unwrap_or(0) + 1,
+                    i + 1
+                );
+            }
+        }
+        assert!(outcome.is_ok(), "{outcome:?} (q = {q:?})");
+        check(m, q, &x);
+        lemke.most_ties
+    }
+
+    /// Eight nodes pressed straight down onto a floor, with friction and no tangential drive
+    /// (`q_T = 0`, `q_λ = 0`): every normal ties at `x₀`'s entry and the tangential rows tie at
+    /// the ratio 0. Cold, then warm through other presses (some nodes just touching, `q_N = 0`)
+    /// and back: Lemke's method ends on a solution without visiting a basis twice in any run.
+    #[test]
+    fn lemke_ends_without_revisiting_a_basis_on_a_degenerate_frictional_lcp() {
+        use crate::step::friction::stewart_trinkle_matrix;
+        use crate::step::solver::Friction;
+        let (m, mu) = (8usize, 0.5);
+        let k = 2 * m;
+        // S = GᵀG + I/2 on the normals then the tangents: SPD, coupled (as E C⁻¹ Eᵀ is).
+        let g = |i: usize, j: usize| ((7 * i + 3 * j) % 11) as f64 / 11.0 - 0.45;
+        let mut s = vec![0.0; k * k];
+        for i in 0..k {
+            for j in 0..k {
+                s[i * k + j] = (0..k).map(|l| g(l, i) * g(l, j)).sum::<f64>();
+            }
+            s[i * k + i] += 0.5;
+        }
+        let friction = Friction {
+            normals: (0..m).collect(),
+            tangents: (m..k).collect(),
+            coefficients: vec![mu; m],
+        };
+        let sigma = (0..k).map(|i| s[i * k + i]).fold(0.0, f64::max);
+        let a = stewart_trinkle_matrix(&s, m, &friction, sigma);
+        let n = m + 3 * m;
+        let pressed = |down: &[f64]| {
+            let mut q = vec![0.0; n];
+            q[..m].copy_from_slice(down);
+            q
+        };
+        let straight = pressed(&[-1.0; 8]);
+        let touching = pressed(&[-1.0, 0.0, -1.0, 0.0, -2.0, -2.0, 0.0, -1.0]);
+        let mut lemke = Lemke::new(&a, n);
+        let mut most = 0;
+        for q in [&straight, &touching, &straight, &touching] {
+            most = most.max(solve_without_revisiting(&mut lemke, &a, q));
+        }
+        most = most.max(solve_without_revisiting(
+            &mut Lemke::new(&a, n),
+            &a,
+            &touching,
+        ));
+        // The ties the lexicographic rule breaks: all eight normals at x₀'s entry.
+        assert!(most >= m, "most rows tied {most}");
+    }
+
+    /// Two degenerate LCPs on which the plain ratio test, ties broken by row order, cycles;
+    /// built here and run in exact (rational) arithmetic: `q = −1` ties every row at `x₀`'s
+    /// entry and later ratios tie at 0. `M₁` (ties to the least row) and `M₂` (to the greatest)
+    /// return to their second basis at the eighth pivot and go round a cycle of six bases for
+    /// ever; the lexicographic rule reaches the solution `x = (⅓, ⅓, ⅓)` in 4 and 6 pivots.
+    /// Both are P-matrices (unique solution, on which Lemke's method must end).
+    #[test]
+    fn lemke_does_not_cycle_where_the_plain_ratio_test_does() {
+        let m1 = [1.0, 2.0, 0.0, 0.0, 1.0, 2.0, 2.0, 0.0, 1.0];
+        let m2 = [1.0, 0.0, 2.0, 2.0, 1.0, 0.0, 0.0, 2.0, 1.0];
+        let q = [-1.0; 3];
+        for m in [m1, m2] {
+            let ties = solve_without_revisiting(&mut Lemke::new(&m, 3), &m, &q);
+            assert_eq!(ties, 3, "every row ties at x₀'s entry");
+            let mut x = [0.0; 3];
+            Lemke::new(&m, 3).solve(&q, &mut x).unwrap();
+            for xi in x {
+                assert!((xi - 1.0 / 3.0).abs() <= KKT_TOL, "{x:?}");
+            }
+        }
     }
 }

@@ -3,6 +3,8 @@
 //! coupled thermoelastic modes (the cubic's roots against the run's, extracted by Prony's
 //! method) and a manufactured solution with contact. Closed forms and derivations: `docs/thermal.md`. Fast enough for `cargo test`.
 
+pub mod boundary;
+
 use nalgebra::{Complex, Matrix3, Vector3};
 use std::fmt::Write;
 use viscobar::output::run_thermal_in_memory;
