@@ -9,63 +9,89 @@ use viscobar::scene::{self, AnyScene};
 /// The name a scene given as TOML text or as a dict runs under (`summary.json`'s `scene`).
 pub const INLINE_NAME: &str = "scene";
 
-/// The scene `scene` with the assignments of `set` and `solver` applied, and its name.
-pub fn load(
-    scene: &Bound<'_, PyAny>,
-    set: Option<&Bound<'_, PyDict>>,
-    solver: Option<&str>,
-) -> PyResult<(String, AnyScene)> {
-    let mut overrides = Vec::new();
-    for (key, value) in set.into_iter().flat_map(|d| d.iter()) {
-        let key: String = key
-            .extract()
-            .map_err(|_| SceneError::new_err(format!("set: a key is not a str: {key}")))?;
-        let text = if let Ok(s) = value.cast::<PyString>() {
-            s.to_cow()?.into_owned()
-        } else {
-            toml_value(&value, &key)?.to_string()
-        };
-        overrides.push(format!("{key}={text}"));
-    }
-    // After `set`, as the command line puts `--solver` after the `--set`s.
-    if let Some(s) = solver {
-        overrides.push(format!("solver.method=\"{s}\""));
-    }
-    let fail = |e: scene::SceneError| SceneError::new_err(e.to_string());
-    if let Ok(table) = scene.cast::<PyDict>() {
-        let mut t = toml::Table::new();
-        for (key, value) in table.iter() {
+/// A scene as the library reads it: its TOML text or its name or path, and the
+/// `key=value` assignments to apply.
+pub struct Source {
+    scene: Scene,
+    overrides: Vec<String>,
+}
+
+enum Scene {
+    Text(String),
+    NameOrPath(String),
+}
+
+impl Source {
+    /// The scene `scene` with the assignments of `set` and `solver`, read from Python (the
+    /// library reads it in [`Source::load`]).
+    pub fn new(
+        scene: &Bound<'_, PyAny>,
+        set: Option<&Bound<'_, PyDict>>,
+        solver: Option<&str>,
+    ) -> PyResult<Self> {
+        let mut overrides = Vec::new();
+        for (key, value) in set.into_iter().flat_map(|d| d.iter()) {
             let key: String = key
                 .extract()
-                .map_err(|_| SceneError::new_err(format!("scene: a key is not a str: {key}")))?;
-            let v = toml_value(&value, &key)?;
-            t.insert(key, v);
+                .map_err(|_| SceneError::new_err(format!("set: a key is not a str: {key}")))?;
+            let text = if let Ok(s) = value.cast::<PyString>() {
+                s.to_cow()?.into_owned()
+            } else {
+                toml_value(&value, &key)?.to_string()
+            };
+            overrides.push(format!("{key}={text}"));
         }
-        let text = toml::to_string(&t).map_err(|e| SceneError::new_err(e.to_string()))?;
-        let any = scene::plane::any_from_toml(&text, &overrides).map_err(fail)?;
-        return Ok((INLINE_NAME.into(), any));
+        // After `set`, as the command line puts `--solver` after the `--set`s.
+        if let Some(s) = solver {
+            overrides.push(format!("solver.method=\"{s}\""));
+        }
+        if let Ok(table) = scene.cast::<PyDict>() {
+            let mut t = toml::Table::new();
+            for (key, value) in table.iter() {
+                let key: String = key.extract().map_err(|_| {
+                    SceneError::new_err(format!("scene: a key is not a str: {key}"))
+                })?;
+                let v = toml_value(&value, &key)?;
+                t.insert(key, v);
+            }
+            let text = toml::to_string(&t).map_err(|e| SceneError::new_err(e.to_string()))?;
+            let scene = Scene::Text(text);
+            return Ok(Source { scene, overrides });
+        }
+        let text: String = if let Ok(s) = scene.cast::<PyString>() {
+            s.to_cow()?.into_owned()
+        } else {
+            // A path-like object.
+            let os = scene.py().import("os")?;
+            let path = os.call_method1("fspath", (scene,)).map_err(|_| {
+                SceneError::new_err(format!(
+                    "scene: a built-in name, a path, TOML text or a dict, not {}",
+                    scene
+                        .get_type()
+                        .name()
+                        .map_or("this".into(), |n| n.to_string())
+                ))
+            })?;
+            path.extract()?
+        };
+        let scene = if is_toml_text(&text) {
+            Scene::Text(text)
+        } else {
+            Scene::NameOrPath(text)
+        };
+        Ok(Source { scene, overrides })
     }
-    let text: String = if let Ok(s) = scene.cast::<PyString>() {
-        s.to_cow()?.into_owned()
-    } else {
-        // A path-like object.
-        let os = scene.py().import("os")?;
-        let path = os.call_method1("fspath", (scene,)).map_err(|_| {
-            SceneError::new_err(format!(
-                "scene: a built-in name, a path, TOML text or a dict, not {}",
-                scene
-                    .get_type()
-                    .name()
-                    .map_or("this".into(), |n| n.to_string())
-            ))
-        })?;
-        path.extract()?
-    };
-    if is_toml_text(&text) {
-        let any = scene::plane::any_from_toml(&text, &overrides).map_err(fail)?;
-        return Ok((INLINE_NAME.into(), any));
+
+    /// The scene read, validated and overridden as the command line does, and its name.
+    pub fn load(&self) -> Result<(String, AnyScene), scene::SceneError> {
+        match &self.scene {
+            Scene::Text(text) => Ok((
+                INLINE_NAME.into(),
+                scene::plane::any_from_toml(text, &self.overrides)?,
+            )),
+            Scene::NameOrPath(name) => scene::load_any(name, &self.overrides),
+        }
     }
-    scene::load_any(&text, &overrides).map_err(fail)
 }
 
 /// TOML text rather than a name or a path: a line break, or an `=` with no file of that name.

@@ -119,8 +119,12 @@ fn run(
     solver: Option<&str>,
     set: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Run> {
-    let (name, any) = convert::load(scene, set, solver)?;
-    let recorded = detached(py, || Ok(record_any(&name, &any)?))?;
+    let source = convert::Source::new(scene, set, solver)?;
+    let (name, any, recorded) = detached(py, || {
+        let (name, any) = source.load()?;
+        let recorded = record_any(&name, &any)?;
+        Ok((name, any, recorded))
+    })?;
     Run::new(py, name, any, recorded)
 }
 
@@ -134,9 +138,9 @@ fn _panic_for_test(py: Python<'_>) -> PyResult<()> {
     Ok(())
 }
 
-/// Seconds the library takes to run `scene` in memory, timed in Rust with the GIL released
-/// (python/bench/ratio.py's reference; not part of the API). `keep = "outputs"` keeps what
-/// `run` keeps (`viscobar::output::memory`); `keep = "records"` is the library's
+/// Seconds the library takes to read and run `scene` in memory, timed in Rust with the GIL
+/// released (python/bench/ratio.py's reference; not part of the API). `keep = "outputs"` keeps
+/// what `run` keeps (`viscobar::output::memory`); `keep = "records"` is the library's
 /// `run_in_memory` (every step's record, no profiles).
 #[pyfunction]
 #[pyo3(signature = (scene, *, set=None, keep="outputs"))]
@@ -146,7 +150,7 @@ fn _library_run_seconds(
     set: Option<&Bound<'_, PyDict>>,
     keep: &str,
 ) -> PyResult<f64> {
-    let (name, any) = convert::load(scene, set, None)?;
+    let source = convert::Source::new(scene, set, None)?;
     let records = match keep {
         "outputs" => false,
         "records" => true,
@@ -154,6 +158,7 @@ fn _library_run_seconds(
     };
     let seconds = detached(py, || {
         let start = std::time::Instant::now();
+        let (name, any) = source.load()?;
         match (&any, records) {
             (_, false) => drop(record_any(&name, &any)?),
             (AnyScene::Bar(bar), true) if bar.heat.is_some() => {

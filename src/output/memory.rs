@@ -346,12 +346,13 @@ mod tests {
 
     /// The in-memory run writes the files of the run to a folder byte for byte (summary.json
     /// but for its clock fields), and its arrays are the numbers the files read back to, on a
-    /// bar with sampled steps and nodes and unmeasured steps, a bar with an obstacle moving
+    /// bar with sampled steps and nodes and unmeasured steps, a bar on an obstacle under every
+    /// node (the extent's cells empty before contact), a bar whose obstacle moves
     /// (`obstacle_work`), a thermal bar, a plane and a plane with friction.
     #[test]
     fn the_memory_run_holds_the_files_of_the_run_to_a_folder() {
         // Each case's scene, overrides and a column that only such a run writes.
-        let cases: [(&str, &[&str], &str); 5] = [
+        let cases: [(&str, &[&str], &str); 6] = [
             (
                 "impact",
                 &[
@@ -363,10 +364,12 @@ mod tests {
             ),
             (
                 "distributed-forced",
-                &[
-                    "time.end=0.5",
-                    "obstacle.gap=\"0.2 + 0.1*cos(2*x) + 0.05*t\"",
-                ],
+                &["time.end=2.5"],
+                "contact_s_min_obstacle",
+            ),
+            (
+                "impact",
+                &["time.end=0.5", "left.gap=\"0.1 - 0.5*t\""],
                 "obstacle_work",
             ),
             (
