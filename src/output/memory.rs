@@ -183,6 +183,14 @@ fn record_prepared<B: Body>(
         has_theta: B::TEMPERATURE,
         ..Profile::default()
     };
+    // Sized once: the kept steps are known (`sampling.kept_steps`).
+    let kept = usize::try_from(sampling.kept_steps).unwrap_or(0);
+    profile.times.reserve_exact(kept);
+    profile.displacement.reserve_exact(kept * dofs.len());
+    profile.velocity.reserve_exact(kept * dofs.len());
+    if B::TEMPERATURE {
+        profile.theta.reserve_exact(kept * nodes.len());
+    }
     let keep_step = |profile: &mut Profile, t: f64, state: State<'_>, body: &B| {
         profile.keep(t, state, &dofs);
         if B::TEMPERATURE {
