@@ -13,7 +13,9 @@ fi
 py="$venv/bin/python"
 "$py" -m pip install --quiet --disable-pip-version-check \
   'maturin>=1.9.4,<2' pytest numpy 'dask[distributed]' matplotlib
-# maturin is in the environment already: no isolated build environment to fetch it into.
+# maturin is in the environment already (its PEP 517 hook calls it from PATH): no isolated
+# build environment to fetch it into.
+export PATH="$PWD/$venv/bin:$PATH"
 "$py" -m pip install --quiet --disable-pip-version-check --no-build-isolation ./python
 cargo build --release --quiet
 VISCOBAR_CLI="$PWD/target/release/viscobar" MPLBACKEND=Agg "$py" -m pytest python/tests -q "$@"
