@@ -264,11 +264,11 @@ impl Recorded {
     /// Writes `summary.json`, `history.csv` and `displacement.csv` into `out` as
     /// [`super::run::run_to_dir`] does (whole or not at all); the scene's `[output]` format
     /// must be `csv` (the other formats' writers need the run's bodies: run the scene to a
-    /// folder instead), else a [`crate::SceneError`] naming `output.format`.
+    /// folder instead), else a [`crate::scene::SceneError`] naming `output.format`.
     pub fn write_to_dir(&self, out: &Path) -> Result<(), RunError> {
         let format = self.summary.output.map_or(OutputFormat::Csv, |s| s.format);
         if format != OutputFormat::Csv {
-            return Err(crate::SceneError::Invalid {
+            return Err(crate::scene::SceneError::Invalid {
                 field: "output.format".into(),
                 value: format!("\"{}\"", format.name()),
                 allowed: "a run kept in memory writes \"csv\"; run the scene to a folder for \
