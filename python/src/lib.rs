@@ -8,10 +8,11 @@
 
 mod convert;
 
-use numpy::{PyArray1, PyArrayMethods};
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
+use std::mem::take;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 use viscobar::output::memory::{Recorded, record_any};
@@ -182,6 +183,7 @@ fn _library_run_seconds(
 #[pyclass(frozen, module = "viscobar")]
 struct Run {
     name: String,
+    /// The run's outputs, its profile arrays and history columns moved into numpy's.
     recorded: Recorded,
     scene: AnyScene,
     times: Py<PyAny>,
@@ -192,18 +194,28 @@ struct Run {
     history: Py<PyDict>,
 }
 
-/// A read-only numpy array of `values` with `shape`.
-fn array(py: Python<'_>, values: &[f64], shape: &[usize]) -> PyResult<Py<PyAny>> {
-    let a = PyArray1::from_slice(py, values).reshape(shape.to_vec())?;
+/// A read-only numpy array of `values` (moved, not copied) with `shape`.
+fn array(py: Python<'_>, values: Vec<f64>, shape: &[usize]) -> PyResult<Py<PyAny>> {
+    let a = PyArray1::from_vec(py, values).reshape(shape.to_vec())?;
     let flags = PyDict::new(py);
     flags.set_item("write", false)?;
     a.call_method("setflags", (), Some(&flags))?;
     Ok(a.into_any().unbind())
 }
 
+/// The values of an array made by [`array`], in order.
+fn values(py: Python<'_>, a: &Py<PyAny>) -> PyResult<Vec<f64>> {
+    Ok(a.bind(py).cast::<PyArrayDyn<f64>>()?.to_vec()?)
+}
+
 impl Run {
-    fn new(py: Python<'_>, name: String, scene: AnyScene, recorded: Recorded) -> PyResult<Self> {
-        let p = &recorded.profile;
+    fn new(
+        py: Python<'_>,
+        name: String,
+        scene: AnyScene,
+        mut recorded: Recorded,
+    ) -> PyResult<Self> {
+        let p = &mut recorded.profile;
         let (kept, n, k) = (p.times.len(), p.nodes(), p.components);
         let fields = if k == 1 {
             vec![kept, n]
@@ -211,28 +223,50 @@ impl Run {
             vec![kept, n, k]
         };
         let positions = if k == 1 {
-            array(py, &p.x, &[n])?
+            array(py, p.x.clone(), &[n])?
         } else {
             let xy: Vec<f64> = p.x.iter().zip(&p.y).flat_map(|(x, y)| [*x, *y]).collect();
-            array(py, &xy, &[n, 2])?
+            array(py, xy, &[n, 2])?
         };
+        let times = array(py, take(&mut p.times), &[kept])?;
+        let displacement = array(py, take(&mut p.displacement), &fields)?;
+        let velocity = array(py, take(&mut p.velocity), &fields)?;
+        let theta = (p.has_theta)
+            .then(|| array(py, take(&mut p.theta), &[kept, n]))
+            .transpose()?;
         let history = PyDict::new(py);
-        for (column, values) in recorded.history_columns.iter().zip(&recorded.history) {
-            history.set_item(column, array(py, values, &[values.len()])?)?;
+        for (column, v) in recorded
+            .history_columns
+            .iter()
+            .zip(take(&mut recorded.history))
+        {
+            let len = v.len();
+            history.set_item(column, array(py, v, &[len])?)?;
         }
         Ok(Run {
-            times: array(py, &p.times, &[kept])?,
+            times,
             positions,
-            displacement: array(py, &p.displacement, &fields)?,
-            velocity: array(py, &p.velocity, &fields)?,
-            theta: (p.has_theta)
-                .then(|| array(py, &p.theta, &[kept, n]))
-                .transpose()?,
+            displacement,
+            velocity,
+            theta,
             history: history.unbind(),
             name,
             scene,
             recorded,
         })
+    }
+
+    /// The run's outputs with the profile arrays read back from numpy's.
+    fn with_profiles(&self, py: Python<'_>) -> PyResult<Recorded> {
+        let mut recorded = self.recorded.clone();
+        let p = &mut recorded.profile;
+        p.times = values(py, &self.times)?;
+        p.displacement = values(py, &self.displacement)?;
+        p.velocity = values(py, &self.velocity)?;
+        if let Some(theta) = &self.theta {
+            p.theta = values(py, theta)?;
+        }
+        Ok(recorded)
     }
 }
 
@@ -308,9 +342,10 @@ impl Run {
     fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let csv =
             (self.recorded.summary.output).is_none_or(|s| s.format == scene::OutputFormat::Csv);
+        let recorded = csv.then(|| self.with_profiles(py)).transpose()?;
         detached(py, || {
-            if csv {
-                return Ok(self.recorded.write_to_dir(&path)?);
+            if let Some(recorded) = recorded {
+                return Ok(recorded.write_to_dir(&path)?);
             }
             match &self.scene {
                 AnyScene::Bar(bar) => drop(run_to_dir(&self.name, bar, &path, false)?),
@@ -328,7 +363,7 @@ impl Run {
             self.name,
             s.body,
             s.steps,
-            self.recorded.profile.times.len(),
+            s.output.map_or(0, |o| o.kept_steps),
             s.unknowns,
             s.solver
         )
