@@ -1,12 +1,14 @@
 //! A run's outputs, through the same code for both bodies: `summary.json` ([`summary`]),
 //! `history.csv` ([`history`]) and the profile file ([`profiles`], `displacement.csv` or
 //! `displacement.npy`) or the ParaView files ([`vtk`]), the text of their numbers ([`text`]),
-//! written whole or not at all ([`files`]) by the run loop ([`run`]).
+//! written whole or not at all ([`files`]) by the run loop ([`run`]), or kept in memory
+//! ([`memory`]).
 //!
 //! Imports every layer below it.
 
 pub mod files;
 pub mod history;
+pub mod memory;
 #[cfg(feature = "npy")]
 pub mod npy;
 pub mod profiles;

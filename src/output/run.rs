@@ -28,7 +28,11 @@ pub enum Certify {
 }
 
 /// The records of a run so far, checked against its certificate as `certify` asks.
-fn observe(tracker: &mut Tracker, r: &StepRecord, certify: Certify) -> Result<(), RunError> {
+pub(crate) fn observe(
+    tracker: &mut Tracker,
+    r: &StepRecord,
+    certify: Certify,
+) -> Result<(), RunError> {
     match tracker.observe(r) {
         Some(failure) if certify == Certify::Strict => Err(RunError::Uncertified(failure)),
         _ => Ok(()),
