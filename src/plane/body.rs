@@ -13,12 +13,15 @@ use crate::plane::matrices::{Material, assemble, assemble_with};
 use crate::plane::mesh::Grid;
 use crate::plane::normals::{Normal, edge_motion, normals};
 use crate::plane::stress;
+use crate::scene::SceneError;
 use crate::scene::SolverMethod;
 use crate::scene::expr::Expression;
 use crate::scene::plane::PENALTY_CONDENSED_MAX_NORMALS;
 use crate::scene::plane::{EDGE_NAMES, PlaneScene};
 use crate::scheme::body::{Body, EnergySums, FullMassRows};
-use crate::scheme::certify::{LAMBDA_IDENTITY_ULPS, PLANE_IDENTITY_TOL, conditioned_bound};
+use crate::scheme::certify::{
+    LAMBDA_IDENTITY_ULPS, MAX_IDENTITY_BOUND, PLANE_IDENTITY_TOL, conditioned_bound,
+};
 use crate::scheme::contact::{ContactSet, Group, Positions};
 use crate::scheme::{Load, RunError, Scheme, Setup, Unstarted};
 use crate::step::{CondensedSolver, OsqpSolver, SparsePenaltySolver, StepSolver};
@@ -125,6 +128,27 @@ pub struct PlaneBody {
     /// `1/Δt²` and `½ − α/(2Δt)`.
     inv_dt2: f64,
     c_w: f64,
+    /// An upper bound on `κ(C)` ([`condition_bound`]), for the identity's bound.
+    condition: f64,
+}
+
+/// An upper bound on `κ₂(C)` in one pass over the pattern: `λ_max(C)` is at most the largest
+/// absolute row sum, and `λ_min(C) >= λ_min(M)/Δt² >= min_i Σ_j M_ij / (9 Δt²)` (`K` is
+/// positive semi-definite; on a rectangle Q1's mass matrix is the tensor product of P1's, each
+/// at least a third of its row-sum lumping as a quadratic form, so at least a ninth; the row
+/// sums on the unknowns alone are at most the full ones).
+fn condition_bound(p: &Pattern, c: &[f64], mass: &[f64], dt: f64) -> f64 {
+    let (mut largest, mut least) = (0.0f64, f64::INFINITY);
+    for i in 0..p.n {
+        let row = p.row_ptr[i]..p.row_ptr[i + 1];
+        largest = largest.max(c[row.clone()].iter().map(|v| v.abs()).sum());
+        least = least.min(mass[row].iter().sum());
+    }
+    if least > 0.0 {
+        largest * 9.0 * dt * dt / least
+    } else {
+        f64::INFINITY
+    }
 }
 
 impl PlaneBody {
@@ -150,13 +174,17 @@ impl PlaneBody {
 impl Body for PlaneBody {
     const NAME: &'static str = "plane";
 
-    /// `PLANE_IDENTITY_TOL + LAMBDA_IDENTITY_ULPS ε λ/μ + ε n`: the volumetric energy weighs
-    /// the solve's round-off by `λ` ([`crate::scheme::certify::LAMBDA_IDENTITY_ULPS`]), and the
-    /// energy sums over `n` unknowns round by `γ_n`.
+    /// `PLANE_IDENTITY_TOL + LAMBDA_IDENTITY_ULPS ε λ/μ`, with [`conditioned_bound`]'s terms of
+    /// the `n` unknowns and of `C`'s conditioning ([`condition_bound`]): the volumetric energy
+    /// weighs the solve's round-off by `λ` ([`crate::scheme::certify::LAMBDA_IDENTITY_ULPS`]).
     fn identity_tolerance(&self) -> f64 {
         let m = self.disc.material;
         let volumetric = LAMBDA_IDENTITY_ULPS * f64::EPSILON * m.lambda / m.mu;
-        conditioned_bound(PLANE_IDENTITY_TOL + volumetric, self.unknowns(), 0.0)
+        conditioned_bound(
+            PLANE_IDENTITY_TOL + volumetric,
+            self.unknowns(),
+            self.condition,
+        )
     }
 
     fn unknowns(&self) -> usize {
@@ -349,8 +377,22 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
         )?),
     };
     let (dt, alpha) = (disc.dt, disc.alpha);
+    let condition = condition_bound(&disc.pattern, &c, &disc.mass, dt);
+    let bound = conditioned_bound(PLANE_IDENTITY_TOL, disc.unknowns(), condition);
+    if bound > MAX_IDENTITY_BOUND {
+        return Err(SceneError::Invalid {
+            field: "time.step".into(),
+            value: dt.to_string(),
+            allowed: format!(
+                "a step matrix with condition number up to {condition:.1e} holds the energy \
+                 identity only to {bound:.1e}, above {MAX_IDENTITY_BOUND:e}: take a smaller step"
+            ),
+        }
+        .into());
+    }
     let body = PlaneBody {
         normals,
+        condition,
         c,
         inv_dt2: 1.0 / (dt * dt),
         c_w: 0.5 - alpha / (2.0 * dt),
