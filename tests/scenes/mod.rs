@@ -356,6 +356,9 @@ pub struct PlaneDraw {
     pub dt: f64,
     pub steps: u64,
     pub solver: &'static str,
+    /// Seen from the other side: `x → W − x` (the bottom and top gaps' `s` read as `W − s`, the
+    /// `x` components of the velocity and the load negated; the caller swaps left and right).
+    pub mirrored: bool,
 }
 
 pub fn plane_draw() -> impl Strategy<Value = PlaneDraw> {
@@ -403,6 +406,7 @@ pub fn plane_draw() -> impl Strategy<Value = PlaneDraw> {
             dt,
             steps,
             solver,
+            mirrored: false,
         },
     )
 }
@@ -414,28 +418,47 @@ impl PlaneDraw {
              viscosity = {:?}\nintegration = \"{}\"\n\n[edges]\n",
             self.width, self.height, self.lambda, self.mu, self.viscosity, self.integration
         );
-        for (name, e) in ["left", "right", "bottom", "top"].iter().zip(self.edges) {
+        for (k, (name, e)) in ["left", "right", "bottom", "top"]
+            .iter()
+            .zip(self.edges)
+            .enumerate()
+        {
+            // Along bottom and top `s = x`, which the mirror turns into `W − s`.
+            let gap = |g: &str| {
+                if self.mirrored && k >= 2 {
+                    g.replace('s', &format!("({:?} - s)", self.width))
+                } else {
+                    g.to_string()
+                }
+            };
             t += &match e {
                 Edge::Free => format!("{name} = {{ condition = \"free\" }}\n"),
                 Edge::Clamped => format!("{name} = {{ condition = \"clamped\" }}\n"),
-                Edge::Signorini {
-                    gap,
-                    friction: None,
-                } => format!("{name} = {{ condition = \"signorini\", gap = \"{gap}\" }}\n"),
-                Edge::Signorini {
-                    gap,
-                    friction: Some(f),
-                } => format!(
-                    "{name} = {{ condition = \"signorini\", gap = \"{gap}\", friction = {f:?} }}\n"
-                ),
+                Edge::Signorini { gap: g, friction } => {
+                    let friction =
+                        friction.map_or(String::new(), |f| format!(", friction = {f:?}"));
+                    format!(
+                        "{name} = {{ condition = \"signorini\", gap = \"{}\"{friction} }}\n",
+                        gap(g)
+                    )
+                }
             };
         }
+        // The mirror negates the x components.
+        let x = |v: &str| {
+            if self.mirrored {
+                format!("-({v})")
+            } else {
+                v.to_string()
+            }
+        };
         t += &format!(
             "\n[initial]\nvelocity = [\"{}\", \"{}\"]\n\n",
-            self.velocity[0], self.velocity[1]
+            x(self.velocity[0]),
+            self.velocity[1]
         );
         if let Some([lx, ly]) = self.load {
-            t += &format!("[load]\ndensity = [\"{lx}\", \"{ly}\"]\n\n");
+            t += &format!("[load]\ndensity = [\"{}\", \"{ly}\"]\n\n", x(lx));
         }
         t += &format!(
             "[mesh]\nnx = {}\nny = {}\n\n[time]\nstep = {:?}\nend = {:?}\n\n[solver]\nmethod = \"{}\"\n",
@@ -446,6 +469,14 @@ impl PlaneDraw {
             self.solver
         );
         t
+    }
+
+    /// The same scene seen from the other side: `x → W − x`, left and right swapped.
+    pub fn mirrored(&self) -> Self {
+        let mut m = self.clone();
+        m.mirrored = !self.mirrored;
+        m.edges.swap(0, 1);
+        m
     }
 
     /// With some `friction = 0`, the scene without those keys.
