@@ -175,7 +175,7 @@ impl Body for PlaneBody {
     const NAME: &'static str = "plane";
 
     /// `PLANE_IDENTITY_TOL + LAMBDA_IDENTITY_ULPS ε λ/μ`, with [`conditioned_bound`]'s terms of
-    /// the `n` unknowns and of `C`'s conditioning ([`condition_bound`]): the volumetric energy
+    /// the `n` unknowns and of `C`'s conditioning (bounded at set-up): the volumetric energy
     /// weighs the solve's round-off by `λ` ([`crate::scheme::certify::LAMBDA_IDENTITY_ULPS`]).
     fn identity_tolerance(&self) -> f64 {
         let m = self.disc.material;
