@@ -4,6 +4,8 @@
 //! identity measured against the run's energy resolution once every term is rounding noise),
 //! a run's own certificate in `summary.json`, and the refusal of scenes too stiff to certify.
 
+mod common;
+
 use viscobar::output::{RunOptions, run_thermal_in_memory, run_to_dir_with};
 use viscobar::scheme::{RunError, StepRecord};
 use viscobar::{Scene, SceneError};
@@ -148,12 +150,6 @@ fn a_bar_at_rest_on_an_obstacle_under_a_moving_end_keeps_its_identity() {
     assert!(records.iter().any(|r| r.obstacle_work != 0.0));
 }
 
-fn fresh_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("viscobar-seams-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
-
 /// A written run carries its certificate in `summary.json`: `certified`, the measured steps,
 /// and no failure (a run over its bound is tested in `output::run`'s unit tests: no valid
 /// scene breaks its certificate).
@@ -165,7 +161,7 @@ fn a_written_run_carries_its_certificate_in_summary_json() {
         EXCHANGE_ON_MOVING_OBSTACLE,
         &["heat.diffusivity=5e5", "time.end=0.1"],
     );
-    let out = fresh_dir("certified");
+    let out = common::fresh_dir("seams", "certified");
     let summary = run_to_dir_with("hot", &s, &out, RunOptions::strict(false)).unwrap();
     assert!(summary.certificate.certified);
     assert_eq!(summary.certificate.measured_steps, summary.steps);

@@ -407,10 +407,7 @@ mod tests {
         let json = serde_json::to_value(&summary).unwrap();
         assert_eq!(json["certified"], false);
         assert_eq!(json["first_failure"]["step"], 2);
-        assert_eq!(RunError::Uncertified(json_failure(&summary)).exit_code(), 1);
-    }
-
-    fn json_failure(s: &Summary) -> crate::scheme::CertificateFailure {
-        s.certificate.first_failure.clone().unwrap()
+        let failure = summary.certificate.first_failure.clone().unwrap();
+        assert_eq!(RunError::Uncertified(failure).exit_code(), 1);
     }
 }
