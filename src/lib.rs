@@ -25,8 +25,12 @@ pub mod study;
 pub mod thermal;
 
 pub use bar::Simulation;
-pub use output::{ContactEpisode, Summary, run_in_memory, run_to_dir};
+pub use output::{
+    BarSimulation, ContactEpisode, Summary, run_in_memory, run_plane_in_memory, run_plane_to_dir,
+    run_to_dir,
+};
 pub use plane::PlaneSimulation;
 pub use scene::{AnyScene, PlaneScene, Scene, SceneError, SolverMethod};
 pub use scheme::{RunError, StepRecord};
 pub use step::{StepFailure, StepSolver};
+pub use thermal::ThermalSimulation;

@@ -74,6 +74,9 @@ fn complementarity_holds_at_every_step_and_constrained_node() {
     for name in builtin_names() {
         let scene = common::builtin(name, &[]);
         let (records, summary, sim) = run_in_memory(name, &scene).unwrap();
+        let sim = sim
+            .mechanical()
+            .expect("the built-in bar scenes have no [heat]");
         let constrained = sim.discretisation().constraints.len();
         for r in &records {
             // The record's aggregates run over every constrained node (ends and obstacle).

@@ -37,6 +37,7 @@ fn impact_has_one_episode_whose_impulse_reverses_the_momentum() {
             ],
         );
         let (_, summary, sim) = run_in_memory("impact", &scene).unwrap();
+        let sim = sim.mechanical().expect("impact has no [heat]");
         let e = episodes(&summary, "left");
         assert_eq!(e.len(), 1, "{e:?}");
         let e = &e[0];

@@ -20,7 +20,7 @@ use proptest::test_runner::{Config, TestCaseError, TestRunner};
 use scenes::{BarDraw, PlaneDraw, bar_draw, plane_draw};
 use viscobar::scene::{AnyScene, load_any};
 use viscobar::scheme::{CONTACT_GAP_TOL, RunError, StepRecord};
-use viscobar::{PlaneScene, Scene};
+use viscobar::{BarSimulation, PlaneScene, Scene};
 
 fn cases() -> u32 {
     std::env::var("SCENE_CASES")
@@ -236,16 +236,20 @@ type Ran = (Vec<StepRecord>, Vec<f64>, usize, bool);
 
 fn run_bar(s: &Scene, _text: &str) -> Result<Ran, RunError> {
     let exact = s.solver.method == viscobar::SolverMethod::Exact;
-    if s.heat.is_some() {
-        let (records, _, sim) = viscobar::output::run_thermal_in_memory("draw", s)?;
-        let groups = sim.contact().groups().len();
-        // The displacement block of `[u | θ]`.
-        let n_u = sim.body().bar().discretisation().unknowns();
-        Ok((records, sim.state().u[..n_u].to_vec(), groups, exact))
-    } else {
-        let (records, _, sim) = viscobar::run_in_memory("draw", s)?;
-        let groups = sim.contact().groups().len();
-        Ok((records, sim.state().u.to_vec(), groups, exact))
+    // `run_in_memory` runs a scene with `[heat]` with its temperature, as `run_to_dir` does.
+    let (records, _, sim) = viscobar::run_in_memory("draw", s)?;
+    assert_eq!(sim.thermal().is_some(), s.heat.is_some());
+    match sim {
+        BarSimulation::Thermal(sim) => {
+            let groups = sim.contact().groups().len();
+            // The displacement block of `[u | θ]`.
+            let n_u = sim.body().bar().discretisation().unknowns();
+            Ok((records, sim.state().u[..n_u].to_vec(), groups, exact))
+        }
+        BarSimulation::Mechanical(sim) => {
+            let groups = sim.contact().groups().len();
+            Ok((records, sim.state().u.to_vec(), groups, exact))
+        }
     }
 }
 

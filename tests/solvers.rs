@@ -308,9 +308,7 @@ fn stiff_impact(ratio: f64, extra: &[&str]) -> Scene {
     common::builtin("impact", &o)
 }
 
-fn step_failure(
-    result: Result<(Vec<viscobar::StepRecord>, viscobar::Summary, Simulation), RunError>,
-) -> (usize, StepFailure) {
+fn step_failure<T>(result: Result<T, RunError>) -> (usize, StepFailure) {
     match result {
         Err(RunError::Step { step, failure, .. }) => (step, failure),
         Err(e) => panic!("expected a step failure, got {e}"),

@@ -162,13 +162,8 @@ fn _library_run_seconds(
         let (name, any) = source.load()?;
         match (&any, records) {
             (_, false) => drop(record_any(&name, &any)?),
-            (AnyScene::Bar(bar), true) if bar.heat.is_some() => {
-                drop(viscobar::output::run_thermal_in_memory(&name, bar)?)
-            }
             (AnyScene::Bar(bar), true) => drop(viscobar::run_in_memory(&name, bar)?),
-            (AnyScene::Plane(plane), true) => {
-                drop(viscobar::output::run_plane_in_memory(&name, plane)?)
-            }
+            (AnyScene::Plane(plane), true) => drop(viscobar::run_plane_in_memory(&name, plane)?),
         }
         Ok(start.elapsed().as_secs_f64())
     })?;

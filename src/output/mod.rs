@@ -18,7 +18,7 @@ pub mod text;
 pub mod vtk;
 
 pub use run::{
-    Certify, RunOptions, run_in_memory, run_plane_in_memory, run_plane_to_dir,
+    BarSimulation, Certify, RunOptions, run_in_memory, run_plane_in_memory, run_plane_to_dir,
     run_plane_to_dir_with, run_thermal_in_memory, run_to_dir, run_to_dir_with,
 };
 pub use summary::{ContactEpisode, Summary, Tracker};

@@ -111,15 +111,48 @@ pub fn run_scheme_in_memory_with<B: Body>(
 /// ```
 ///
 /// A scene built in code is validated like a scene file: [`crate::Simulation::new`] returns the
-/// same [`crate::SceneError`] (inside [`RunError::Scene`]) that the command line prints.
+/// same [`crate::SceneError`] (inside [`RunError::Scene`]) that the command line prints. A
+/// scene with `[heat]` runs with its temperature, as [`run_to_dir`] runs it.
 pub fn run_in_memory(
     name: &str,
     scene: &Scene,
-) -> Result<(Vec<StepRecord>, Summary, Simulation), RunError> {
-    run_scheme_in_memory(name, Simulation::new(scene)?, scene.steps())
+) -> Result<(Vec<StepRecord>, Summary, BarSimulation), RunError> {
+    if scene.heat.is_some() {
+        let (records, summary, sim) = run_thermal_in_memory(name, scene)?;
+        return Ok((records, summary, BarSimulation::Thermal(sim)));
+    }
+    let (records, summary, sim) =
+        run_scheme_in_memory(name, Simulation::new(scene)?, scene.steps())?;
+    Ok((records, summary, BarSimulation::Mechanical(sim)))
 }
 
-/// Runs a bar scene with a temperature (`[heat]`) in memory.
+/// A bar scene's simulation as [`run_in_memory`] leaves it: the bar alone, or the bar with its
+/// temperature (a scene with `[heat]`).
+pub enum BarSimulation {
+    Mechanical(Simulation),
+    Thermal(ThermalSimulation),
+}
+
+impl BarSimulation {
+    /// The bar without a temperature; `None` for a scene with `[heat]`.
+    pub fn mechanical(&self) -> Option<&Simulation> {
+        match self {
+            Self::Mechanical(sim) => Some(sim),
+            Self::Thermal(_) => None,
+        }
+    }
+
+    /// The bar with its temperature; `None` for a scene without `[heat]`.
+    pub fn thermal(&self) -> Option<&ThermalSimulation> {
+        match self {
+            Self::Mechanical(_) => None,
+            Self::Thermal(sim) => Some(sim),
+        }
+    }
+}
+
+/// Runs a bar scene with a temperature (`[heat]`) in memory: [`run_in_memory`]'s run, its
+/// simulation typed.
 pub fn run_thermal_in_memory(
     name: &str,
     scene: &Scene,

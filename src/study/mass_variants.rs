@@ -3,7 +3,7 @@
 //! The derivation of the variants is in `docs/mass-variants.md`; their measured behaviour in
 //! VERIFICATION.md ("Mass variants").
 
-use crate::bar::Simulation;
+use crate::output::BarSimulation;
 use crate::output::summary::Summary;
 use crate::scene::{MassVariant, Scene, SceneError};
 use crate::scheme::{RunError, StepRecord};
@@ -41,6 +41,6 @@ pub fn run_with_mass(
     name: &str,
     scene: &Scene,
     mass: MassVariant,
-) -> Result<(Vec<StepRecord>, Summary, Simulation), RunError> {
+) -> Result<(Vec<StepRecord>, Summary, BarSimulation), RunError> {
     crate::output::run_in_memory(name, &with_mass(scene, mass)?)
 }

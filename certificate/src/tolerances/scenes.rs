@@ -38,6 +38,9 @@ pub fn scene_worst() -> Result<[f64; 5], RunError> {
     for name in builtin_names() {
         let (_, scene) = scene::load(name, &[])?;
         let (records, _, sim) = run_in_memory(name, &scene)?;
+        let sim = sim
+            .mechanical()
+            .expect("the built-in bar scenes have no [heat]");
         let constrained = !sim.discretisation().constraints.is_empty();
         let e0 = records[0].energy;
         for (i, r) in records.iter().enumerate() {
@@ -533,6 +536,7 @@ pub fn resting_bar_worst() -> Result<(f64, bool), RunError> {
         ],
     )?;
     let (records, _, sim) = run_in_memory("resting", &scene)?;
+    let sim = sim.mechanical().expect("a scene without [heat]");
     let disc = sim.discretisation();
     let m_one = disc.mass.mul(&vec![1.0; disc.unknowns()]);
     let mut worst = 0.0f64;
