@@ -7,7 +7,7 @@
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use viscobar::bar::Kernels;
-use viscobar::scene::nodal::NodalEvaluator;
+use viscobar::internals::scene::nodal::NodalEvaluator;
 use viscobar::{Scene, Simulation};
 
 /// The bar of `benches/step.rs`: length 1, `α = 0.1`, at rest under the load `−10`, `Δt = Δx`,

@@ -7,7 +7,7 @@
 //!     cargo run --release --example plane_tilted_drop_exact
 
 use viscobar::output::Tracker;
-use viscobar::output::text::output_time;
+use viscobar::output::output_time;
 use viscobar::plane::PlaneSimulation;
 use viscobar::scene::{AnyScene, load_any};
 

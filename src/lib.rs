@@ -15,6 +15,8 @@
 //! Use as a library: [`run_in_memory`] runs a scene built in code (its doc, a tested example).
 
 pub mod bar;
+#[doc(hidden)]
+pub mod internals;
 pub mod linalg;
 pub mod output;
 pub mod plane;

@@ -615,8 +615,9 @@ fn compare(
     };
     let out = out.unwrap_or_else(|| PathBuf::from("out").join(format!("compare-{scene_name}")));
     let path = out.join("comparison.md");
-    let written = std::fs::create_dir_all(&out)
-        .and_then(|()| viscobar::output::files::write_atomically(&path, table.as_bytes()));
+    let written = std::fs::create_dir_all(&out).and_then(|()| {
+        viscobar::internals::output::files::write_atomically(&path, table.as_bytes())
+    });
     written.map_err(|source| viscobar::RunError::Write {
         path: path.clone(),
         source,
@@ -627,7 +628,7 @@ fn compare(
 }
 
 /// [`compare`]'s table (Markdown) on a scene of either body.
-fn compare_on<S: viscobar::study::refine::StudyScene>(
+fn compare_on<S: viscobar::study::StudyScene>(
     scene_name: &str,
     scene: &S,
     methods: &[SolverMethod],
@@ -707,7 +708,7 @@ fn compare_on<S: viscobar::study::refine::StudyScene>(
 /// The contact episodes of one end (or of the obstacle) in one line: when, impulse and the
 /// energy the contact term took (the same episodes as `summary.json` and the figures).
 fn episode_line(episodes: &[viscobar::ContactEpisode]) -> String {
-    use viscobar::output::text::output_time;
+    use viscobar::internals::output::text::output_time;
     if episodes.is_empty() {
         return "no contact".into();
     }

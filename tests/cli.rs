@@ -621,7 +621,7 @@ fn converge_on_a_scene_file_writes_valid_csv_with_energy_and_contact_errors() {
     let header = &records[0];
     assert_eq!(
         header.len(),
-        viscobar::study::convergence_table::CSV_HEADER.len()
+        viscobar::internals::study::convergence_table::CSV_HEADER.len()
     );
     let column = |name: &str| header.iter().position(|h| h == name).unwrap();
     // exact, osqp 1e-6, osqp 1e-9 at 2 levels.

@@ -207,19 +207,19 @@ fn a_reference_run_measures_like_the_closed_form_up_to_its_own_error() {
 #[test]
 fn csv_cells_are_quoted_as_rfc_4180_says_and_the_median_is_the_middle() {
     assert_eq!(
-        viscobar::study::convergence_table::csv_cell("eps=1e-7"),
+        viscobar::internals::study::convergence_table::csv_cell("eps=1e-7"),
         "eps=1e-7"
     );
     assert_eq!(
-        viscobar::study::convergence_table::csv_cell("exact solver, 400 elements"),
+        viscobar::internals::study::convergence_table::csv_cell("exact solver, 400 elements"),
         "\"exact solver, 400 elements\""
     );
     assert_eq!(
-        viscobar::study::convergence_table::csv_cell("say \"hi\""),
+        viscobar::internals::study::convergence_table::csv_cell("say \"hi\""),
         "\"say \"\"hi\"\"\""
     );
     assert_eq!(
-        viscobar::study::convergence_table::csv_cell("a\nb"),
+        viscobar::internals::study::convergence_table::csv_cell("a\nb"),
         "\"a\nb\""
     );
     assert_eq!(converge::median(vec![3.0, 1.0, 2.0]), 2.0);

@@ -7,7 +7,7 @@ mod common;
 use common::{IDENTITY_TOL, KINK_ORDER_BAND, builtin};
 use viscobar::ContactEpisode;
 use viscobar::bar::matrices::{MatrixVariant, mass};
-use viscobar::output::text::{TIME_DIGITS, output_time};
+use viscobar::internals::output::text::{TIME_DIGITS, output_time};
 use viscobar::study::accuracy::observed_order;
 use viscobar::{Summary, run_in_memory};
 

@@ -4,8 +4,8 @@
 
 use proptest::prelude::*;
 use viscobar::Scene;
+use viscobar::internals::scene::nodal::NodalEvaluator;
 use viscobar::scene::Expression;
-use viscobar::scene::nodal::NodalEvaluator;
 
 /// Values computed by one or two correctly rounded operations: they must come out exactly,
 /// up to the one rounding of a library function (sqrt is exact, 2π is one multiplication).
@@ -310,7 +310,7 @@ proptest! {
 
 /// Nodes spanning three blocks of the node-array evaluator and a partial one.
 fn nodes() -> Vec<f64> {
-    let n = 3 * viscobar::scene::nodal::BLOCK + 41;
+    let n = 3 * viscobar::internals::scene::nodal::BLOCK + 41;
     (0..n).map(|i| -2.0 + 4.0 * i as f64 / n as f64).collect()
 }
 
@@ -362,7 +362,7 @@ proptest! {
 // ---------------------------------------------------------------------------------------------
 // The block kernels of the compiled loads (src/scene/vecmath.rs) against `std`
 
-use viscobar::scene::vecmath;
+use viscobar::internals::scene::vecmath;
 
 /// Seeded arguments (SplitMix64), the same on every run.
 struct Seeded(u64);

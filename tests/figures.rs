@@ -7,9 +7,9 @@ use common::viscobar;
 
 use std::path::{Path, PathBuf};
 use viscobar::Simulation;
-use viscobar::output::text::output_time;
+use viscobar::internals::output::text::output_time;
+use viscobar::internals::study::sampled_run::{self, Sampling};
 use viscobar::study::figures::{self, TALK_FIGURES};
-use viscobar::study::sampled_run::{self, Sampling};
 
 fn tmpdir(name: &str) -> PathBuf {
     common::fresh_dir("figures", name)

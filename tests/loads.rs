@@ -96,7 +96,7 @@ fn non_separable() -> impl Strategy<Value = Pair> {
 /// denominators `2 + g` exceed `|g|`).
 fn roundoff_tol(text: &str) -> f64 {
     let ops = text.chars().filter(|c| "+-*/^(".contains(*c)).count() + 4;
-    ops as f64 * (viscobar::scene::vecmath::MAX_ULPS as f64 + 1.0) * f64::EPSILON
+    ops as f64 * (viscobar::internals::scene::vecmath::MAX_ULPS as f64 + 1.0) * f64::EPSILON
 }
 
 proptest! {

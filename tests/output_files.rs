@@ -183,7 +183,7 @@ fn cli_run_with_npy_output_without_the_feature_exits_2_writing_nothing() {
 /// (a bar of 1e24), and times needing every digit.
 #[test]
 fn t_and_x_are_the_display_of_the_rounded_values() {
-    use viscobar::output::text::output_time;
+    use viscobar::internals::output::text::output_time;
     for (tag, sets) in [
         ("unit", vec!["mesh.elements=80"]),
         ("short", vec!["bar.length=1.23e-5", "mesh.elements=50"]),

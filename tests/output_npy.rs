@@ -6,9 +6,9 @@
 mod common;
 use std::path::{Path, PathBuf};
 use viscobar::Simulation;
-use viscobar::output::npy::ProfileRow;
+use viscobar::internals::output::npy::ProfileRow;
+use viscobar::internals::output::text::output_time;
 use viscobar::output::run_to_dir;
-use viscobar::output::text::output_time;
 
 fn fresh_dir(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("viscobar-npy-{tag}-{}", std::process::id()));

@@ -83,7 +83,7 @@ fn check_against_the_run(scene: &PlaneScene, out: &Path) -> usize {
     let prepared = PlaneSimulation::prepare(scene).unwrap();
     let body = prepared.body();
     let stride = sampling.node_stride as usize;
-    let nodes = viscobar::output::profiles::written_nodes(body.lattice(), stride);
+    let nodes = viscobar::internals::output::profiles::written_nodes(body.lattice(), stride);
     assert_eq!(nodes.len() as u64, sampling.nodes_written);
     let mut files = 0;
     let steps = scene.steps();
@@ -100,7 +100,7 @@ fn check_against_the_run(scene: &PlaneScene, out: &Path) -> usize {
                 "timestep=\"{}\" group=\"\" part=\"0\" file=\"{name}\"",
                 {
                     let mut t = Vec::new();
-                    viscobar::output::text::push_time(sim.time(), &mut t);
+                    viscobar::internals::output::text::push_time(sim.time(), &mut t);
                     String::from_utf8(t).unwrap()
                 }
             )),

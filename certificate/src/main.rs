@@ -176,7 +176,7 @@ fn run_verify(
             verify::update_document(&doc, &sections).map_err(|e| format!("{}: {e}", path.display()))
         })
         .and_then(|doc| {
-            viscobar::output::files::write_atomically(&path, doc.as_bytes())
+            viscobar::internals::output::files::write_atomically(&path, doc.as_bytes())
                 .map_err(|e| format!("cannot write {}: {e}", path.display()))
         });
     match result {

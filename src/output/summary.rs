@@ -118,7 +118,7 @@ pub struct Summary {
 }
 
 /// Where the time of the steps goes, as fractions of the timed phases of the sampled steps
-/// (one in [`crate::scheme::clock::TIMING_SAMPLE_EVERY`]): `rhs` (load and right-hand side),
+/// (one in `crate::scheme::clock::TIMING_SAMPLE_EVERY`): `rhs` (load and right-hand side),
 /// `solver` (the step solver and `u += z`), `diagnostics` (energy identity and contact state);
 /// the three add up to 1. `stepping` is the step loop's share of the wall time, measured from
 /// the first step after the start-up to the last (with the rows it writes); the rest is set-up,

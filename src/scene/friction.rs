@@ -45,7 +45,7 @@ impl Edges {
 
 impl PlaneScene {
     /// The friction keys: values, edges, the solver method, and the size of the frictional
-    /// step's problem (at most [`MAX_FRICTION_LCP`], counting every node of a frictional edge).
+    /// step's problem (at most `MAX_FRICTION_LCP`, counting every node of a frictional edge).
     pub fn validate_friction(&self) -> Result<(), SceneError> {
         let mu = self.edges.frictions()?;
         let Some(edge) = (0..4).find(|&k| mu[k] > 0.0) else {

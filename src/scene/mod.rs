@@ -1,21 +1,21 @@
-//! The input: a scene's TOML schema (the bar's, [`schema`], or the plane body's, [`plane`]),
+//! The input: a scene's TOML schema (the bar's, `schema`, or the plane body's, [`plane`]),
 //! its validation and the expressions it holds (initial data, loads, gaps), with
 //! [`SceneError`] naming the field at fault.
 //!
 //! Imports [`crate::linalg`] and [`crate::step`] (solver settings).
 
-pub mod error;
-pub mod expr;
-pub mod friction;
+pub(crate) mod error;
+pub(crate) mod expr;
+pub(crate) mod friction;
 pub mod heat;
-pub mod nodal;
-pub mod output;
-pub mod parser;
+pub(crate) mod nodal;
+pub(crate) mod output;
+pub(crate) mod parser;
 pub mod plane;
-pub mod schema;
-pub mod separation;
-pub mod solver;
-pub mod vecmath;
+pub(crate) mod schema;
+pub(crate) mod separation;
+pub(crate) mod solver;
+pub(crate) mod vecmath;
 
 pub use error::SceneError;
 pub use expr::Expression;

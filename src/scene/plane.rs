@@ -11,7 +11,7 @@ use crate::scene::schema::{
     GIB, MAX_STEPS, Scene, Time, available_memory_bytes, check_time_grid, number_or_expression,
     number_text, positive, toml_syntax, with_overrides,
 };
-/// The built-in plane scenes (kept beside the bar's list in [`crate::scene::schema`]).
+/// The built-in plane scenes (kept beside the bar's list in `scene::schema`).
 pub use crate::scene::schema::{PLANE_BUILTIN, plane_builtin_text};
 use crate::scene::solver::{SolverMethod, SolverSpec};
 use crate::scene::{SceneError, builtin_names, builtin_text};
@@ -115,7 +115,7 @@ pub enum EdgeCondition {
 
 /// One edge: its condition and, for `signorini`, the gap (a number or an expression in the
 /// edge's coordinate `s`: `x` along bottom and top, `y` along left and right) and the Coulomb
-/// friction coefficient ([`crate::scene::friction`]).
+/// friction coefficient (`crate::scene::friction`).
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EdgeSpec {

@@ -120,7 +120,7 @@ fn split(node: &Node) -> Option<Vec<(Factor, Factor)>> {
 
 impl Expression {
     /// `Some` terms `f_k(t) g_k(x)` whose sum is this expression, when it depends on both `x`
-    /// and `t` and separates within [`MAX_TERMS`] terms; the sum equals the expression up to
+    /// and `t` and separates within `MAX_TERMS` terms; the sum equals the expression up to
     /// the rounding of the regrouped operations.
     pub fn separate(&self) -> Option<Vec<SeparatedTerm>> {
         if !(self.depends_on_x() && self.depends_on_t()) {

@@ -68,7 +68,7 @@ pub trait Body {
     fn step_matrix_mul(&self, x: &[f64], y: &mut [f64]);
     /// `a ← M⁻¹ a` on the unknowns that carry mass, `0` on the others (start-up only).
     fn solve_mass(&self, a: &mut [f64]) -> Result<(), RunError>;
-    /// The rows of the full-mesh mass matrix at the unknowns ([`FullMassRows`]).
+    /// The rows of the full-mesh mass matrix at the unknowns (`FullMassRows`).
     fn full_mass_rows(&self) -> FullMassRows;
     /// The mesh nodes (clamped ones included).
     fn nodes(&self) -> usize;

@@ -7,14 +7,14 @@
 //!
 //! Imports [`crate::linalg`], [`crate::step`] and [`crate::scene`].
 
-pub mod body;
+pub(crate) mod body;
 pub mod certify;
-pub mod clock;
-pub mod contact;
-pub mod error;
-pub mod friction;
-pub mod load;
-pub mod stepper;
+pub(crate) mod clock;
+pub(crate) mod contact;
+pub(crate) mod error;
+pub(crate) mod friction;
+pub(crate) mod load;
+pub(crate) mod stepper;
 
 pub use body::{Body, EnergySums, HeatTerms};
 pub use certify::{Certificate, CertificateFailure};

@@ -29,7 +29,7 @@ pub struct StepRecord {
     pub contact_dissipation: f64,
     /// `|E^{n+1/2} − E^{n−1/2} − work − obstacle_work + viscous + D + D_f|` over the largest
     /// of those terms (with a temperature: `+ thermal dissipation + exchange − supply`,
-    /// [`HeatTerms`]), or over the run's energy resolution [`ENERGY_RESOLUTION`] times the
+    /// [`HeatTerms`]), or over the run's energy resolution `ENERGY_RESOLUTION` times the
     /// largest term measured so far where that is larger.
     pub identity_residual: f64,
     /// The bound the run's certificate holds `identity_residual` to on a measured step: the
@@ -40,7 +40,7 @@ pub struct StepRecord {
     pub obstacle_work: f64,
     /// `D_f = −½ Σ_j r_T,j δ_j >= 0`, the friction dissipation (0 without friction).
     pub friction_dissipation: f64,
-    /// Frictional nodes in contact that stick and that slip ([`crate::scheme::friction`]).
+    /// Frictional nodes in contact that stick and that slip (`crate::scheme::friction`).
     pub stick_nodes: usize,
     pub slip_nodes: usize,
     /// The thermal terms of a body with a temperature (measured steps; `E^{1/2}`'s at the
@@ -258,7 +258,7 @@ impl<B: Body> Scheme<B> {
     ///    side and `g^{n+1} − g^{n−1}` to `D`'s bracket ([`ContactSet::advance_gaps`],
     ///    [docs/moving-obstacles.md](../../docs/moving-obstacles.md)). With friction the
     ///    right-hand side also loses `D_f = −½ Σ_j r_T,j δ_{t_j} >= 0`
-    ///    ([`crate::scheme::friction`]); the solver reads `w` for the central slip.
+    ///    (`crate::scheme::friction`); the solver reads `w` for the central slip.
     ///
     /// The identity is measured every `[output] diagnostics_every`-th step and at the last; a
     /// measured step after an unmeasured one first recomputes `E^{n−1/2}` from `u^n` and `w`,
@@ -454,7 +454,7 @@ impl<B: Body> Scheme<B> {
     }
 
     /// Wall time spent in each phase of the steps taken so far, measured on a sample of the
-    /// steps ([`PhaseTimes`]).
+    /// steps (`PhaseTimes`).
     pub fn phase_times(&self) -> PhaseTimes {
         self.timing
     }

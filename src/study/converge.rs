@@ -11,7 +11,7 @@
 //! only non-deterministic columns.
 
 use crate::bar::closed_form::ClosedForm;
-use crate::output::summary::Tracker;
+use crate::output::Tracker;
 use crate::scene::{SolverMethod, SolverSpec};
 use crate::scheme::{Body, RunError, Scheme};
 use crate::study::accuracy::observed_order;

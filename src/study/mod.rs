@@ -8,15 +8,17 @@
 pub mod accuracy;
 pub mod compare;
 pub mod converge;
-pub mod convergence_table;
-pub mod figure_writer;
+pub(crate) mod convergence_table;
+pub(crate) mod figure_writer;
 pub mod figures;
-pub mod friction_figure;
+pub(crate) mod friction_figure;
 pub mod mass_figure;
 pub mod mass_variants;
-pub mod plane_contact_figure;
+pub(crate) mod plane_contact_figure;
 pub mod plane_figure;
-pub mod refine;
-pub mod sampled_run;
+pub(crate) mod refine;
+pub(crate) mod sampled_run;
 pub mod viscosity_sweep;
 pub mod work_precision;
+
+pub use refine::StudyScene;

@@ -270,8 +270,8 @@ impl Drawing for PlaneFigure {
 }
 
 /// Runs `scene` and writes `deformed.png` and `deformed.svg` into `out`, with Signorini
-/// edges `contact-pressure.png`/`.svg` ([`crate::study::plane_contact_figure`]) and with
-/// friction `friction-state.png`/`.svg` ([`crate::study::friction_figure`]); returns their
+/// edges `contact-pressure.png`/`.svg` (`crate::study::plane_contact_figure`) and with
+/// friction `friction-state.png`/`.svg` (`crate::study::friction_figure`); returns their
 /// paths.
 pub fn write(name: &str, scene: &PlaneScene, out: &Path) -> Result<Vec<PathBuf>, PlaneFigureError> {
     register_font()?;

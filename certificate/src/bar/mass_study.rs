@@ -7,9 +7,10 @@
 //! variants is in `docs/mass-variants.md`.
 
 use std::fmt::Write;
+use viscobar::Summary;
 use viscobar::bar::Simulation;
 use viscobar::bar::closed_form;
-use viscobar::output::summary::{Summary, Tracker};
+use viscobar::output::Tracker;
 use viscobar::scene::{self, MassVariant, Scene, SceneError};
 use viscobar::scheme::RunError;
 use viscobar::study::accuracy::observed_order;

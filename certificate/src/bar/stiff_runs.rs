@@ -21,7 +21,7 @@ use viscobar::linalg::ldlt::Ldlt;
 use viscobar::linalg::norms::{max_abs, max_distance};
 use viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS;
 use viscobar::linalg::tridiag::SymTridiag;
-use viscobar::output::summary::Tracker;
+use viscobar::output::Tracker;
 use viscobar::scheme::RunError;
 use viscobar::scheme::StepRecord;
 use viscobar::step::audit::{KktAudit, Law};

@@ -408,7 +408,7 @@ pub fn run(o: &Options) -> i32 {
             let section = Section { id, markdown: md };
             let new = update_document(&doc, &[section])
                 .map_err(|e| format!("{}: {e}", path.display()))?;
-            viscobar::output::files::write_atomically(path, new.as_bytes())
+            viscobar::internals::output::files::write_atomically(path, new.as_bytes())
                 .map_err(|e| format!("cannot write {}: {e}", path.display()))
         }
     });

@@ -594,7 +594,7 @@ fn update_files(files: &[PathBuf], m: &Measurements) -> Result<(), String> {
         written.push((path, new));
     }
     for (path, text) in written {
-        viscobar::output::files::write_atomically(path, text.as_bytes())
+        viscobar::internals::output::files::write_atomically(path, text.as_bytes())
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }
     Ok(())

@@ -51,7 +51,7 @@ pub fn run(elements: u64, steps: u64, ends: Ends) -> Result<(), RunError> {
     )?;
     let before = vm_hwm_kib();
     let out = crate::workspace_root().join("target/peak-memory");
-    let summary = viscobar::output::run::run_to_dir("peak-memory", &scene, &out, false)?;
+    let summary = viscobar::run_to_dir("peak-memory", &scene, &out, false)?;
     let peak = vm_hwm_kib();
     let ends = match ends {
         Ends::Free => "free",

@@ -14,6 +14,7 @@ pub mod symmetry;
 
 use std::fmt::Write;
 use viscobar::bar::Simulation;
+use viscobar::internals::scene::schema::number_text;
 use viscobar::linalg::cholesky::SparseCholesky;
 use viscobar::output::run_plane_in_memory;
 use viscobar::plane::PlaneSimulation;
@@ -24,7 +25,6 @@ use viscobar::scene::plane::{
     Body, EdgeCondition, EdgeSpec, Edges, PLANE_BUILTIN, PlaneInitial, PlaneLoad, PlaneMesh,
     PlaneScene, Vector, plane_builtin_text,
 };
-use viscobar::scene::schema::number_text;
 use viscobar::scene::{Condition, Scene};
 use viscobar::scheme::RunError;
 use viscobar::study::converge::ConvergeError;

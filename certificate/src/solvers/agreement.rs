@@ -49,7 +49,7 @@ fn with_method(m: &str, extra: &[String]) -> Vec<String> {
 /// The audit report of an OSQP or penalty run (both always audit).
 fn audit_of<'a>(
     name: &str,
-    s: &'a viscobar::output::summary::Summary,
+    s: &'a viscobar::Summary,
 ) -> Result<&'a viscobar::step::AuditReport, RunError> {
     s.audit.as_ref().ok_or_else(|| RunError::SolverSetup {
         solver: s.solver.clone(),

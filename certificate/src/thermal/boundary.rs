@@ -8,8 +8,8 @@
 
 use crate::thermal::{Study2, sized, temperatures};
 use std::f64::consts::PI;
+use viscobar::internals::scene::expr::Expression;
 use viscobar::output::run_thermal_in_memory;
-use viscobar::scene::expr::Expression;
 use viscobar::scene::{Scene, SceneError};
 use viscobar::scheme::RunError;
 use viscobar::study::accuracy::observed_order;

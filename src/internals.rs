@@ -1,0 +1,55 @@
+//! Not API: the crate's internals that its certificate (the member crate
+//! `viscobar-certificate`), its tests, benches, Python package and command line measure or
+//! reuse. Each module below mirrors the path of the module it opens (`internals::output::text`
+//! is `crate::output::text`), so a reader finds the code where the path says. Nothing here is
+//! documented or kept stable; a user calls the modules of the crate root.
+
+/// Internals of [`crate::output`].
+pub mod output {
+    pub mod files {
+        pub use crate::output::files::*;
+    }
+    pub mod history {
+        pub use crate::output::history::*;
+    }
+    #[cfg(feature = "npy")]
+    pub mod npy {
+        pub use crate::output::npy::*;
+    }
+    pub mod profiles {
+        pub use crate::output::profiles::*;
+    }
+    pub mod summary {
+        pub use crate::output::summary::*;
+    }
+    pub mod text {
+        pub use crate::output::text::*;
+    }
+}
+
+/// Internals of [`crate::scene`].
+pub mod scene {
+    pub mod expr {
+        pub use crate::scene::expr::*;
+    }
+    pub mod nodal {
+        pub use crate::scene::nodal::*;
+    }
+    pub mod schema {
+        pub use crate::scene::schema::*;
+    }
+    pub mod vecmath {
+        pub use crate::scene::vecmath::*;
+    }
+}
+
+/// Internals of [`crate::study`].
+pub mod study {
+    pub mod convergence_table {
+        pub use crate::study::convergence_table::*;
+    }
+    #[cfg(feature = "plots")]
+    pub mod sampled_run {
+        pub use crate::study::sampled_run::*;
+    }
+}
