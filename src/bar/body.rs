@@ -18,7 +18,7 @@ use crate::scheme::body::{Body, EnergySums, FullMassRows};
 use crate::scheme::certify::{IDENTITY_TOL, MAX_IDENTITY_BOUND, conditioned_bound};
 use crate::scheme::contact::{ContactSet, Group, Positions};
 use crate::scheme::{Load, RunError, Scheme, Setup, Unstarted};
-use crate::step::{BlockPivotSolver, ExactSolver, OsqpSolver, PenaltySolver, StepSolver};
+use crate::step::{BlockPivoting, EndEnumeration, EndPenalty, Osqp, StepSolver};
 
 /// A run of a bar scene: the scheme stepping the bar.
 pub type Simulation = Scheme<BarBody>;
@@ -271,19 +271,19 @@ fn make_solver_with(
 ) -> Result<Box<dyn StepSolver>, RunError> {
     let nodes = disc.constrained_locals();
     match scene.solver.method {
-        SolverMethod::Exact if disc.ends_only() => Ok(Box::new(ExactSolver::with_options(
+        SolverMethod::Exact if disc.ends_only() => Ok(Box::new(EndEnumeration::with_options(
             &disc.step_matrix,
             &nodes,
             kernels.twisted_solve,
             kernels.warm_start,
         )?)),
-        SolverMethod::Exact => Ok(Box::new(BlockPivotSolver::new(&disc.step_matrix, &nodes)?)),
-        SolverMethod::Osqp => Ok(Box::new(OsqpSolver::new(
+        SolverMethod::Exact => Ok(Box::new(BlockPivoting::new(&disc.step_matrix, &nodes)?)),
+        SolverMethod::Osqp => Ok(Box::new(Osqp::new(
             &disc.step_matrix,
             &nodes,
             scene.solver.osqp_settings(),
         )?)),
-        SolverMethod::Penalty => Ok(Box::new(PenaltySolver::new(
+        SolverMethod::Penalty => Ok(Box::new(EndPenalty::new(
             &disc.step_matrix,
             &nodes,
             scene.solver.penalty_settings(),

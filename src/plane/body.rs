@@ -24,7 +24,7 @@ use crate::scheme::certify::{
 };
 use crate::scheme::contact::{ContactSet, Group, Positions};
 use crate::scheme::{Load, RunError, Scheme, Setup, Unstarted};
-use crate::step::{CondensedSolver, OsqpSolver, SparsePenaltySolver, StepSolver};
+use crate::step::{CondensedLcp, Osqp, SemismoothPenalty, StepSolver};
 
 /// A run of a plane scene: the scheme stepping the plane body.
 pub type PlaneSimulation = Scheme<PlaneBody>;
@@ -361,16 +361,16 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
         _ if !friction.is_empty() => {
             crate::plane::friction::frictional_solver(scene, system()?, constraints, friction)?
         }
-        SolverMethod::Exact => Box::new(CondensedSolver::new(system()?, constraints, 0.0)?),
+        SolverMethod::Exact => Box::new(CondensedLcp::new(system()?, constraints, 0.0)?),
         SolverMethod::Penalty => {
             let epsilon = scene.solver.penalty_settings().epsilon;
             if constraints.len() as u64 <= PENALTY_CONDENSED_MAX_NORMALS {
-                Box::new(CondensedSolver::new(system()?, constraints, epsilon)?)
+                Box::new(CondensedLcp::new(system()?, constraints, epsilon)?)
             } else {
-                Box::new(SparsePenaltySolver::new(system()?, constraints, epsilon)?)
+                Box::new(SemismoothPenalty::new(system()?, constraints, epsilon)?)
             }
         }
-        SolverMethod::Osqp => Box::new(OsqpSolver::with_system(
+        SolverMethod::Osqp => Box::new(Osqp::with_system(
             system()?,
             constraints,
             scene.solver.osqp_settings(),

@@ -9,7 +9,7 @@ use crate::plane::normals::Normal;
 use crate::scene::SolverMethod;
 use crate::scene::plane::PlaneScene;
 use crate::scheme::RunError;
-use crate::step::{Constraints, Friction, FrictionalSolver, StepSolver, TrescaSolver};
+use crate::step::{CondensedLemke, Constraints, Friction, OsqpTresca, StepSolver};
 
 /// The frictional nodes of the normals `normals` (in the contact set's order) with the edges'
 /// coefficients `mu` (`[left, right, bottom, top]`); `index` maps a degree of freedom of the mesh
@@ -43,7 +43,7 @@ pub fn frictional_solver(
     friction: Friction,
 ) -> Result<Box<dyn StepSolver>, RunError> {
     Ok(match scene.solver.method {
-        SolverMethod::Osqp => Box::new(TrescaSolver::new(
+        SolverMethod::Osqp => Box::new(OsqpTresca::new(
             system,
             constraints,
             friction,
@@ -51,7 +51,7 @@ pub fn frictional_solver(
         )?),
         // The penalty method is refused with friction by the scene's validation.
         SolverMethod::Exact | SolverMethod::Penalty => {
-            Box::new(FrictionalSolver::new(system, constraints, friction)?)
+            Box::new(CondensedLemke::new(system, constraints, friction)?)
         }
     })
 }

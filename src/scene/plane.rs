@@ -163,7 +163,7 @@ pub const EDGE_NAMES: [&str; 4] = ["left", "right", "bottom", "top"];
 pub const EXACT_BYTES_PER_NORMAL_PAIR: u64 = 16;
 /// The penalty law is solved on the condensed `S + εI` (as the exact step) up to this many
 /// normals (256 MiB of dense arrays), and beyond by the sparse Newton iteration
-/// ([`crate::step::SparsePenaltySolver`]), which needs no dense matrix: a fixed switch, so that
+/// ([`crate::step::SemismoothPenalty`]), which needs no dense matrix: a fixed switch, so that
 /// a scene gives the same bits on every machine.
 pub const PENALTY_CONDENSED_MAX_NORMALS: u64 = 4096;
 

@@ -1,8 +1,8 @@
 //! The `[solver]` table of a scene, bar or plane: the step solver and its settings.
 
 use crate::scene::SceneError;
+use crate::step::end_penalty::PenaltySettings;
 use crate::step::osqp::OsqpSettings;
-use crate::step::penalty::PenaltySettings;
 use serde::{Deserialize, Serialize};
 
 /// Which step solver to use.
@@ -55,7 +55,7 @@ pub struct SolverSpec {
     /// Accept OSQP's "solved inaccurate" (default false), counted in `summary.json`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub accept_inaccurate: Option<bool>,
-    /// Penalty parameter ε of (PP) (default [`PENALTY_DEFAULT_EPSILON`](crate::step::penalty::PENALTY_DEFAULT_EPSILON)).
+    /// Penalty parameter ε of (PP) (default [`PENALTY_DEFAULT_EPSILON`](crate::step::end_penalty::PENALTY_DEFAULT_EPSILON)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub epsilon: Option<f64>,
 }

@@ -6,7 +6,7 @@ use crate::bar::{Kernels, Simulation};
 use crate::scene::Expression;
 use crate::scene::{Scene, SceneError, SolverMethod};
 use crate::scheme::{Body, Load, RunError, Scheme, Setup, Unstarted};
-use crate::step::{ExactSolver, StepSolver};
+use crate::step::{EndEnumeration, StepSolver};
 use crate::thermal::body::ThermalBody;
 use crate::thermal::solver::{CoupledSolver, DecoupledSolver};
 use crate::thermal::system::CoupledEnds;
@@ -101,7 +101,7 @@ impl Scheme<ThermalBody> {
                     value: m.gamma.to_string(),
                     allowed: format!("the coupled step matrix has no block LDLᵀ: {e}"),
                 })?;
-                variants.push(Box::new(ExactSolver::on(system, &unknowns, true)));
+                variants.push(Box::new(EndEnumeration::on(system, &unknowns, true)));
             }
             Box::new(CoupledSolver::new(variants, exchange))
         };

@@ -1,5 +1,5 @@
 //! The penalty law (normal compliance `ε r_k = (lo_k − s_k z_{i_k})⁺`) for any number of
-//! constraints, without the dense `S` of [`crate::step::CondensedSolver`]: the step problem is
+//! constraints, without the dense `S` of [`crate::step::CondensedLcp`]: the step problem is
 //! the minimisation of the convex, piecewise quadratic
 //! `f(z) = ½ zᵀCz − bᵀz + 1/(2ε) Σ_k ((lo_k − s_k z_{i_k})⁺)²`, solved by a damped semismooth
 //! Newton iteration on the sparse system. With the active set `A` (the constraints whose
@@ -26,7 +26,7 @@ const MAX_HALVINGS: u32 = 60;
 const ARMIJO: f64 = 1e-4;
 
 /// The sparse penalty solver.
-pub struct SparsePenaltySolver {
+pub struct SemismoothPenalty {
     pattern: Pattern,
     /// `C` and `C + D_A/ε` on the pattern.
     c: Vec<f64>,
@@ -94,7 +94,7 @@ impl Objective<'_> {
     }
 }
 
-impl SparsePenaltySolver {
+impl SemismoothPenalty {
     /// The solver of the penalty law with compliance `epsilon > 0` for `system`'s `C` (its
     /// factor is the one of `A = ∅`).
     pub fn new(
@@ -176,7 +176,7 @@ impl SparsePenaltySolver {
     }
 }
 
-impl StepSolver for SparsePenaltySolver {
+impl StepSolver for SemismoothPenalty {
     fn name(&self) -> &'static str {
         "penalty"
     }

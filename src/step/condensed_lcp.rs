@@ -51,7 +51,7 @@ pub fn condensed_matrix(constraints: &Constraints, system: &mut impl SpdSystem) 
 }
 
 /// Condensation and the exact LCP solver (or the penalty law with `ε > 0`).
-pub struct CondensedSolver<S: SpdSystem> {
+pub struct CondensedLcp<S: SpdSystem> {
     system: S,
     constraints: Constraints,
     /// `None` without constraints: then a step is one solve.
@@ -62,7 +62,7 @@ pub struct CondensedSolver<S: SpdSystem> {
     w: Vec<f64>,
 }
 
-impl<S: SpdSystem> CondensedSolver<S> {
+impl<S: SpdSystem> CondensedLcp<S> {
     /// Forms `S` (plus `εI` for the penalty law, `epsilon > 0`) and its LCP solver.
     pub fn new(mut system: S, constraints: Constraints, epsilon: f64) -> Result<Self, SetupError> {
         if !(epsilon.is_finite() && epsilon >= 0.0) {
@@ -104,7 +104,7 @@ impl<S: SpdSystem> CondensedSolver<S> {
     }
 }
 
-impl<S: SpdSystem> StepSolver for CondensedSolver<S> {
+impl<S: SpdSystem> StepSolver for CondensedLcp<S> {
     fn name(&self) -> &'static str {
         if self.epsilon > 0.0 {
             "penalty"
