@@ -5,28 +5,7 @@ use crate::step::end_penalty::PenaltySettings;
 use crate::step::osqp::OsqpSettings;
 use serde::{Deserialize, Serialize};
 
-/// Which step solver to use.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SolverMethod {
-    /// Active-set enumeration on the constrained nodes (exact to round-off).
-    #[default]
-    Exact,
-    /// OSQP (ADMM, Stellato et al. 2020), every answer audited against the KKT conditions.
-    Osqp,
-    /// The talk's penalised problem (PP): normal compliance `(u + a)⁻/ε` instead of contact.
-    Penalty,
-}
-
-impl SolverMethod {
-    pub fn name(self) -> &'static str {
-        match self {
-            SolverMethod::Exact => "exact",
-            SolverMethod::Osqp => "osqp",
-            SolverMethod::Penalty => "penalty",
-        }
-    }
-}
+pub use crate::step::algorithm::SolverMethod;
 
 /// The `[solver]` table. Every setting but `method` belongs to one method; naming it with
 /// another method is refused (see [`crate::scene::Scene::validate`]), so a setting is never

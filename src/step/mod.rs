@@ -2,10 +2,12 @@
 //! seam, for every body: condensation onto the constraints with an exact LCP solve (any body),
 //! enumeration over the bar's two ends and block pivoting for its obstacle (tridiagonal
 //! kernels), penalty and OSQP; with Coulomb friction, Lemke's method on the condensed LCP and
-//! OSQP's Tresca fixed point; with the independent audits of their answers.
+//! OSQP's Tresca fixed point; with the independent audits of their answers. Which one serves a
+//! scene's `[solver] method` on each body is the table of [`algorithm`].
 //!
 //! Imports only [`crate::linalg`].
 
+pub mod algorithm;
 pub mod audit;
 pub mod block_pivot;
 pub mod condensed_lcp;
@@ -23,6 +25,7 @@ pub mod schur;
 pub mod semismooth_penalty;
 pub mod solver;
 
+pub use algorithm::{Algorithm, Shape, SolverMethod, algorithm_for};
 pub use block_pivot::BlockPivoting;
 pub use condensed_lcp::CondensedLcp;
 pub use condensed_lemke::CondensedLemke;
