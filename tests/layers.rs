@@ -275,10 +275,7 @@ fn the_checker_catches_an_upward_import_and_a_loop() {
     ];
     let found = violations(&upward);
     assert_eq!(found.len(), 2, "{found:?}");
-    assert!(
-        found[0].contains("crate::step::end_enumeration::X"),
-        "{found:?}"
-    );
+    assert!(found[0].contains("crate::step::exact::X"), "{found:?}");
 
     let looped = [
         source(
