@@ -10,10 +10,10 @@ use std::cell::RefCell;
 use std::rc::Rc;
 use std::time::Instant;
 use viscobar::bar::Discretisation;
-use viscobar::step::block_pivot::BlockPivotSolver;
+use viscobar::step::block_pivot::BlockPivoting;
 use viscobar::step::{SolveInfo, StepFailure, StepSolver};
 
-struct Shared(Rc<RefCell<BlockPivotSolver>>, Rc<RefCell<f64>>);
+struct Shared(Rc<RefCell<BlockPivoting>>, Rc<RefCell<f64>>);
 
 impl StepSolver for Shared {
     fn name(&self) -> &'static str {
@@ -53,7 +53,7 @@ fn main() {
         return;
     }
     let solver = Rc::new(RefCell::new(
-        BlockPivotSolver::new(&disc.step_matrix, &nodes).unwrap(),
+        BlockPivoting::new(&disc.step_matrix, &nodes).unwrap(),
     ));
     let solve_time = Rc::new(RefCell::new(0.0));
     let shared = Shared(solver.clone(), solve_time.clone());
@@ -92,7 +92,7 @@ pub fn repeated(c: &viscobar::linalg::tridiag::SymTridiag) {
         .map(|i| -(std::f64::consts::PI * i as f64 / n as f64).cos())
         .collect();
     let lo = vec![0.0; n];
-    let mut s = BlockPivotSolver::new(c, &nodes).unwrap();
+    let mut s = BlockPivoting::new(c, &nodes).unwrap();
     let (mut z, mut r) = (vec![0.0; n], vec![0.0; n]);
     s.solve(&b, &lo, &mut z, &mut r).unwrap();
     let reps: usize = std::env::var("REPS").map_or(50, |v| v.parse().unwrap());

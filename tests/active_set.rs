@@ -10,11 +10,11 @@ use proptest::prelude::*;
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
-use viscobar::step::block_pivot::BlockPivotSolver;
+use viscobar::step::block_pivot::BlockPivoting;
 use viscobar_certificate::solvers::oracle::brute_force;
 
 fn solve(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64]) -> (Vec<f64>, Vec<f64>, u32) {
-    let mut s = BlockPivotSolver::new(c, nodes).unwrap();
+    let mut s = BlockPivoting::new(c, nodes).unwrap();
     let (mut z, mut r) = (vec![0.0; b.len()], vec![0.0; nodes.len()]);
     let info = s.solve(b, lo, &mut z, &mut r).unwrap();
     (z, r, info.iterations)
@@ -153,7 +153,7 @@ fn the_oracle_refuses_more_than_16_bounds() {
 // ---- incremental re-solves against the whole-bar reference -------------------------------
 
 /// Runs `steps` solves of the incremental solver and of its whole-bar reference
-/// ([`BlockPivotSolver::with_full_solves`]) on the data `data(step)`, each warm-started by its
+/// ([`BlockPivoting::with_full_solves`]) on the data `data(step)`, each warm-started by its
 /// own previous answer, and asserts that every answer, reaction and iteration count is the
 /// same bit for bit: an incremental re-solve that stops a recurrence too early, misses a
 /// changed row or keeps a stale feasibility verdict changes bits (or the active sets).
@@ -165,8 +165,8 @@ fn incremental_matches_reference(
     mut data: impl FnMut(usize) -> (Vec<f64>, Vec<f64>),
 ) -> viscobar::step::block_pivot::PivotWork {
     let n = c.dim();
-    let mut fast = BlockPivotSolver::new(c, nodes).unwrap();
-    let mut reference = BlockPivotSolver::new(c, nodes).unwrap().with_full_solves();
+    let mut fast = BlockPivoting::new(c, nodes).unwrap();
+    let mut reference = BlockPivoting::new(c, nodes).unwrap().with_full_solves();
     let (mut z, mut r) = (vec![0.0; n], vec![0.0; nodes.len()]);
     let (mut z_ref, mut r_ref) = (vec![0.0; n], vec![0.0; nodes.len()]);
     for step in 0..steps {
@@ -250,8 +250,8 @@ proptest! {
 /// A `StepSolver` that runs the incremental solver, checks its answer bit for bit against the
 /// whole-bar reference and audits it at the round-off floors of `step::audit` (`eps = 0`).
 struct Checked {
-    fast: BlockPivotSolver,
-    reference: BlockPivotSolver,
+    fast: BlockPivoting,
+    reference: BlockPivoting,
     audit: viscobar::step::audit::KktAudit,
     z_ref: Vec<f64>,
     r_ref: Vec<f64>,
@@ -341,8 +341,8 @@ fn obstacle_runs_meet_kkt_at_the_round_off_floors_at_every_step() {
         let c = &disc.step_matrix;
         let steps = std::rc::Rc::new(std::cell::Cell::new(0));
         let checked = Checked {
-            fast: BlockPivotSolver::new(c, &nodes).unwrap(),
-            reference: BlockPivotSolver::new(c, &nodes).unwrap().with_full_solves(),
+            fast: BlockPivoting::new(c, &nodes).unwrap(),
+            reference: BlockPivoting::new(c, &nodes).unwrap().with_full_solves(),
             audit: KktAudit::new(c, &nodes, false).unwrap(),
             z_ref: vec![0.0; c.dim()],
             r_ref: vec![0.0; nodes.len()],

@@ -9,7 +9,7 @@ use viscobar_certificate::tolerances::{TIE_TOL, exact_tie, oracle_agreement};
 use proptest::prelude::*;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
-use viscobar::step::exact::ExactSolver;
+use viscobar::step::end_enumeration::EndEnumeration;
 
 /// KKT residuals of `(z, r)` against their per-case round-off bound (`kkt_ratio`) and its distance
 /// to the dense brute-force oracle against the a-posteriori bound of both answers
@@ -57,7 +57,7 @@ proptest! {
             _ => vec![0, n - 1],
         };
         let lower = &lo[..nodes.len()];
-        let mut solver = ExactSolver::new(&c, &nodes).unwrap();
+        let mut solver = EndEnumeration::new(&c, &nodes).unwrap();
         let mut z = vec![0.0; n];
         let mut r = vec![0.0; nodes.len()];
         solver.solve(b, lower, &mut z, &mut r).unwrap();
@@ -90,7 +90,7 @@ fn the_warm_start_is_exercised_by_the_random_problems() {
         let b: Vec<f64> = (0..n).map(|i| ((i * 7 + n) as f64).sin() * 5.0).collect();
         let nodes = [0, n - 1];
         let (mut z, mut r) = (vec![0.0; n], vec![0.0; 2]);
-        let mut solver = ExactSolver::new(&c, &nodes).unwrap();
+        let mut solver = EndEnumeration::new(&c, &nodes).unwrap();
         solver.solve(&b, &[0.5, 0.5], &mut z, &mut r).unwrap();
         if r.iter().any(|v| *v > 0.0) {
             active += 1;

@@ -165,7 +165,7 @@ enum Kind {
     Zero,
 }
 
-/// One way a solver calls the audit (src/step/friction.rs, src/step/tresca.rs).
+/// One way a solver calls the audit (src/step/condensed_lemke.rs, src/step/osqp_tresca.rs).
 #[derive(Clone, Copy, Debug)]
 struct Case {
     name: &'static str,

@@ -68,7 +68,7 @@ fn with_solver_validates_its_scene() {
 #[test]
 fn osqp_settings_are_validated_by_the_solver() {
     use viscobar::linalg::SymTridiag;
-    use viscobar::step::{OsqpSettings, OsqpSolver, SetupError};
+    use viscobar::step::{Osqp, OsqpSettings, SetupError};
     let c = SymTridiag::new(vec![2.0; 4], vec![-1.0; 3]);
     let cases = [
         (
@@ -109,11 +109,11 @@ fn osqp_settings_are_validated_by_the_solver() {
         ),
     ];
     for (field, settings) in cases {
-        match OsqpSolver::new(&c, &[0], settings) {
+        match Osqp::new(&c, &[0], settings) {
             Err(SetupError::Settings(e)) => assert_eq!(e.field, field),
             Err(other) => panic!("{field}: expected a settings error, got {other}"),
             Ok(_) => panic!("{field}: bad settings accepted"),
         }
     }
-    assert!(OsqpSolver::new(&c, &[0], OsqpSettings::default()).is_ok());
+    assert!(Osqp::new(&c, &[0], OsqpSettings::default()).is_ok());
 }

@@ -14,9 +14,9 @@ use viscobar::linalg::norms::{max_abs, max_distance};
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
-use viscobar::step::block_pivot::BlockPivotSolver;
+use viscobar::step::block_pivot::BlockPivoting;
 use viscobar::step::osqp::OSQP_DEFAULT_EPS;
-use viscobar::step::osqp::{OsqpSettings, OsqpSolver};
+use viscobar::step::osqp::{Osqp, OsqpSettings};
 
 /// Largest problem drawn: large enough for many simultaneous contact changes, small enough that
 /// 200 cases of two OSQP solves each stay within seconds.
@@ -109,8 +109,8 @@ proptest! {
         let mut rnd = common::stream(seed);
         let nodes: Vec<usize> = (0..n).filter(|_| every_node || rnd() < 0.5).collect();
         let k = nodes.len();
-        let mut exact = BlockPivotSolver::new(&c, &nodes).unwrap();
-        let mut osqp = OsqpSolver::new(&c, &nodes, OsqpSettings::default()).unwrap();
+        let mut exact = BlockPivoting::new(&c, &nodes).unwrap();
+        let mut osqp = Osqp::new(&c, &nodes, OsqpSettings::default()).unwrap();
         // Two problems in a row: the second warm-starts both solvers from the first's answer.
         for _ in 0..2 {
             // Loads and obstacle heights of comparable size: a mixed contact set.
@@ -163,7 +163,7 @@ fn a_wrong_active_set_exceeds_the_tolerance() {
     let b = vec![-1.0; n];
     let nodes: Vec<usize> = (0..n).collect();
     let lo = vec![-0.5; n];
-    let mut exact = BlockPivotSolver::new(&c, &nodes).unwrap();
+    let mut exact = BlockPivoting::new(&c, &nodes).unwrap();
     let (mut z, mut r) = (vec![0.0; n], vec![0.0; n]);
     exact.solve(&b, &lo, &mut z, &mut r).unwrap();
     let j = r

@@ -9,9 +9,9 @@ use viscobar::linalg::norms::max_abs;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::audit::AUDIT_MARGIN;
-use viscobar::step::exact::ExactSolver;
+use viscobar::step::end_enumeration::EndEnumeration;
 use viscobar::step::osqp::OSQP_DEFAULT_EPS;
-use viscobar::step::osqp::{OsqpSettings, OsqpSolver};
+use viscobar::step::osqp::{Osqp, OsqpSettings};
 
 /// OSQP's tolerance carried to the answer. The audit accepts a displacement-unit stationarity
 /// error and a primal violation up to `t_z = AUDIT_MARGIN·eps·(1 + ‖z‖)` and a multiplier (sign
@@ -45,8 +45,8 @@ proptest! {
             _ => vec![0, n - 1],
         };
         let k = nodes.len();
-        let mut exact = ExactSolver::new(&c, &nodes).unwrap();
-        let mut osqp = OsqpSolver::new(&c, &nodes, OsqpSettings::default()).unwrap();
+        let mut exact = EndEnumeration::new(&c, &nodes).unwrap();
+        let mut osqp = Osqp::new(&c, &nodes, OsqpSettings::default()).unwrap();
         // Two problems in a row: the second starts from the first's answer.
         for (b, lower) in [(&seed_b[..n], &lo[..k]), (&seed_b[24..24 + n], &lo[2..2 + k])] {
             let (mut ze, mut re) = (vec![0.0; n], vec![0.0; k]);

@@ -15,9 +15,9 @@ use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::output::run_in_memory;
 use viscobar::scene::{MassVariant, Scene};
 use viscobar::step::audit::dual_tolerance;
-use viscobar::step::osqp::{OSQP_INFTY, OsqpSettings, OsqpSolver, raw_problem};
-use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
-use viscobar::step::penalty::PenaltySettings;
+use viscobar::step::end_penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::step::end_penalty::PenaltySettings;
+use viscobar::step::osqp::{OSQP_INFTY, Osqp, OsqpSettings, raw_problem};
 use viscobar::step::{StepFailure, StepSolver};
 use viscobar::study::accuracy::observed_order;
 use viscobar::study::compare::compare;
@@ -264,7 +264,7 @@ fn penalty_converges_to_exact_at_first_order_in_epsilon() {
 // ---- OSQP's failures are errors ---------------------------------------------------------
 
 /// What OSQP itself says about one step problem, called through the `osqp` crate directly
-/// (independently of `OsqpSolver`): status, answer, its own dual residual and tolerance.
+/// (independently of `Osqp`): status, answer, its own dual residual and tolerance.
 struct RawOsqp {
     solved: bool,
     reaction: Vec<f64>,
@@ -507,7 +507,7 @@ fn osqp_handles_no_constraints_and_reports_reactions_with_the_right_sign() {
 #[test]
 fn osqp_refuses_non_finite_data_without_panicking() {
     let c = SymTridiag::new(vec![2.0, 2.0], vec![-1.0]);
-    let mut s = OsqpSolver::new(&c, &[0], OsqpSettings::default()).unwrap();
+    let mut s = Osqp::new(&c, &[0], OsqpSettings::default()).unwrap();
     let (mut z, mut r) = ([0.0; 2], [0.0]);
     for (b, lo) in [
         ([f64::NAN, 0.0], 0.0),
@@ -645,8 +645,12 @@ fn penalty_solver_refuses_a_bad_epsilon_without_panicking() {
     let c = SymTridiag::new(vec![2.0, 2.0], vec![-1.0]);
     for eps in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         assert!(
-            viscobar::step::penalty::PenaltySolver::new(&c, &[0], PenaltySettings { epsilon: eps })
-                .is_err()
+            viscobar::step::end_penalty::EndPenalty::new(
+                &c,
+                &[0],
+                PenaltySettings { epsilon: eps }
+            )
+            .is_err()
         );
     }
     // A scene built in code, never validated, gets an error naming the field.

@@ -13,12 +13,15 @@ use crate::linalg::ldlt::NotPositiveDefinite;
 use crate::linalg::ldlt_fast::TwistedLdlt;
 use crate::linalg::tridiag::Uniform;
 use crate::scene::expr::Expression;
-use crate::scene::{Condition, Scene, SceneError, SolverMethod};
+use crate::scene::{Condition, Scene, SceneError};
 use crate::scheme::body::{Body, EnergySums, FullMassRows};
 use crate::scheme::certify::{IDENTITY_TOL, MAX_IDENTITY_BOUND, conditioned_bound};
 use crate::scheme::contact::{ContactSet, Group, Positions};
 use crate::scheme::{Load, RunError, Scheme, Setup, Unstarted};
-use crate::step::{BlockPivotSolver, ExactSolver, OsqpSolver, PenaltySolver, StepSolver};
+use crate::step::{
+    Algorithm, BlockPivoting, EndEnumeration, EndPenalty, Osqp, SetupError, Shape, StepSolver,
+    algorithm_for,
+};
 
 /// A run of a bar scene: the scheme stepping the bar.
 pub type Simulation = Scheme<BarBody>;
@@ -270,24 +273,37 @@ fn make_solver_with(
     kernels: Kernels,
 ) -> Result<Box<dyn StepSolver>, RunError> {
     let nodes = disc.constrained_locals();
-    match scene.solver.method {
-        SolverMethod::Exact if disc.ends_only() => Ok(Box::new(ExactSolver::with_options(
+    let shape = if disc.ends_only() {
+        Shape::BarEnds
+    } else {
+        Shape::BarObstacle
+    };
+    match algorithm_for(scene.solver.method, shape) {
+        Some(Algorithm::EndEnumeration) => Ok(Box::new(EndEnumeration::with_options(
             &disc.step_matrix,
             &nodes,
             kernels.twisted_solve,
             kernels.warm_start,
         )?)),
-        SolverMethod::Exact => Ok(Box::new(BlockPivotSolver::new(&disc.step_matrix, &nodes)?)),
-        SolverMethod::Osqp => Ok(Box::new(OsqpSolver::new(
+        Some(Algorithm::BlockPivoting) => {
+            Ok(Box::new(BlockPivoting::new(&disc.step_matrix, &nodes)?))
+        }
+        Some(Algorithm::Osqp) => Ok(Box::new(Osqp::new(
             &disc.step_matrix,
             &nodes,
             scene.solver.osqp_settings(),
         )?)),
-        SolverMethod::Penalty => Ok(Box::new(PenaltySolver::new(
+        Some(Algorithm::EndPenalty) => Ok(Box::new(EndPenalty::new(
             &disc.step_matrix,
             &nodes,
             scene.solver.penalty_settings(),
         )?)),
+        None => Err(SetupError::TooManyBounds {
+            solver: scene.solver.method.name(),
+            nodes: nodes.len(),
+        }
+        .into()),
+        Some(other) => unreachable!("the table gives the bar {other:?}"),
     }
 }
 

@@ -14,7 +14,6 @@ use crate::plane::mesh::Grid;
 use crate::plane::normals::{Normal, edge_motion, normals};
 use crate::plane::stress;
 use crate::scene::SceneError;
-use crate::scene::SolverMethod;
 use crate::scene::expr::Expression;
 use crate::scene::plane::PENALTY_CONDENSED_MAX_NORMALS;
 use crate::scene::plane::{EDGE_NAMES, PlaneScene};
@@ -24,7 +23,10 @@ use crate::scheme::certify::{
 };
 use crate::scheme::contact::{ContactSet, Group, Positions};
 use crate::scheme::{Load, RunError, Scheme, Setup, Unstarted};
-use crate::step::{CondensedSolver, OsqpSolver, SparsePenaltySolver, StepSolver};
+use crate::step::{
+    Algorithm, CondensedLcp, CondensedLemke, Osqp, OsqpTresca, SemismoothPenalty, Shape,
+    StepSolver, algorithm_for,
+};
 
 /// A run of a plane scene: the scheme stepping the plane body.
 pub type PlaneSimulation = Scheme<PlaneBody>;
@@ -357,24 +359,47 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
     let c = disc.step_matrix();
     let system = || SparseSystem::new(&disc.pattern, &c, "C");
     let constraints = contact.constraints();
-    let solver: Box<dyn StepSolver> = match scene.solver.method {
-        _ if !friction.is_empty() => {
-            crate::plane::friction::frictional_solver(scene, system()?, constraints, friction)?
+    let shape = if !friction.is_empty() {
+        Shape::PlaneFriction
+    } else if constraints.len() as u64 <= PENALTY_CONDENSED_MAX_NORMALS {
+        Shape::PlaneNormals
+    } else {
+        Shape::ManyPlaneNormals
+    };
+    let method = scene.solver.method;
+    let epsilon = || scene.solver.penalty_settings().epsilon;
+    let solver: Box<dyn StepSolver> = match algorithm_for(method, shape) {
+        Some(Algorithm::CondensedLcp) => Box::new(CondensedLcp::new(system()?, constraints, 0.0)?),
+        Some(Algorithm::CondensedPenalty) => {
+            Box::new(CondensedLcp::new(system()?, constraints, epsilon())?)
         }
-        SolverMethod::Exact => Box::new(CondensedSolver::new(system()?, constraints, 0.0)?),
-        SolverMethod::Penalty => {
-            let epsilon = scene.solver.penalty_settings().epsilon;
-            if constraints.len() as u64 <= PENALTY_CONDENSED_MAX_NORMALS {
-                Box::new(CondensedSolver::new(system()?, constraints, epsilon)?)
-            } else {
-                Box::new(SparsePenaltySolver::new(system()?, constraints, epsilon)?)
-            }
+        Some(Algorithm::SemismoothPenalty) => {
+            Box::new(SemismoothPenalty::new(system()?, constraints, epsilon())?)
         }
-        SolverMethod::Osqp => Box::new(OsqpSolver::with_system(
+        Some(Algorithm::Osqp) => Box::new(Osqp::with_system(
             system()?,
             constraints,
             scene.solver.osqp_settings(),
         )?),
+        Some(Algorithm::CondensedLemke) => {
+            Box::new(CondensedLemke::new(system()?, constraints, friction)?)
+        }
+        Some(Algorithm::OsqpTresca) => Box::new(OsqpTresca::new(
+            system()?,
+            constraints,
+            friction,
+            scene.solver.osqp_settings(),
+        )?),
+        // The scene's validation refuses a method the table has not (penalty with friction).
+        None => {
+            return Err(SceneError::Invalid {
+                field: "solver.method".into(),
+                value: method.name().into(),
+                allowed: format!("has no algorithm for the {}", shape.describe()),
+            }
+            .into());
+        }
+        Some(other) => unreachable!("the table gives the plane {other:?}"),
     };
     let (dt, alpha) = (disc.dt, disc.alpha);
     let condition = condition_bound(&disc.pattern, &c, &disc.mass, dt);

@@ -1,15 +1,12 @@
 //! Coulomb friction on the plane body's Signorini edges: the frictional node of each normal of
 //! an edge with `friction = μ > 0`, its tangent `t` the edge's direction of increasing `s`
-//! (`+e_y` along left and right, `+e_x` along bottom and top), and the step solver that has the
-//! law (the exact frictional solver or OSQP's Tresca fixed point). A corner shared with another
-//! Signorini edge carries that edge's normal on its tangential component and no friction.
+//! (`+e_y` along left and right, `+e_x` along bottom and top); the step solver that has the law
+//! is [`crate::step::algorithm`]'s choice for [`crate::step::Shape::PlaneFriction`]. A corner
+//! shared with another Signorini edge carries that edge's normal on its tangential component
+//! and no friction.
 
-use crate::linalg::system::SparseSystem;
 use crate::plane::normals::Normal;
-use crate::scene::SolverMethod;
-use crate::scene::plane::PlaneScene;
-use crate::scheme::RunError;
-use crate::step::{Constraints, Friction, FrictionalSolver, StepSolver, TrescaSolver};
+use crate::step::Friction;
 
 /// The frictional nodes of the normals `normals` (in the contact set's order) with the edges'
 /// coefficients `mu` (`[left, right, bottom, top]`); `index` maps a degree of freedom of the mesh
@@ -33,25 +30,4 @@ pub fn frictional_nodes(normals: &[Normal], index: &[Option<usize>], mu: &[f64; 
         friction.coefficients.push(mu[nk.edge]);
     }
     friction
-}
-
-/// The step solver of a scene with frictional nodes: its `[solver]` method with the law.
-pub fn frictional_solver(
-    scene: &PlaneScene,
-    system: SparseSystem,
-    constraints: Constraints,
-    friction: Friction,
-) -> Result<Box<dyn StepSolver>, RunError> {
-    Ok(match scene.solver.method {
-        SolverMethod::Osqp => Box::new(TrescaSolver::new(
-            system,
-            constraints,
-            friction,
-            scene.solver.osqp_settings(),
-        )?),
-        // The penalty method is refused with friction by the scene's validation.
-        SolverMethod::Exact | SolverMethod::Penalty => {
-            Box::new(FrictionalSolver::new(system, constraints, friction)?)
-        }
-    })
 }

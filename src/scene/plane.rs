@@ -161,11 +161,7 @@ pub const EDGE_NAMES: [&str; 4] = ["left", "right", "bottom", "top"];
 /// Bytes per pair of contact normals of the exact step: the condensed matrix `S` and the
 /// factor of its active block are two dense `m × m` arrays of doubles.
 pub const EXACT_BYTES_PER_NORMAL_PAIR: u64 = 16;
-/// The penalty law is solved on the condensed `S + εI` (as the exact step) up to this many
-/// normals (256 MiB of dense arrays), and beyond by the sparse Newton iteration
-/// ([`crate::step::SparsePenaltySolver`]), which needs no dense matrix: a fixed switch, so that
-/// a scene gives the same bits on every machine.
-pub const PENALTY_CONDENSED_MAX_NORMALS: u64 = 4096;
+pub use crate::step::algorithm::PENALTY_CONDENSED_MAX_NORMALS;
 
 /// `[edges]`: `left` (x = 0), `right` (x = W), `bottom` (y = 0), `top` (y = H); free when absent.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]

@@ -1,32 +1,11 @@
 //! The `[solver]` table of a scene, bar or plane: the step solver and its settings.
 
 use crate::scene::SceneError;
+use crate::step::end_penalty::PenaltySettings;
 use crate::step::osqp::OsqpSettings;
-use crate::step::penalty::PenaltySettings;
 use serde::{Deserialize, Serialize};
 
-/// Which step solver to use.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SolverMethod {
-    /// Active-set enumeration on the constrained nodes (exact to round-off).
-    #[default]
-    Exact,
-    /// OSQP (ADMM, Stellato et al. 2020), every answer audited against the KKT conditions.
-    Osqp,
-    /// The talk's penalised problem (PP): normal compliance `(u + a)⁻/ε` instead of contact.
-    Penalty,
-}
-
-impl SolverMethod {
-    pub fn name(self) -> &'static str {
-        match self {
-            SolverMethod::Exact => "exact",
-            SolverMethod::Osqp => "osqp",
-            SolverMethod::Penalty => "penalty",
-        }
-    }
-}
+pub use crate::step::algorithm::SolverMethod;
 
 /// The `[solver]` table. Every setting but `method` belongs to one method; naming it with
 /// another method is refused (see [`crate::scene::Scene::validate`]), so a setting is never
@@ -55,7 +34,7 @@ pub struct SolverSpec {
     /// Accept OSQP's "solved inaccurate" (default false), counted in `summary.json`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub accept_inaccurate: Option<bool>,
-    /// Penalty parameter ε of (PP) (default [`PENALTY_DEFAULT_EPSILON`](crate::step::penalty::PENALTY_DEFAULT_EPSILON)).
+    /// Penalty parameter ε of (PP) (default [`PENALTY_DEFAULT_EPSILON`](crate::step::end_penalty::PENALTY_DEFAULT_EPSILON)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub epsilon: Option<f64>,
 }

@@ -235,7 +235,7 @@ impl<S: SpdSystem> KktAudit<S> {
 
 /// Whether the penalty solver takes a constrained node's reaction from its gap,
 /// `(lo_j − z_j)/ε`: when the spring `1/ε` (`stiffness`) is no stiffer than `C_jj`; otherwise
-/// from stationarity, `(C z − b)_j` (`PenaltySolver::solve_on_support`). The solver and the
+/// from stationarity, `(C z − b)_j` (`EndPenalty::solve_on_support`). The solver and the
 /// audit, which weighs each form's round-off, share this rule.
 pub fn reaction_from_gap(c_jj: f64, stiffness: f64) -> bool {
     c_jj >= stiffness

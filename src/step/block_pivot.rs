@@ -9,7 +9,7 @@
 //! of `C` with the active rows replaced by identity ones; an iteration after the step's first
 //! recomputes each recurrence (pivots, forward chain, backward chain) only from the first
 //! changed row until its carried value meets the stored bits, so every answer is bitwise the
-//! whole-bar sweep's ([`BlockPivotSolver::with_full_solves`], compared in the tests). The
+//! whole-bar sweep's ([`BlockPivoting::with_full_solves`], compared in the tests). The
 //! margins are re-evaluated only where `z` changed. Termination, tie thresholds, how far a flip
 //! reaches and what the code does for speed:
 //! [docs/step-solvers.md](../docs/step-solvers.md#block-principal-pivoting).
@@ -60,7 +60,7 @@ pub struct PivotWork {
 
 /// Exact solver for bounds at many nodes.
 #[derive(Clone, Debug)]
-pub struct BlockPivotSolver {
+pub struct BlockPivoting {
     c: SymTridiag,
     /// `max_i Σ_j |C_ij|`, for the round-off threshold of the multipliers.
     c_norm: f64,
@@ -86,7 +86,7 @@ pub struct BlockPivotSolver {
     t: Vec<f64>,
     /// `max|z|` per block of [`MAX_BLOCK`] nodes.
     block_max: Vec<f64>,
-    /// Per node: the margin of the last evaluation ([`BlockPivotSolver::margin_at`]).
+    /// Per node: the margin of the last evaluation ([`BlockPivoting::margin_at`]).
     margin: Vec<f64>,
     /// Nodes with a negative margin, increasing; those beyond the round-off threshold
     /// (infeasible), increasing; scratch for their update; the flipped nodes.
@@ -105,7 +105,7 @@ pub struct BlockPivotSolver {
 
 const NONE: usize = usize::MAX;
 
-impl BlockPivotSolver {
+impl BlockPivoting {
     /// `nodes` must be strictly increasing indices into `0..C.dim()`.
     pub fn new(c: &SymTridiag, nodes: &[usize]) -> Result<Self, NotPositiveDefinite> {
         let n = c.dim();
@@ -523,7 +523,7 @@ impl BlockPivotSolver {
     }
 }
 
-impl StepSolver for BlockPivotSolver {
+impl StepSolver for BlockPivoting {
     fn name(&self) -> &'static str {
         "exact"
     }
@@ -552,7 +552,7 @@ impl StepSolver for BlockPivotSolver {
     }
 }
 
-impl BlockPivotSolver {
+impl BlockPivoting {
     /// [`StepSolver::solve`] with the bounds `lo` per node.
     fn solve_with(
         &mut self,
@@ -678,7 +678,7 @@ mod tests {
         let n = diag.len();
         let c = SymTridiag::new(diag, off);
         let nodes: Vec<usize> = (0..n).filter(|&i| all || i % 3 != 1).collect();
-        let mut s = BlockPivotSolver::new(&c, &nodes).unwrap();
+        let mut s = BlockPivoting::new(&c, &nodes).unwrap();
         let mut i = 0;
         for &(flag, len) in runs.iter().cycle() {
             for _ in 0..len {

@@ -1,6 +1,6 @@
 //! Exact solver of the dense linear complementarity problem `w = S r + q >= 0, r >= 0,
 //! rᵀw = 0` with `S` symmetric positive definite (`m × m`; the condensed contact problem
-//! `S = E C⁻¹ Eᵀ` of [`crate::step::condensed`]). An SPD matrix is a P-matrix, so the solution
+//! `S = E C⁻¹ Eᵀ` of [`crate::step::condensed_lcp`]). An SPD matrix is a P-matrix, so the solution
 //! exists and is unique for every `q` (Cottle, Pang & Stone, *The Linear Complementarity
 //! Problem*, Thm 3.3.7).
 //!

@@ -1,5 +1,5 @@
 //! Lemke's complementary pivoting method for the dense, non-symmetric LCP `w = M x + q >= 0,
-//! x >= 0, xᵀw = 0` (`N × N`; the frictional contact problem of [`crate::step::friction`]), with
+//! x >= 0, xᵀw = 0` (`N × N`; the frictional contact problem of [`crate::step::condensed_lemke`]), with
 //! the lexicographic ratio test, which visits no almost-complementary basis twice, so the method
 //! ends after finitely many pivots, on a solution or on a ray (Cottle, Pang & Stone, *The Linear
 //! Complementarity Problem*, §4.4 and §4.9). Revised form: `B⁻¹` of the current basis, dense,
@@ -598,7 +598,7 @@ mod tests {
     }
 
     /// The frictional LCP of a random SPD `S` on `m` normals, the first `p` with friction
-    /// `mu` (the structure of [`crate::step::friction`] at scale 1): rows and columns `N`
+    /// `mu` (the structure of [`crate::step::condensed_lemke`] at scale 1): rows and columns `N`
     /// (`0..m`), `β⁺`, `β⁻`, `λ` (`p` each).
     fn friction_lcp(m: usize, p: usize, seed: &[f64], mu: f64) -> Vec<f64> {
         let k = m + p;
@@ -760,7 +760,7 @@ mod tests {
     /// and back: Lemke's method ends on a solution without visiting a basis twice in any run.
     #[test]
     fn lemke_ends_without_revisiting_a_basis_on_a_degenerate_frictional_lcp() {
-        use crate::step::friction::stewart_trinkle_matrix;
+        use crate::step::condensed_lemke::stewart_trinkle_matrix;
         use crate::step::solver::Friction;
         let (m, mu) = (8usize, 0.5);
         let k = 2 * m;

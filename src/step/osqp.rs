@@ -100,7 +100,7 @@ impl OsqpSettings {
 }
 
 /// OSQP on the step problem, set up once per run, audited every step.
-pub struct OsqpSolver<S: SpdSystem = TridiagSystem> {
+pub struct Osqp<S: SpdSystem = TridiagSystem> {
     problem: Problem,
     settings: OsqpSettings,
     k: usize,
@@ -112,9 +112,9 @@ pub struct OsqpSolver<S: SpdSystem = TridiagSystem> {
     inaccurate_steps: u64,
 }
 
-impl<S: SpdSystem> std::fmt::Debug for OsqpSolver<S> {
+impl<S: SpdSystem> std::fmt::Debug for Osqp<S> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("OsqpSolver")
+        f.debug_struct("Osqp")
             .field("settings", &self.settings)
             .field("constraints", &self.k)
             .finish_non_exhaustive()
@@ -159,7 +159,7 @@ fn constraint_csc(n: usize, constraints: &Constraints) -> CscMatrix<'static> {
     })
 }
 
-/// The OSQP problem of one step exactly as [`OsqpSolver`] builds it (same matrices and
+/// The OSQP problem of one step exactly as [`Osqp`] builds it (same matrices and
 /// settings), with `q = −b` and lower bounds `lower`, but without the audit: for the tests and
 /// studies that examine OSQP's own answer.
 pub fn raw_problem(
@@ -219,7 +219,7 @@ pub(crate) fn accepted(
     Err(StepFailure::Osqp { status, iterations })
 }
 
-impl OsqpSolver<TridiagSystem> {
+impl Osqp<TridiagSystem> {
     /// Sets OSQP up for the tridiagonal `C` and lower bounds at the unknowns `nodes`.
     pub fn new(
         c: &SymTridiag,
@@ -235,7 +235,7 @@ impl OsqpSolver<TridiagSystem> {
     }
 }
 
-impl<S: SpdSystem> OsqpSolver<S> {
+impl<S: SpdSystem> Osqp<S> {
     /// Sets OSQP up for `C` (with its factorisation, for the audit) and the constraints.
     pub fn with_system(
         system: S,
@@ -279,7 +279,7 @@ impl<S: SpdSystem> OsqpSolver<S> {
     }
 }
 
-impl<S: SpdSystem> StepSolver for OsqpSolver<S> {
+impl<S: SpdSystem> StepSolver for Osqp<S> {
     fn name(&self) -> &'static str {
         "osqp"
     }

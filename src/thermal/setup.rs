@@ -4,9 +4,9 @@
 
 use crate::bar::{Kernels, Simulation};
 use crate::scene::Expression;
-use crate::scene::{Scene, SceneError, SolverMethod};
+use crate::scene::{Scene, SceneError};
 use crate::scheme::{Body, Load, RunError, Scheme, Setup, Unstarted};
-use crate::step::{ExactSolver, StepSolver};
+use crate::step::{Algorithm, EndEnumeration, Shape, StepSolver, algorithm_for};
 use crate::thermal::body::ThermalBody;
 use crate::thermal::solver::{CoupledSolver, DecoupledSolver};
 use crate::thermal::system::CoupledEnds;
@@ -40,14 +40,17 @@ impl Scheme<ThermalBody> {
             }
             .into());
         };
-        if scene.solver.method != SolverMethod::Exact {
+        // The mechanical step, coupled or not, is the end enumeration the table gives.
+        let Some(Algorithm::EndEnumeration) =
+            algorithm_for(scene.solver.method, Shape::ThermalEnds)
+        else {
             return Err(SceneError::Invalid {
                 field: "solver.method".into(),
                 value: format!("{:?}", scene.solver.method).to_lowercase(),
                 allowed: "a scene with [heat] takes the exact step solver (\"exact\")".into(),
             }
             .into());
-        }
+        };
         let expressions = heat.validate(scene.thermal_view(), scene.obstacle.is_some())?;
         let bar = Simulation::prepare_mechanics(scene)?.into_setup();
         let disc = bar.body.discretisation().clone();
@@ -101,7 +104,7 @@ impl Scheme<ThermalBody> {
                     value: m.gamma.to_string(),
                     allowed: format!("the coupled step matrix has no block LDLᵀ: {e}"),
                 })?;
-                variants.push(Box::new(ExactSolver::on(system, &unknowns, true)));
+                variants.push(Box::new(EndEnumeration::on(system, &unknowns, true)));
             }
             Box::new(CoupledSolver::new(variants, exchange))
         };

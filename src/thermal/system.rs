@@ -11,7 +11,7 @@
 use crate::linalg::block_tridiag::{BlockLdlt, BlockTridiag, SingularBlock};
 use crate::linalg::block_tridiag_fast::TwistedBlockLdlt;
 use crate::linalg::tridiag::SymTridiag;
-use crate::step::exact::EndSystem;
+use crate::step::end_enumeration::EndSystem;
 use crate::step::schur::{constraint_rows, row_product};
 use crate::thermal::matrices::{ThermalMatrices, coupling_entry};
 

@@ -18,8 +18,8 @@ use std::fmt::Write;
 use viscobar::scene::Scene;
 use viscobar::scheme::RunError;
 use viscobar::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
+use viscobar::step::end_penalty::PENALTY_DEFAULT_EPSILON;
 use viscobar::step::osqp::OSQP_DEFAULT_EPS;
-use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
 
 /// Full size (`verify --stiff`) or the reduced size of `tests/stiff.rs`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -744,7 +744,7 @@ impl StepTerms {
     /// `−γ_2 (|lo_j| + |û^{n+1}_j|)` (Higham, Lemma 3.1). No forward error of the solve enters
     /// it: only whether the returned `z_j >= lo_j` holds.
     ///
-    /// *The exact solvers' allowance* (`src/step/exact.rs`, `src/step/block_pivot.rs`). At a
+    /// *The exact solvers' allowance* (`src/step/end_enumeration.rs`, `src/step/block_pivot.rs`). At a
     /// node with a reaction every path writes `z_j = lo_j` bit for bit (`superpose`,
     /// `superpose_and_add`, `solve_on_active_set`; block pivoting copies `lo` into the active
     /// runs in `solve_all`): allowance 0. At a node without one:

@@ -20,9 +20,9 @@ use viscobar::scene::{self, Scene};
 use viscobar::scheme::RunError;
 use viscobar::step::StepSolver;
 use viscobar::step::audit::dual_tolerance;
-use viscobar::step::exact::ExactSolver;
-use viscobar::step::osqp::{OsqpSettings, OsqpSolver, raw_problem};
-use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::step::end_enumeration::EndEnumeration;
+use viscobar::step::end_penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::step::osqp::{Osqp, OsqpSettings, raw_problem};
 use viscobar::study::accuracy::observed_order;
 use viscobar::study::compare::compare;
 
@@ -348,7 +348,7 @@ fn random_problems(md: &mut String) -> Result<(), RunError> {
         let lo: Vec<f64> = nodes.iter().map(|_| g.uniform(-2.0, 2.0)).collect();
         let k = nodes.len();
         let (mut ze, mut re) = (vec![0.0; n], vec![0.0; k]);
-        ExactSolver::new(&c, &nodes)?
+        EndEnumeration::new(&c, &nodes)?
             .solve(&b, &lo, &mut ze, &mut re)
             .map_err(|failure| RunError::Step {
                 step: case,
@@ -357,7 +357,7 @@ fn random_problems(md: &mut String) -> Result<(), RunError> {
                 failure,
             })?;
         let (mut zo, mut ro) = (vec![0.0; n], vec![0.0; k]);
-        let mut osqp = OsqpSolver::new(&c, &nodes, OsqpSettings::default())?;
+        let mut osqp = Osqp::new(&c, &nodes, OsqpSettings::default())?;
         if osqp.solve(&b, &lo, &mut zo, &mut ro).is_err() {
             failures += 1;
             continue;

@@ -1,11 +1,11 @@
 //! Contact at scale: the sparse penalty solver (the penalty law beyond the condensed switch,
-//! `viscobar::step::SparsePenaltySolver`) against the condensed one on the same step problems.
+//! `viscobar::step::SemismoothPenalty`) against the condensed one on the same step problems.
 
 use viscobar::linalg::system::SparseSystem;
 use viscobar::plane::{PlaneDiscretisation, PlaneSimulation};
 use viscobar::scene::plane::{PlaneScene, plane_builtin_text};
 use viscobar::scheme::RunError;
-use viscobar::step::{CondensedSolver, SparsePenaltySolver, StepSolver};
+use viscobar::step::{CondensedLcp, SemismoothPenalty, StepSolver};
 
 /// The compliances compared.
 pub const EPSILONS: [f64; 2] = [1e-3, 1e-6];
@@ -32,8 +32,8 @@ pub fn sparse_penalty_agreement(epsilon: f64) -> Result<f64, RunError> {
     let constraints = PlaneSimulation::prepare(&scene)?.contact().constraints();
     let m = constraints.len();
     let system = || SparseSystem::new(&disc.pattern, &c, "C");
-    let mut condensed = CondensedSolver::new(system()?, constraints.clone(), epsilon)?;
-    let mut sparse = SparsePenaltySolver::new(system()?, constraints, epsilon)?;
+    let mut condensed = CondensedLcp::new(system()?, constraints.clone(), epsilon)?;
+    let mut sparse = SemismoothPenalty::new(system()?, constraints, epsilon)?;
     let n = disc.unknowns();
     let (mut za, mut zb) = (vec![0.0; n], vec![0.0; n]);
     let (mut ra, mut rb) = (vec![0.0; m], vec![0.0; m]);

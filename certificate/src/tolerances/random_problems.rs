@@ -93,7 +93,7 @@ pub const KKT_SAMPLE_CASES: usize = 200;
 /// random half, two problems in a row: the second warm-started).
 pub fn random_kkt_worst() -> Result<(f64, f64), RunError> {
     use viscobar::step::StepSolver;
-    use viscobar::step::block_pivot::BlockPivotSolver;
+    use viscobar::step::block_pivot::BlockPivoting;
     let mut rnd = stream(2026);
     let (mut ratio, mut worst) = (0.0f64, 0.0f64);
     for case in 0..KKT_SAMPLE_CASES {
@@ -103,7 +103,7 @@ pub fn random_kkt_worst() -> Result<(f64, f64), RunError> {
         let every_node = large || case % 2 == 1;
         let nodes: Vec<usize> = (0..n).filter(|_| every_node || rnd() < 0.5).collect();
         let k = nodes.len();
-        let mut solver = BlockPivotSolver::new(&c, &nodes)?;
+        let mut solver = BlockPivoting::new(&c, &nodes)?;
         for _ in 0..if large { 1 } else { 2 } {
             let b: Vec<f64> = (0..n).map(|_| 4.0 * rnd() - 2.0).collect();
             let lo: Vec<f64> = (0..k).map(|_| 2.0 * rnd() - 1.0).collect();
@@ -255,7 +255,7 @@ pub fn oracle_agreement(
 /// problems in a row (the second `s b` with bounds moved by `t`: warm-started).
 pub fn oracle_agreement_worst() -> Result<f64, RunError> {
     use viscobar::step::StepSolver;
-    use viscobar::step::exact::ExactSolver;
+    use viscobar::step::end_enumeration::EndEnumeration;
     let mut rnd = stream(22);
     let mut worst = 0.0f64;
     for case in 0..KKT_SAMPLE_CASES * 5 {
@@ -270,7 +270,7 @@ pub fn oracle_agreement_worst() -> Result<f64, RunError> {
         };
         let lower: Vec<f64> = nodes.iter().map(|_| 4.0 * rnd() - 2.0).collect();
         let (s, t) = (0.5 + rnd(), 0.4 * rnd() - 0.2);
-        let mut solver = ExactSolver::new(&c, &nodes)?;
+        let mut solver = EndEnumeration::new(&c, &nodes)?;
         let (mut z, mut r) = (vec![0.0; n], vec![0.0; nodes.len()]);
         let b2: Vec<f64> = b.iter().map(|v| s * v).collect();
         let lower2: Vec<f64> = lower.iter().map(|v| v + t).collect();

@@ -7,8 +7,8 @@ use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::scene::{self, MassVariant, Scene, SolverMethod, builtin_names};
 use viscobar::scheme::RunError;
 use viscobar::step::audit::AUDIT_MARGIN;
+use viscobar::step::end_penalty::PENALTY_DEFAULT_EPSILON;
 use viscobar::step::osqp::OSQP_DEFAULT_EPS;
-use viscobar::step::penalty::PENALTY_DEFAULT_EPSILON;
 use viscobar::study::compare::{Comparison, compare};
 
 // ---- tests/solvers.rs: the three step solvers on every built-in scene ----------------------
@@ -215,7 +215,7 @@ pub const SMALL_TOL: f64 = 64.0 * f64::EPSILON;
 /// forms, and the number of steps the second solver audited.
 pub fn osqp_small_problems() -> Result<(f64, u64), RunError> {
     use viscobar::step::StepSolver;
-    use viscobar::step::osqp::{OsqpSettings, OsqpSolver};
+    use viscobar::step::osqp::{Osqp, OsqpSettings};
     let c = SymTridiag::new(vec![2.0, 2.0, 2.0], vec![-1.0, -1.0]);
     let b = [1.0, 1.0, 1.0];
     let mut worst = 0.0f64;
@@ -225,14 +225,14 @@ pub fn osqp_small_problems() -> Result<(f64, u64), RunError> {
         solver: "osqp".into(),
         failure,
     };
-    let mut free = OsqpSolver::new(&c, &[], OsqpSettings::default())?;
+    let mut free = Osqp::new(&c, &[], OsqpSettings::default())?;
     let mut z = [0.0; 3];
     free.solve(&b, &[], &mut z, &mut [])
         .map_err(|f| failed(0, f))?;
     for (zi, want) in z.iter().zip([1.5, 2.0, 1.5]) {
         worst = worst.max((zi - want).abs());
     }
-    let mut one = OsqpSolver::new(&c, &[0], OsqpSettings::default())?;
+    let mut one = Osqp::new(&c, &[0], OsqpSettings::default())?;
     let mut r = [0.0];
     one.solve(&b, &[2.0], &mut z, &mut r)
         .map_err(|f| failed(1, f))?;
@@ -255,11 +255,11 @@ pub const TIE_TOL: f64 = 1e-14;
 /// reactions were not negative, and whether every call gave the first call's bits.
 pub fn exact_tie() -> Result<(f64, bool, bool), RunError> {
     use viscobar::step::StepSolver;
-    use viscobar::step::exact::ExactSolver;
+    use viscobar::step::end_enumeration::EndEnumeration;
     let c = SymTridiag::new(vec![2.0, 2.0, 2.0], vec![-1.0, -1.0]);
     let z_free = [1.0, 1.0, 1.0];
     let b = c.mul(&z_free);
-    let mut solver = ExactSolver::new(&c, &[0, 2])?;
+    let mut solver = EndEnumeration::new(&c, &[0, 2])?;
     let (mut worst, mut signs, mut same) = (0.0f64, true, true);
     let mut first: Option<(Vec<f64>, Vec<f64>)> = None;
     for call in 0..3 {

@@ -6,7 +6,7 @@
 //!   minimise ½ rᵀ S r + qᵀ r   subject to   r_N >= 0,   −g <= r_T <= g,
 //! ```
 //!
-//! (`S`, `q` of [`crate::step::friction`]; its KKT conditions are Signorini on the normals and
+//! (`S`, `q` of [`crate::step::condensed_lemke`]; its KKT conditions are Signorini on the normals and
 //! Tresca's law on the central slip), solved by OSQP, set up once and warm-started; `z` then
 //! from `C z = b + Eᵀ r`, and each answer audited against the Tresca law it solved
 //! ([`crate::step::friction_audit`]). The iteration starts from the previous step's normal
@@ -16,7 +16,7 @@
 use crate::linalg::norms::max_abs;
 use crate::linalg::system::{Csc, SpdSystem};
 use crate::step::audit::{AUDIT_MARGIN, INACCURATE_FACTOR};
-use crate::step::condensed::condensed_matrix;
+use crate::step::condensed_lcp::condensed_matrix;
 use crate::step::friction_audit::{FrictionAudit, FrictionLaw, Thresholds};
 use crate::step::osqp::{OSQP_INFTY, OsqpSettings, accepted, identity_allowance, osqp_csc};
 use crate::step::solver::{Constraints, Friction};
@@ -33,7 +33,7 @@ pub const FIXED_POINT_TOL: f64 = 1e-12;
 pub const FIXED_POINT_MAX_ITERATIONS: u32 = 200;
 
 /// OSQP on the Tresca problems of the fixed point.
-pub struct TrescaSolver<S: SpdSystem> {
+pub struct OsqpTresca<S: SpdSystem> {
     system: S,
     constraints: Constraints,
     friction: Friction,
@@ -74,7 +74,7 @@ fn dense_upper(s: &[f64], k: usize, sigma: f64) -> Csc {
     }
 }
 
-impl<S: SpdSystem> TrescaSolver<S> {
+impl<S: SpdSystem> OsqpTresca<S> {
     /// Forms `S` and sets OSQP up on it with `A = I`.
     pub fn new(
         mut system: S,
@@ -178,7 +178,7 @@ impl<S: SpdSystem> TrescaSolver<S> {
     }
 }
 
-impl<S: SpdSystem> StepSolver for TrescaSolver<S> {
+impl<S: SpdSystem> StepSolver for OsqpTresca<S> {
     fn name(&self) -> &'static str {
         "osqp"
     }

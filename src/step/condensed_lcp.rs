@@ -51,7 +51,7 @@ pub fn condensed_matrix(constraints: &Constraints, system: &mut impl SpdSystem) 
 }
 
 /// Condensation and the exact LCP solver (or the penalty law with `ε > 0`).
-pub struct CondensedSolver<S: SpdSystem> {
+pub struct CondensedLcp<S: SpdSystem> {
     system: S,
     constraints: Constraints,
     /// `None` without constraints: then a step is one solve.
@@ -62,7 +62,7 @@ pub struct CondensedSolver<S: SpdSystem> {
     w: Vec<f64>,
 }
 
-impl<S: SpdSystem> CondensedSolver<S> {
+impl<S: SpdSystem> CondensedLcp<S> {
     /// Forms `S` (plus `εI` for the penalty law, `epsilon > 0`) and its LCP solver.
     pub fn new(mut system: S, constraints: Constraints, epsilon: f64) -> Result<Self, SetupError> {
         if !(epsilon.is_finite() && epsilon >= 0.0) {
@@ -104,7 +104,7 @@ impl<S: SpdSystem> CondensedSolver<S> {
     }
 }
 
-impl<S: SpdSystem> StepSolver for CondensedSolver<S> {
+impl<S: SpdSystem> StepSolver for CondensedLcp<S> {
     fn name(&self) -> &'static str {
         if self.epsilon > 0.0 {
             "penalty"
@@ -150,5 +150,123 @@ impl<S: SpdSystem> StepSolver for CondensedSolver<S> {
             self.system.solve_in_place(z);
         }
         Ok(SolveInfo { iterations })
+    }
+}
+
+/// The bar's specialised solvers against this general one on the bar's tridiagonal system:
+/// each is its twin ([`crate::step::algorithm`] names which serves a scene).
+#[cfg(test)]
+mod twins {
+    use super::*;
+    use crate::linalg::system::TridiagSystem;
+    use crate::linalg::tridiag::SymTridiag;
+    use crate::step::{BlockPivoting, EndEnumeration, EndPenalty, PenaltySettings};
+
+    /// Units of `ε max|z|` (`ε max r`) the twins' answers may differ by: both are backward
+    /// stable on a matrix with `κ(C) <= 3` (diagonal 4, off-diagonals `−1`), and the condensed
+    /// route's second solve and LCP add a few roundings of each quantity to the twin's.
+    const TWIN_AGREEMENT_ULPS: f64 = 64.0;
+
+    /// A deterministic pseudo-random number in `[−1, 1)` from `seed` and `i`.
+    fn draw(seed: u64, i: usize) -> f64 {
+        let x = (seed.wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ (i as u64).wrapping_mul(0xBF58_476D_1CE4_E5B9))
+        .wrapping_mul(0x94D0_49BB_1331_11EB);
+        (x >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+
+    fn bar_matrix(n: usize) -> SymTridiag {
+        SymTridiag::new(vec![4.0; n], vec![-1.0; n - 1])
+    }
+
+    /// The largest of `|a − b|` over `max |a|` (0 when `a` vanishes), in units of ε.
+    fn ulps_apart(a: &[f64], b: &[f64]) -> f64 {
+        let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if scale == 0.0 {
+            return 0.0;
+        }
+        let worst = a
+            .iter()
+            .zip(b)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        worst / (scale * f64::EPSILON)
+    }
+
+    /// Solves a run of problems with both solvers, warm starts included, and compares them;
+    /// returns how many problems had a positive reaction (so that contact was exercised).
+    fn compare(
+        twin: &mut dyn StepSolver,
+        general: &mut dyn StepSolver,
+        n: usize,
+        bounds: usize,
+        seed: u64,
+    ) -> usize {
+        let mut contacts = 0;
+        for problem in 0..40 {
+            let s = seed * 1000 + problem;
+            let rhs: Vec<f64> = (0..n).map(|i| draw(s, i)).collect();
+            let lower: Vec<f64> = (0..bounds).map(|k| 0.2 * draw(s + 500, k) - 0.1).collect();
+            let (mut za, mut zb) = (vec![0.0; n], vec![0.0; n]);
+            let (mut ra, mut rb) = (vec![0.0; bounds], vec![0.0; bounds]);
+            twin.solve(&rhs, &lower, &mut za, &mut ra).unwrap();
+            general.solve(&rhs, &lower, &mut zb, &mut rb).unwrap();
+            let (dz, dr) = (ulps_apart(&za, &zb), ulps_apart(&ra, &rb));
+            assert!(
+                dz <= TWIN_AGREEMENT_ULPS,
+                "{}: z {dz} ulps apart",
+                twin.name()
+            );
+            assert!(
+                dr <= TWIN_AGREEMENT_ULPS,
+                "{}: r {dr} ulps apart",
+                twin.name()
+            );
+            contacts += usize::from(ra.iter().any(|&r| r > 0.0));
+        }
+        contacts
+    }
+
+    fn general(c: &SymTridiag, nodes: &[usize], epsilon: f64) -> CondensedLcp<TridiagSystem> {
+        let system = TridiagSystem::new(c).unwrap();
+        CondensedLcp::new(system, Constraints::lower_bounds(nodes), epsilon).unwrap()
+    }
+
+    #[test]
+    fn end_enumeration_is_the_condensed_lcp_on_the_bar_ends() {
+        for (n, ends) in [
+            (2, vec![0, 1]),
+            (9, vec![0]),
+            (9, vec![8]),
+            (30, vec![0, 29]),
+        ] {
+            let c = bar_matrix(n);
+            let mut twin = EndEnumeration::new(&c, &ends).unwrap();
+            let contacts = compare(&mut twin, &mut general(&c, &ends, 0.0), n, ends.len(), 1);
+            assert!(contacts > 0, "n = {n}: no contact drawn");
+        }
+    }
+
+    #[test]
+    fn end_penalty_is_the_condensed_lcp_with_compliance_on_the_bar_ends() {
+        for epsilon in [1e-1, 1e-4] {
+            for (n, ends) in [(9, vec![0]), (30, vec![0, 29])] {
+                let c = bar_matrix(n);
+                let mut twin = EndPenalty::new(&c, &ends, PenaltySettings { epsilon }).unwrap();
+                let mut general = general(&c, &ends, epsilon);
+                let contacts = compare(&mut twin, &mut general, n, ends.len(), 2);
+                assert!(contacts > 0, "n = {n}, ε = {epsilon}: no contact drawn");
+            }
+        }
+    }
+
+    #[test]
+    fn block_pivoting_is_the_condensed_lcp_under_an_obstacle() {
+        for n in [5, 40] {
+            let c = bar_matrix(n);
+            let nodes: Vec<usize> = (0..n).collect();
+            let mut twin = BlockPivoting::new(&c, &nodes).unwrap();
+            let contacts = compare(&mut twin, &mut general(&c, &nodes, 0.0), n, n, 3);
+            assert!(contacts > 0, "n = {n}: no contact drawn");
+        }
     }
 }

@@ -1,5 +1,5 @@
 //! The penalty law (normal compliance `ε r_k = (lo_k − s_k z_{i_k})⁺`) for any number of
-//! constraints, without the dense `S` of [`crate::step::CondensedSolver`]: the step problem is
+//! constraints, without the dense `S` of [`crate::step::CondensedLcp`]: the step problem is
 //! the minimisation of the convex, piecewise quadratic
 //! `f(z) = ½ zᵀCz − bᵀz + 1/(2ε) Σ_k ((lo_k − s_k z_{i_k})⁺)²`, solved by a damped semismooth
 //! Newton iteration on the sparse system. With the active set `A` (the constraints whose
@@ -26,7 +26,7 @@ const MAX_HALVINGS: u32 = 60;
 const ARMIJO: f64 = 1e-4;
 
 /// The sparse penalty solver.
-pub struct SparsePenaltySolver {
+pub struct SemismoothPenalty {
     pattern: Pattern,
     /// `C` and `C + D_A/ε` on the pattern.
     c: Vec<f64>,
@@ -51,6 +51,13 @@ pub struct SparsePenaltySolver {
 #[inline(always)]
 fn compression(constraints: &Constraints, k: usize, lower: &[f64], z: &[f64]) -> f64 {
     lower[k] - constraints.directions[k] * z[constraints.unknowns[k]]
+}
+
+/// The penalty law's reaction from the compression `lo_k − s_k z_{i_k}` of a constraint: normal
+/// compliance, `ε r_k = (lo_k − s_k z_{i_k})⁺`.
+#[inline]
+pub fn compliance_reaction(compression: f64, epsilon: f64) -> f64 {
+    compression.max(0.0) / epsilon
 }
 
 /// The step problem's `f` and its data.
@@ -87,14 +94,17 @@ impl Objective<'_> {
         }
         for k in 0..self.constraints.len() {
             let (i, s) = (self.constraints.unknowns[k], self.constraints.directions[k]);
-            let r = compression(self.constraints, k, self.lower, z).max(0.0) / self.epsilon;
+            let r = compliance_reaction(
+                compression(self.constraints, k, self.lower, z),
+                self.epsilon,
+            );
             g -= r * s * d[i];
         }
         g
     }
 }
 
-impl SparsePenaltySolver {
+impl SemismoothPenalty {
     /// The solver of the penalty law with compliance `epsilon > 0` for `system`'s `C` (its
     /// factor is the one of `A = ∅`).
     pub fn new(
@@ -176,7 +186,7 @@ impl SparsePenaltySolver {
     }
 }
 
-impl StepSolver for SparsePenaltySolver {
+impl StepSolver for SemismoothPenalty {
     fn name(&self) -> &'static str {
         "penalty"
     }
@@ -247,7 +257,7 @@ impl StepSolver for SparsePenaltySolver {
             minimiser = alpha == 1.0;
         }
         for (k, r) in reactions.iter_mut().enumerate() {
-            *r = compression(&self.constraints, k, lower, z).max(0.0) / self.epsilon;
+            *r = compliance_reaction(compression(&self.constraints, k, lower, z), self.epsilon);
         }
         Ok(SolveInfo { iterations })
     }

@@ -10,7 +10,7 @@
 //! `z_A = lo_A`, `C_FF z_F = b_F − C_FA lo_A`, `r_A = (Cz − b)_A`: backward stable.
 //!
 //! Warm start: the previous step's active set is tried first by the same direct solve and kept
-//! when it meets the KKT conditions ([docs/step-solvers.md](../docs/step-solvers.md#exact-solver)).
+//! when it meets the KKT conditions ([docs/step-solvers.md](../docs/step-solvers.md#end-enumeration)).
 //! The step matrix enters through [`EndSystem`]: the bar's tridiagonal `C` ([`BarEnds`]), or
 //! any body's matrix whose constrained unknowns are at most two.
 
@@ -118,7 +118,7 @@ impl EndSystem for BarEnds {
 /// Exact enumeration for zero, one or two constrained unknowns of the step matrix `E` (the
 /// bar's `C` unless said otherwise).
 #[derive(Clone, Debug)]
-pub struct ExactSolver<E: EndSystem = BarEnds> {
+pub struct EndEnumeration<E: EndSystem = BarEnds> {
     system: E,
     /// The constrained unknowns (at most two).
     nodes: Vec<usize>,
@@ -132,14 +132,14 @@ pub struct ExactSolver<E: EndSystem = BarEnds> {
     warm_kept: u64,
 }
 
-impl ExactSolver {
+impl EndEnumeration {
     /// Factorises `C` and, for each non-empty subset of the constrained nodes (at most two), `C`
     /// with those rows and columns replaced by identity ones (`TwistedLdlt`); warm start on.
     pub fn new(c: &SymTridiag, nodes: &[usize]) -> Result<Self, NotPositiveDefinite> {
         Self::with_options(c, nodes, true, true)
     }
 
-    /// [`ExactSolver::new`] with the plain factorisation `Ldlt` instead of its twin
+    /// [`EndEnumeration::new`] with the plain factorisation `Ldlt` instead of its twin
     /// (`twisted = false`) or without the warm start: the same answers to round-off (with
     /// the warm start or without, the bits of the direct solve on the same set), for
     /// measuring what each buys.
@@ -161,7 +161,7 @@ impl ExactSolver {
     }
 }
 
-impl<E: EndSystem> ExactSolver<E> {
+impl<E: EndSystem> EndEnumeration<E> {
     /// The solver on `system`, whose constrained unknowns are `nodes` (at most two).
     pub fn on(mut system: E, nodes: &[usize], warm_start: bool) -> Self {
         assert!(
@@ -238,7 +238,7 @@ impl<E: EndSystem> ExactSolver<E> {
     }
 }
 
-impl<E: EndSystem> StepSolver for ExactSolver<E> {
+impl<E: EndSystem> StepSolver for EndEnumeration<E> {
     fn name(&self) -> &'static str {
         "exact"
     }
@@ -350,7 +350,7 @@ mod tests {
         let ends = [0, nodes - 1];
         let lower = [0.0, 0.0];
         let (mut z, mut reactions) = (vec![0.0; nodes], [0.0; 2]);
-        let mut solver = ExactSolver::new(&c, &ends).unwrap();
+        let mut solver = EndEnumeration::new(&c, &ends).unwrap();
         solver.solve(&b, &lower, &mut z, &mut reactions).unwrap();
         assert!(reactions.iter().all(|r| *r > 0.0), "both ends stop the bar");
         let mut audit = KktAudit::new(&c, &ends, false).unwrap();
@@ -360,7 +360,7 @@ mod tests {
         };
         audit.check(law, &b, &lower, &z, &reactions).unwrap();
 
-        let mut pivot = crate::step::block_pivot::BlockPivotSolver::new(&c, &ends).unwrap();
+        let mut pivot = crate::step::block_pivot::BlockPivoting::new(&c, &ends).unwrap();
         let (mut z_pivot, mut r_pivot) = (vec![0.0; nodes], [0.0; 2]);
         pivot.solve(&b, &lower, &mut z_pivot, &mut r_pivot).unwrap();
         let tol = DIRECT_SOLVES_AGREE_ULPS * f64::EPSILON * max_abs(&z_pivot);
@@ -395,7 +395,7 @@ mod tests {
             let nodes = c.dim();
             let ends = [0, nodes - 1];
             let fresh = |lower: &[f64; 2]| {
-                let mut s = ExactSolver::new(c, &ends).unwrap();
+                let mut s = EndEnumeration::new(c, &ends).unwrap();
                 let (mut z, mut r) = (vec![0.0; nodes], [0.0; 2]);
                 let info = s.solve(b, lower, &mut z, &mut r).unwrap();
                 (z, r, info.iterations)
@@ -404,7 +404,7 @@ mod tests {
             let (z_enum, r_enum, _) = fresh(&both);
             assert!(r_enum.iter().all(|r| *r > 0.0), "both ends in contact");
 
-            let mut solver = ExactSolver::new(c, &ends).unwrap();
+            let mut solver = EndEnumeration::new(c, &ends).unwrap();
             let (mut z, mut r) = (vec![0.0; nodes], [0.0; 2]);
             for call in 0..2 {
                 let info = solver.solve(b, &both, &mut z, &mut r).unwrap();

@@ -11,7 +11,7 @@
 //! [docs/friction.md](../docs/friction.md).
 
 use crate::linalg::system::SpdSystem;
-use crate::step::condensed::condensed_matrix;
+use crate::step::condensed_lcp::condensed_matrix;
 use crate::step::friction_audit::{FrictionAudit, FrictionLaw, Thresholds};
 use crate::step::lcp::{DenseLcp, LcpError};
 use crate::step::lemke::Lemke;
@@ -61,7 +61,7 @@ pub fn stewart_trinkle_matrix(s: &[f64], m: usize, friction: &Friction, sigma: f
 }
 
 /// The exact frictional solver (see the module doc).
-pub struct FrictionalSolver<S: SpdSystem> {
+pub struct CondensedLemke<S: SpdSystem> {
     system: S,
     constraints: Constraints,
     friction: Friction,
@@ -80,7 +80,7 @@ pub struct FrictionalSolver<S: SpdSystem> {
     audit: FrictionAudit,
 }
 
-impl<S: SpdSystem> FrictionalSolver<S> {
+impl<S: SpdSystem> CondensedLemke<S> {
     /// Forms `S` on the normals and tangents (one block solve per column), checks it positive
     /// definite (the unknowns of `E` distinct) and sets up both LCPs.
     pub fn new(
@@ -172,7 +172,7 @@ impl<S: SpdSystem> FrictionalSolver<S> {
     }
 }
 
-impl<S: SpdSystem> StepSolver for FrictionalSolver<S> {
+impl<S: SpdSystem> StepSolver for CondensedLemke<S> {
     fn name(&self) -> &'static str {
         "exact"
     }
@@ -243,7 +243,7 @@ mod tests {
     use super::*;
     use crate::linalg::system::TridiagSystem;
     use crate::linalg::tridiag::SymTridiag;
-    use crate::step::CondensedSolver;
+    use crate::step::CondensedLcp;
     use proptest::prelude::*;
 
     /// Frictional and frictionless answers of well-conditioned 12-unknown problems (κ(C) below
@@ -279,8 +279,8 @@ mod tests {
             mu in 0.05f64..1.5,
         ) {
             let (system, constraints, friction) = problem(0.0);
-            let mut plain = CondensedSolver::new(system.clone(), constraints.clone(), 0.0).unwrap();
-            let mut zero = FrictionalSolver::new(system, constraints.clone(), friction).unwrap();
+            let mut plain = CondensedLcp::new(system.clone(), constraints.clone(), 0.0).unwrap();
+            let mut zero = CondensedLemke::new(system, constraints.clone(), friction).unwrap();
             zero.set_previous_increment(&w);
             let (mut z0, mut r0) = (vec![0.0; 12], vec![0.0; 3]);
             let (mut z1, mut r1) = (vec![0.0; 12], vec![0.0; 6]);
@@ -295,7 +295,7 @@ mod tests {
             }
             // With friction: the law, recomputed here from (z, r) (the solver's audit passed).
             let (system, constraints, friction) = problem(mu);
-            let mut f = FrictionalSolver::new(system, constraints.clone(), friction.clone()).unwrap();
+            let mut f = CondensedLemke::new(system, constraints.clone(), friction.clone()).unwrap();
             f.set_previous_increment(&w);
             f.solve(&b, &lo, &mut z1, &mut r1).unwrap();
             for k in 0..3 {

@@ -12,7 +12,7 @@
 //!
 //! Each step solves the LCP in the reactions by enumerating the at most four supports, then
 //! computes the answer by a direct solve on the chosen one; why this is exact and backward
-//! stable: [docs/step-solvers.md](../docs/step-solvers.md#penalty-solver).
+//! stable: [docs/step-solvers.md](../docs/step-solvers.md#end-penalty).
 
 use crate::linalg::ldlt::RowChange;
 use crate::linalg::tridiag::SymTridiag;
@@ -58,7 +58,7 @@ impl PenaltySettings {
 
 /// Normal compliance with parameter `ε`, solved exactly per step, audited every step.
 #[derive(Clone, Debug)]
-pub struct PenaltySolver {
+pub struct EndPenalty {
     epsilon: f64,
     factor: StepFactor,
     /// The constrained nodes (at most two).
@@ -71,7 +71,7 @@ pub struct PenaltySolver {
     rows: [[f64; 3]; 2],
     /// Per constrained node: whether its reaction is taken from the gap, `(lo_j − z_j)/ε`
     /// (when `C_jj >= 1/ε`), else from stationarity, `(C z − b)_j` (see
-    /// [`PenaltySolver::solve_on_support`]).
+    /// [`EndPenalty::solve_on_support`]).
     from_gap: [bool; 2],
     /// The factorisation of `C + Σ_{j∈A} e_j e_jᵀ/ε` for support `A = mask`, at `mask − 1`.
     springs: Vec<StepFactor>,
@@ -80,7 +80,7 @@ pub struct PenaltySolver {
     audit: KktAudit,
 }
 
-impl PenaltySolver {
+impl EndPenalty {
     /// Factorises `C` and `C` with a spring at each subset of the constrained nodes (at most
     /// two; `TwistedLdlt`), and computes `S + εI`.
     pub fn new(
@@ -190,7 +190,7 @@ impl PenaltySolver {
     }
 }
 
-impl StepSolver for PenaltySolver {
+impl StepSolver for EndPenalty {
     fn name(&self) -> &'static str {
         "penalty"
     }
@@ -253,12 +253,12 @@ mod tests {
     /// everywhere, the stiff matrix's `Δt = 1e-3 Δx` rows (VERIFICATION.md) fail the law.
     #[test]
     fn stiff_impact_on_penalty_springs_passes_the_audit() {
-        let (c, b) = crate::step::exact::rigid_flight();
+        let (c, b) = crate::step::end_enumeration::rigid_flight();
         let n = c.dim();
         let ends = [0, n - 1];
         let springs = [(1e4, true), (10.0, true), (0.1, false), (1e-4, false)];
         for (epsilon, from_gap) in springs.map(|(ratio, g)| (ratio / c.diag[0], g)) {
-            let mut solver = PenaltySolver::new(&c, &ends, PenaltySettings { epsilon }).unwrap();
+            let mut solver = EndPenalty::new(&c, &ends, PenaltySettings { epsilon }).unwrap();
             assert_eq!(solver.from_gap, [from_gap; 2]);
             let (mut z, mut r) = (vec![0.0; n], [0.0; 2]);
             let first = solver.solve(&b, &[0.0, 0.0], &mut z, &mut r).unwrap();
@@ -272,7 +272,7 @@ mod tests {
         }
     }
 
-    /// Pins the reaction-form choice of [`PenaltySolver::solve_on_support`]: the rigid flight
+    /// Pins the reaction-form choice of [`EndPenalty::solve_on_support`]: the rigid flight
     /// of `exact::rigid_flight` (`Δt v = −500` per step) stopped by springs under both ends at
     /// `lo = −400`. With a soft spring (`1/ε = 1e-6 C_jj`) the reaction must come from the gap:
     /// from stationarity the law is off by `ε δ`, about 1e4 times its floor. With a stiff one
@@ -281,7 +281,7 @@ mod tests {
     /// audit (run inside `solve`) on the check named; the chosen form passes.
     #[test]
     fn each_spring_regime_needs_its_reaction_form() {
-        let (c, b) = crate::step::exact::rigid_flight();
+        let (c, b) = crate::step::end_enumeration::rigid_flight();
         let n = c.dim();
         let ends = [0, n - 1];
         let lower = [-400.0; 2];
@@ -289,8 +289,7 @@ mod tests {
         for (ratio, from_gap, swapped_fails) in cases {
             let epsilon = ratio / c.diag[0];
             for swap in [false, true] {
-                let mut solver =
-                    PenaltySolver::new(&c, &ends, PenaltySettings { epsilon }).unwrap();
+                let mut solver = EndPenalty::new(&c, &ends, PenaltySettings { epsilon }).unwrap();
                 assert_eq!(solver.from_gap, [from_gap; 2], "ε = {epsilon:e}");
                 if swap {
                     solver.from_gap = [!from_gap; 2];
