@@ -14,7 +14,7 @@
 //! add one it does not make (stationarity mapped to displacement):
 //! [docs/step-solvers.md](../docs/step-solvers.md#kkt-audit).
 
-use crate::linalg::ldlt::NotPositiveDefinite;
+use crate::linalg::kernels::ldlt::NotPositiveDefinite;
 use crate::linalg::norms::max_abs;
 use crate::linalg::system::{SpdSystem, TridiagSystem, inverse_norm_estimate};
 use crate::linalg::tridiag::SymTridiag;

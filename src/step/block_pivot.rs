@@ -14,8 +14,8 @@
 //! reaches and what the code does for speed:
 //! [docs/step-solvers.md](../docs/step-solvers.md#block-principal-pivoting).
 
-use crate::linalg::ldlt::NotPositiveDefinite;
-use crate::linalg::ldlt_fast::TwistedLdlt;
+use crate::linalg::kernels::ldlt::NotPositiveDefinite;
+use crate::linalg::kernels::ldlt_fast::TwistedLdlt;
 use crate::linalg::norms::max_abs;
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::pivot_sweeps::{

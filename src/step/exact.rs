@@ -14,7 +14,7 @@
 //! The step matrix enters through [`EndSystem`]: the bar's tridiagonal `C` ([`BarEnds`]), or
 //! any body's matrix whose constrained unknowns are at most two.
 
-use crate::linalg::ldlt::{NotPositiveDefinite, RowChange};
+use crate::linalg::kernels::ldlt::{NotPositiveDefinite, RowChange};
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::schur::{
     StepFactor, constraint_rows, factor_each_subset, least_violating, masked_solve, row_product,

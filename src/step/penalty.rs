@@ -14,7 +14,7 @@
 //! computes the answer by a direct solve on the chosen one; why this is exact and backward
 //! stable: [docs/step-solvers.md](../docs/step-solvers.md#penalty-solver).
 
-use crate::linalg::ldlt::RowChange;
+use crate::linalg::kernels::ldlt::RowChange;
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::audit::{KktAudit, Law, reaction_from_gap};
 use crate::step::schur::{

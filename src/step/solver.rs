@@ -12,7 +12,7 @@
 //! implementation must meet, are `C z = b + Σ_k r_k s_k e_{i_k}`, `s_k z_{i_k} >= lo_k`,
 //! `r_k >= 0`, `r_k (s_k z_{i_k} − lo_k) = 0`; the multipliers `r_k` are the contact reactions.
 
-use crate::linalg::dispatch;
+use crate::linalg::kernels::dispatch;
 use crate::step::report::{SolveInfo, SolverReport, StepFailure};
 
 /// The constrained unknowns of a step problem and the direction of each bound: constraint `k`

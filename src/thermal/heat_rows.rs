@@ -3,7 +3,7 @@
 //! the uniform mesh's coefficients, compiled for AVX where the CPU has it
 //! ([`dispatch::run`]: the same operations in the same order, the same bits).
 
-use crate::linalg::dispatch;
+use crate::linalg::kernels::dispatch;
 
 /// The interior heat rows `−sκ (K_θ θ)_j − γ/2 (Gᵀ w)_j` (with `s Q_j` between them when
 /// there is a source) and the coupling's `+= γ (G φ)_i`, for [`dispatch::run`]:
@@ -97,7 +97,7 @@ impl dispatch::Kernel for HeatRows<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::linalg::dispatch::Kernel;
+    use crate::linalg::kernels::dispatch::Kernel;
 
     /// The heat rows run through `dispatch::run` (AVX where the CPU has it) have the bits of
     /// the loop as built, in each case (with or without a source, with or without coupling).
