@@ -12,7 +12,7 @@
 //!
 //! Each step solves the LCP in the reactions by enumerating the at most four supports, then
 //! computes the answer by a direct solve on the chosen one; why this is exact and backward
-//! stable: [docs/step-solvers.md](../docs/step-solvers.md#penalty-solver).
+//! stable: `docs/step-solvers.md#penalty-solver`.
 
 use crate::linalg::kernels::ldlt::RowChange;
 use crate::linalg::tridiag::SymTridiag;
