@@ -96,7 +96,7 @@ pub fn repeated(c: &viscobar::linalg::tridiag::SymTridiag) {
     let (mut z, mut r) = (vec![0.0; n], vec![0.0; n]);
     s.solve(&b, &lo, &mut z, &mut r).unwrap();
     let reps: usize = std::env::var("REPS").map_or(50, |v| v.parse().unwrap());
-    let f = viscobar::linalg::ldlt::Ldlt::factor(c).unwrap();
+    let f = viscobar::linalg::kernels::ldlt::Ldlt::factor(c).unwrap();
     let (mut per, mut plain) = (f64::INFINITY, f64::INFINITY);
     for _ in 0..7 {
         let t = Instant::now();

@@ -6,13 +6,13 @@
 //! plane-strain body (Q1), Signorini conditions at the bar's ends, under it, or on the body's
 //! edges; the implicit three-level scheme (VI)_h, each step a constrained quadratic programme.
 //!
-//! Layers, imports pointing down this list only (`tests/layers.rs`): [`linalg`] (tridiagonal
-//! and sparse matrices, their factorisations) → [`step`] (the step problem's solvers and their
-//! audit) → [`scene`] (input) → [`scheme`] (the talk's scheme, for any body) → [`bar`] (P1, its
-//! kernels, closed forms) → [`plane`] (Q1, sparse Cholesky) → [`output`] (runs and their files,
-//! both bodies) → [`study`] (refinement, comparison, mass variants, figures). The certificate
-//! (VERIFICATION.md's tables, the tolerance registry) is the member crate `viscobar-certificate`.
-//! Use as a library: [`run_in_memory`] runs a scene built in code (its doc, a tested example).
+//! Layers, imports pointing down this list only (`tests/layers.rs`): [`linalg`] (matrices,
+//! factorisations, per-step kernels and their twins) → [`step`] (the step's solvers, their
+//! audit) → [`scene`] (input) → [`scheme`] (the talk's scheme, for any body) → [`bar`] (P1,
+//! closed forms) → [`thermal`] (the bar with a temperature) → [`plane`] (Q1, sparse Cholesky)
+//! → [`output`] (runs and their files) → [`study`] (refinement, comparison, figures). The
+//! certificate is the member crate `viscobar-certificate`. Use as a library: [`run_in_memory`]
+//! runs a scene built in code (its doc, a tested example).
 
 pub mod bar;
 #[doc(hidden)]

@@ -3,7 +3,7 @@
 //! bad input without writing anything.
 
 mod common;
-use common::viscobar;
+use common::{png_size, viscobar};
 
 use std::path::{Path, PathBuf};
 use viscobar::Simulation;
@@ -161,14 +161,6 @@ fn exact_sampling_exists_only_when_the_grid_is_made_of_mesh_points() {
         None,
         "one point has no spacing"
     );
-}
-
-/// The width and height in a PNG's IHDR chunk.
-fn png_size(bytes: &[u8]) -> (u32, u32) {
-    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
-    assert_eq!(&bytes[12..16], b"IHDR");
-    let be = |b: &[u8]| u32::from_be_bytes(b.try_into().unwrap());
-    (be(&bytes[16..20]), be(&bytes[20..24]))
 }
 
 fn expected_files() -> Vec<(String, (u32, u32))> {

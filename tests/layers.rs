@@ -35,16 +35,29 @@ fn sources(root: &Path) -> Vec<Source> {
             .collect();
         files.sort();
         for file in files {
-            assert!(
-                file.extension().is_some_and(|e| e == "rs"),
-                "{} is not a Rust file: layers hold one level of modules",
-                file.display()
-            );
-            out.push(Source {
-                layer: name.clone(),
-                module: file.file_stem().unwrap().to_string_lossy().to_string(),
-                text: std::fs::read_to_string(&file).unwrap(),
-            });
+            // A folder inside a layer is one module of it (`kernels/`), its files its parts.
+            let (module, parts) = if file.is_dir() {
+                let mut parts: Vec<_> = std::fs::read_dir(&file)
+                    .unwrap()
+                    .map(|e| e.unwrap().path())
+                    .collect();
+                parts.sort();
+                (file.file_name().unwrap(), parts)
+            } else {
+                (file.file_stem().unwrap(), vec![file.clone()])
+            };
+            for part in parts {
+                assert!(
+                    part.extension().is_some_and(|e| e == "rs"),
+                    "{} is not a Rust file: layers hold modules and folders of modules",
+                    part.display()
+                );
+                out.push(Source {
+                    layer: name.clone(),
+                    module: module.to_string_lossy().to_string(),
+                    text: std::fs::read_to_string(&part).unwrap(),
+                });
+            }
         }
     }
     out

@@ -163,28 +163,8 @@ fn a_load_that_is_not_finite_is_named_with_its_node() {
 
 /// Counts the allocations of this thread (tests/no_alloc.rs runs the built-in scenes, whose
 /// loads all separate; this one watches the node-array path).
-struct Counting;
-
-thread_local! {
-    static ALLOCATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
-}
-
-unsafe impl std::alloc::GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        unsafe { std::alloc::System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
-        unsafe { std::alloc::System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, new_size: usize) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
-        unsafe { std::alloc::System.realloc(ptr, layout, new_size) }
-    }
-}
-
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: common::alloc::Counting = common::alloc::Counting;
 
 #[test]
 fn steps_with_a_load_that_does_not_separate_do_not_allocate() {
@@ -199,11 +179,11 @@ fn steps_with_a_load_that_does_not_separate_do_not_allocate() {
         );
         let mut sim = Simulation::new(&scene).unwrap();
         sim.step().unwrap(); // warm-up outside the count
-        let before = ALLOCATIONS.with(std::cell::Cell::get);
+        let before = common::alloc::allocations();
         for _ in 0..20 {
             sim.step().unwrap();
         }
-        let count = ALLOCATIONS.with(std::cell::Cell::get) - before;
+        let count = common::alloc::allocations() - before;
         assert_eq!(count, 0, "{text}: {count} allocations in 20 steps");
     }
 }

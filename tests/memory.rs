@@ -5,54 +5,24 @@
 //! (Peak resident memory of the full J = 1e6, 1e4-step run is measured by
 //! `cargo run --release -p viscobar-certificate -- peak-memory`, see benches/README.md.)
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+mod common;
 
-struct Counting;
-
-thread_local! {
-    static LIVE: Cell<usize> = const { Cell::new(0) };
-    static PEAK: Cell<usize> = const { Cell::new(0) };
-}
-
-fn track(delta: isize) {
-    // `try_with`: the thread-locals may already be gone while a thread shuts down.
-    let _ = LIVE.try_with(|live| {
-        let now = live.get().saturating_add_signed(delta);
-        live.set(now);
-        let _ = PEAK.try_with(|p| p.set(p.get().max(now)));
-    });
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        track(layout.size() as isize);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        track(-(layout.size() as isize));
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        track(new_size as isize - layout.size() as isize);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+use common::alloc::{live_bytes, peak_bytes, reset_peak};
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: common::alloc::Counting = common::alloc::Counting;
 
 /// Peak heap above the starting level while `steps` steps of `scene` run with the tracker.
 fn peak_heap(scene: &viscobar::Scene, steps: usize) -> usize {
-    let base = LIVE.with(Cell::get);
-    PEAK.with(|p| p.set(base));
+    let base = live_bytes();
+    reset_peak();
     let mut sim = viscobar::Simulation::new(scene).unwrap();
     let mut tracker = viscobar::output::Tracker::new(&sim, scene.load.density.is_none());
     for _ in 0..steps {
         tracker.observe(&sim.step().unwrap());
     }
     drop((sim, tracker));
-    PEAK.with(Cell::get) - base
+    peak_bytes() - base
 }
 
 /// Peak heap per node of each scene, in doubles: what the run holds plus one (the test prints

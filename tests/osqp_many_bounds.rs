@@ -9,7 +9,7 @@
 mod common;
 
 use proptest::prelude::*;
-use viscobar::linalg::ldlt::Ldlt;
+use viscobar::linalg::kernels::ldlt::Ldlt;
 use viscobar::linalg::norms::{max_abs, max_distance};
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;

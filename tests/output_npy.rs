@@ -11,9 +11,7 @@ use viscobar::internals::output::text::output_time;
 use viscobar::output::run_to_dir;
 
 fn fresh_dir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("viscobar-npy-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    common::fresh_dir("npy", tag)
 }
 
 /// The rows of `dir/displacement.npy` through npyz's reader, after checking its header.

@@ -45,7 +45,7 @@ fn contact_conditions_and_energy_identity_hold_at_every_node_and_step_of_every_p
             continue;
         }
         // The friction scenes (a stiff block resting on its floor at gap 0) are held by their
-        // solver's audit, whose floors follow the stiffness (tests/friction.rs).
+        // solver's audit, whose floors follow the stiffness (tests/plane_coulomb_friction.rs).
         if scene.edges.frictions().unwrap().iter().any(|mu| *mu > 0.0) {
             continue;
         }

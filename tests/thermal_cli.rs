@@ -3,7 +3,7 @@
 //! key, nothing written; a figure that fails after the run exits 1.
 
 mod common;
-use common::{assert_each_refused, fresh_dir, viscobar};
+use common::{assert_each_refused, fresh_dir, png_size, viscobar};
 
 #[test]
 fn a_thermal_run_writes_the_thermal_columns() {
@@ -34,14 +34,6 @@ fn a_thermal_run_writes_the_thermal_columns() {
     assert_eq!(profile.lines().next(), Some("t,x,u,v,theta"));
     assert!(profile.lines().skip(1).all(|l| l.split(',').count() == 5));
     std::fs::remove_dir_all(&out).unwrap();
-}
-
-/// The width and height in a PNG's IHDR chunk.
-fn png_size(bytes: &[u8]) -> (u32, u32) {
-    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
-    assert_eq!(&bytes[12..16], b"IHDR");
-    let be = |b: &[u8]| u32::from_be_bytes(b.try_into().unwrap());
-    (be(&bytes[16..20]), be(&bytes[20..24]))
 }
 
 /// `run SCENE --figure` of a scene with `[heat]` draws the bar's figure with the θ panel: the

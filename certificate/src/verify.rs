@@ -231,7 +231,7 @@ pub fn solve_study(nodes: &[usize]) -> Vec<SolveCase> {
                 &r,
             );
             let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() + 0.1).collect();
-            let Ok(factor) = viscobar::linalg::ldlt_fast::TwistedLdlt::factor(&c) else {
+            let Ok(factor) = viscobar::linalg::kernels::ldlt_fast::TwistedLdlt::factor(&c) else {
                 continue;
             };
             let mut x = b.clone();

@@ -1,16 +1,16 @@
-//! The bar as a [`Body`] of the scheme: its P1 matrices as tridiagonal kernels (right-hand
-//! side [`crate::bar::rhs`], energy sums [`crate::bar::energy`]), its Signorini ends and
+//! The bar as a [`Body`] of the scheme: its P1 matrices as tridiagonal kernels (the
+//! right-hand side and the energy sums, [`crate::bar::kernels`]), its Signorini ends and
 //! obstacle as a [`ContactSet`], and its step solvers (end enumeration, block pivoting,
 //! penalty, OSQP). A run of a bar scene is a [`Simulation`], the scheme stepping this body.
 
 use crate::bar::discretisation::{Discretisation, InitialData};
-use crate::bar::energy::{energy_sums, potential_of_difference};
-use crate::bar::energy_fast::energy_sums_uniform;
+use crate::bar::kernels::energy::{energy_sums, potential_of_difference};
+use crate::bar::kernels::energy_fast::energy_sums_uniform;
+use crate::bar::kernels::rhs::rhs_into;
+use crate::bar::kernels::rhs_fast::rhs_into_uniform;
 use crate::bar::matrices;
-use crate::bar::rhs::rhs_into;
-use crate::bar::rhs_fast::rhs_into_uniform;
-use crate::linalg::ldlt::NotPositiveDefinite;
-use crate::linalg::ldlt_fast::TwistedLdlt;
+use crate::linalg::kernels::ldlt::NotPositiveDefinite;
+use crate::linalg::kernels::ldlt_fast::TwistedLdlt;
 use crate::linalg::tridiag::Uniform;
 use crate::scene::expr::Expression;
 use crate::scene::{Condition, Scene, SceneError};

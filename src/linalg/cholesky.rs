@@ -2,7 +2,7 @@
 //! matrices (faer 0.24, supernodal, AMD fill-reducing ordering), through faer's low-level
 //! API: the symbolic analysis once per pattern, the numeric factorisation once per matrix, and
 //! solves with a work space kept for the run, so that a solve allocates nothing (faer's
-//! high-level `Llt` allocates on every solve: [docs/sparse-cholesky.md](../docs/sparse-cholesky.md)).
+//! high-level `Llt` allocates on every solve: `docs/sparse-cholesky.md`).
 
 use crate::linalg::sparse::Pattern;
 use faer::dyn_stack::{MemBuffer, MemStack};

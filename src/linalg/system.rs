@@ -4,8 +4,8 @@
 //! tridiagonal [`TridiagSystem`], the plane body the sparse [`SparseSystem`].
 
 use crate::linalg::cholesky::{FactorError, SparseCholesky};
-use crate::linalg::ldlt::NotPositiveDefinite;
-use crate::linalg::ldlt_fast::TwistedLdlt;
+use crate::linalg::kernels::ldlt::NotPositiveDefinite;
+use crate::linalg::kernels::ldlt_fast::TwistedLdlt;
 use crate::linalg::sparse::Pattern;
 use crate::linalg::tridiag::SymTridiag;
 

@@ -1,6 +1,6 @@
 //! Symmetric tridiagonal matrices: the matrix type, its products and quadratic forms (in
 //! difference form, exact for rigid motions), and the interior coefficients of a uniform mesh.
-//! nalgebra has no banded solver; the factorisation is in [`super::ldlt`].
+//! nalgebra has no banded solver; the factorisation is in [`super::kernels::ldlt`].
 
 /// A symmetric tridiagonal matrix: `diag[i] = A[i][i]`, `off[i] = A[i][i+1] = A[i+1][i]`.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,11 +1,9 @@
 //! A manufactured solution of the plane Kelvin–Voigt body on `(0, W) × (0, H)`, clamped on
 //! all four edges, `u(x, y, t) = (cos ωt + β sin ωt) Φ(x, y)` with
 //! `Φ = (a₁ sin(πx/W) sin(πy/H), a₂ sin(2πx/W) sin(2πy/H))`, and its load
-//! `l = ρ u_tt − div σ`, `σ = A ε(u + α u_t)` (derivation: [docs/plane-manufactured.md]).
+//! `l = ρ u_tt − div σ`, `σ = A ε(u + α u_t)` (derivation: `docs/plane-manufactured.md`).
 //! `Φ` vanishes on the boundary, so the clamped conditions hold; the unit test checks `l`
 //! against finite differences of `u` and the scene's load text against `l`.
-//!
-//! [docs/plane-manufactured.md]: ../docs/plane-manufactured.md
 
 use crate::scene::plane::{
     Body, EdgeCondition, EdgeSpec, Edges, PlaneInitial, PlaneLoad, PlaneMesh, PlaneScene, Vector,

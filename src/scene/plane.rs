@@ -297,7 +297,7 @@ pub struct PlaneMesh {
 }
 
 /// Largest accepted number of unknowns: the factor of `C` takes about 1 GB at 1e6 (measured,
-/// [docs/sparse-cholesky.md](../docs/sparse-cholesky.md)), growing faster than linearly.
+/// `docs/sparse-cholesky.md`), growing faster than linearly.
 pub const MAX_PLANE_UNKNOWNS: u64 = 2_000_000;
 /// Memory per unknown of a plane run: the factor (about 110 values per unknown at 1e6, 8 bytes
 /// each, plus its symbolic part) and some 30 vectors; a margin over the measured 1 GB at 1e6.

@@ -2,7 +2,7 @@
 //! dissipation `D_f = −½ Σ_j r_T,j δ_j` of the energy identity (`δ_j = (u^{n+1} − u^{n−1})_{t_j}`,
 //! the central slip; `= ½ Σ_j μ_j r_N,j |δ_j| >= 0` by Coulomb's law), and the frictional nodes
 //! in contact that stick or slip ([`is_slipping`], one definition for every output).
-//! Derivation: [docs/friction.md](../docs/friction.md).
+//! Derivation: `docs/friction.md`.
 
 use crate::scheme::contact::{ContactSet, in_contact};
 

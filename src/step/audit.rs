@@ -12,9 +12,9 @@
 //!
 //! The checks, their scales and their round-off floors follow OSQP's own termination test and
 //! add one it does not make (stationarity mapped to displacement):
-//! [docs/step-solvers.md](../docs/step-solvers.md#kkt-audit).
+//! `docs/step-solvers.md#kkt-audit`.
 
-use crate::linalg::ldlt::NotPositiveDefinite;
+use crate::linalg::kernels::ldlt::NotPositiveDefinite;
 use crate::linalg::norms::max_abs;
 use crate::linalg::system::{SpdSystem, TridiagSystem, inverse_norm_estimate};
 use crate::linalg::tridiag::SymTridiag;

@@ -12,10 +12,10 @@
 //! whole-bar sweep's ([`BlockPivoting::with_full_solves`], compared in the tests). The
 //! margins are re-evaluated only where `z` changed. Termination, tie thresholds, how far a flip
 //! reaches and what the code does for speed:
-//! [docs/step-solvers.md](../docs/step-solvers.md#block-principal-pivoting).
+//! `docs/step-solvers.md#block-principal-pivoting`.
 
-use crate::linalg::ldlt::NotPositiveDefinite;
-use crate::linalg::ldlt_fast::TwistedLdlt;
+use crate::linalg::kernels::ldlt::NotPositiveDefinite;
+use crate::linalg::kernels::ldlt_fast::TwistedLdlt;
 use crate::linalg::norms::max_abs;
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::pivot_sweeps::{

@@ -8,7 +8,7 @@
 //! normals' SPD LCP, [`DenseLcp`]). On the cone's boundary `r_T` is set to `∓μ r_N` exactly;
 //! `z` then comes from `C z = b + Eᵀ r` by a second solve. Every answer is audited
 //! ([`crate::step::friction_audit`]). Derivation, termination, audit:
-//! [docs/friction.md](../docs/friction.md).
+//! `docs/friction.md`.
 
 use crate::linalg::system::SpdSystem;
 use crate::step::condensed_lcp::condensed_matrix;

@@ -10,11 +10,11 @@
 //! `z_A = lo_A`, `C_FF z_F = b_F − C_FA lo_A`, `r_A = (Cz − b)_A`: backward stable.
 //!
 //! Warm start: the previous step's active set is tried first by the same direct solve and kept
-//! when it meets the KKT conditions ([docs/step-solvers.md](../docs/step-solvers.md#end-enumeration)).
+//! when it meets the KKT conditions (`docs/step-solvers.md#end-enumeration`).
 //! The step matrix enters through [`EndSystem`]: the bar's tridiagonal `C` ([`BarEnds`]), or
 //! any body's matrix whose constrained unknowns are at most two.
 
-use crate::linalg::ldlt::{NotPositiveDefinite, RowChange};
+use crate::linalg::kernels::ldlt::{NotPositiveDefinite, RowChange};
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::schur::{
     StepFactor, constraint_rows, factor_each_subset, least_violating, masked_solve, row_product,

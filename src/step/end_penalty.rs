@@ -12,9 +12,9 @@
 //!
 //! Each step solves the LCP in the reactions by enumerating the at most four supports, then
 //! computes the answer by a direct solve on the chosen one; why this is exact and backward
-//! stable: [docs/step-solvers.md](../docs/step-solvers.md#end-penalty).
+//! stable: `docs/step-solvers.md#end-penalty`.
 
-use crate::linalg::ldlt::RowChange;
+use crate::linalg::kernels::ldlt::RowChange;
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::audit::{KktAudit, Law, reaction_from_gap};
 use crate::step::schur::{

@@ -6,7 +6,7 @@
 //! problem, 0 for the frictionless start-up), and the step equation's residual mapped to
 //! displacement by one solve. Each check's tolerance is the answer's own
 //! round-off floor plus the solver's stopping slack (0 for the exact solver);
-//! [docs/friction.md](../docs/friction.md#audit) derives the floors.
+//! `docs/friction.md#audit` derives the floors.
 
 use crate::linalg::norms::max_abs;
 use crate::linalg::system::{SpdSystem, inverse_norm_estimate};

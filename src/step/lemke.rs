@@ -7,7 +7,7 @@
 //! once against the basis' own columns. Warm start: each call first tries the previous call's
 //! complementary basis as it is, then Lemke from it with the covering vector `d = B·1`; should
 //! that end on a ray or pass its pivot limit, Lemke from the slack basis with `d = 1`, whose
-//! termination on a solution [docs/friction.md](../docs/friction.md#termination) proves for
+//! termination on a solution `docs/friction.md#termination` proves for
 //! the frictional LCP. Allocates nothing after set-up.
 
 /// A dense LCP that was not solved.

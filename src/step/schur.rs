@@ -3,8 +3,8 @@
 //! direct solves; the Schur complement `S_jk = (C⁻¹)_jk` on the constrained nodes, the 2 × 2
 //! masked solve of an active set and the ranking of candidate sets by KKT violation.
 
-use crate::linalg::ldlt::{Ldlt, NotPositiveDefinite, RowChange};
-use crate::linalg::ldlt_fast::TwistedLdlt;
+use crate::linalg::kernels::ldlt::{Ldlt, NotPositiveDefinite, RowChange};
+use crate::linalg::kernels::ldlt_fast::TwistedLdlt;
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::solver::add_in_place;
 

@@ -12,7 +12,6 @@
 //! implementation must meet, are `C z = b + Σ_k r_k s_k e_{i_k}`, `s_k z_{i_k} >= lo_k`,
 //! `r_k >= 0`, `r_k (s_k z_{i_k} − lo_k) = 0`; the multipliers `r_k` are the contact reactions.
 
-use crate::linalg::dispatch;
 use crate::step::report::{SolveInfo, SolverReport, StepFailure};
 
 /// The constrained unknowns of a step problem and the direction of each bound: constraint `k`
@@ -135,59 +134,9 @@ pub trait StepSolver {
     }
 }
 
-/// `u += z`, compiled for AVX when the CPU has it ([`dispatch`]; the same additions).
+/// `u += z`, the scheme's update.
 pub(crate) fn add_in_place(u: &mut [f64], z: &[f64]) {
-    dispatch::run(AddInPlace { u, z })
-}
-
-/// The loop of [`add_in_place`], for [`dispatch::run`].
-struct AddInPlace<'a> {
-    u: &'a mut [f64],
-    z: &'a [f64],
-}
-
-impl dispatch::Kernel for AddInPlace<'_> {
-    type Output = ();
-    #[inline(always)]
-    fn call(self) {
-        for (ui, zi) in self.u.iter_mut().zip(self.z) {
-            *ui += zi;
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The dispatched `u += z` against the plain loop, bit for bit (lengths around the
-    /// vector widths, values of every magnitude and sign, zeros, infinities and NaN).
-    #[test]
-    fn add_in_place_has_the_bits_of_the_plain_loop() {
-        let special = [
-            0.0,
-            -0.0,
-            1e-310,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NAN,
-        ];
-        for n in 0..40 {
-            let value = |i: usize, a: f64| (a * i as f64).sin() * 10f64.powi((i % 9) as i32 - 4);
-            let mut u: Vec<f64> = (0..n).map(|i| value(i, 0.7)).collect();
-            let z: Vec<f64> = (0..n)
-                .map(|i| {
-                    if i % 7 == 3 {
-                        special[i % 6]
-                    } else {
-                        value(i, 1.3)
-                    }
-                })
-                .collect();
-            let plain: Vec<f64> = u.iter().zip(&z).map(|(a, b)| a + b).collect();
-            add_in_place(&mut u, &z);
-            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            assert_eq!(bits(&u), bits(&plain), "n = {n}");
-        }
+    for (ui, zi) in u.iter_mut().zip(z) {
+        *ui += zi;
     }
 }

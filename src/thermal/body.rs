@@ -7,7 +7,7 @@
 //! terms of the energy identity. Derivation: `docs/thermal.md`.
 
 use crate::bar::BarBody;
-use crate::linalg::ldlt::Ldlt;
+use crate::linalg::kernels::ldlt::Ldlt;
 use crate::scene::SceneError;
 use crate::scene::heat::{EndHeat, HeatExpressions};
 use crate::scheme::RunError;
@@ -435,7 +435,7 @@ impl ThermalBody {
         };
         let n = b.len();
         let bu = coupling.map(|bu| &mut bu[interior.start - m.u_first..interior.end - m.u_first]);
-        crate::linalg::dispatch::run(heat_rows::HeatRows {
+        heat_rows::HeatRows {
             row: heat_rows::HeatRow {
                 a: -s * kappa,
                 kd,
@@ -450,7 +450,8 @@ impl ThermalBody {
             q,
             b,
             bu,
-        });
+        }
+        .run();
     }
 }
 

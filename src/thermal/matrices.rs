@@ -5,7 +5,7 @@
 //! block-tridiagonal with blocks of order 2. Derivation: `docs/thermal.md`.
 
 use crate::bar::matrices::{MatrixVariant, mass, stiffness};
-use crate::linalg::block_tridiag::BlockTridiag;
+use crate::linalg::kernels::block_tridiag::BlockTridiag;
 use crate::linalg::tridiag::SymTridiag;
 
 /// `G_ij = ∫ ψ_j φ_i'` on a uniform mesh of `nodes` nodes: `−½` for `j = i + 1`, `½` for
@@ -190,8 +190,8 @@ mod tests {
     /// the banded `LDLᵀ` of the same matrix, with and without identity rows at the ends.
     #[test]
     fn the_coupled_matrix_has_the_inertia_of_its_blocks() {
-        use crate::linalg::banded::BandedLdlt;
-        use crate::linalg::block_tridiag::BlockLdlt;
+        use crate::linalg::kernels::banded::BandedLdlt;
+        use crate::linalg::kernels::block_tridiag::BlockLdlt;
         let nodes = 11;
         let dx = 0.1;
         let dt = 0.05;

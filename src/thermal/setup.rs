@@ -85,7 +85,7 @@ impl Scheme<ThermalBody> {
         let masks = 1usize << exchange.len();
         let solver: Box<dyn StepSolver> = if m.gamma == 0.0 {
             let heat = (0..masks)
-                .map(|mask| crate::linalg::ldlt::Ldlt::factor(&m.heat_matrix(0.5 * disc.dt, mask)))
+                .map(|mask| crate::linalg::Ldlt::factor(&m.heat_matrix(0.5 * disc.dt, mask)))
                 .collect::<Result<Vec<_>, _>>()?;
             Box::new(DecoupledSolver::new(bar.solver, heat, m.n_u, exchange))
         } else {

@@ -7,7 +7,7 @@
 //! tridiagonal solve; with coupling, the exact end solver per exchange state on the coupled
 //! matrix ([`CoupledSolver`], [`crate::thermal::system::CoupledEnds`]).
 
-use crate::linalg::ldlt::Ldlt;
+use crate::linalg::kernels::ldlt::Ldlt;
 use crate::scheme::in_contact;
 use crate::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
 

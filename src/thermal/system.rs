@@ -1,15 +1,15 @@
 //! The thermal bar's coupled step matrix `A_χ = [[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]]` as the exact
 //! end solver sees it ([`EndSystem`]): vectors in the body's block layout `[u | θ]`, the matrix
 //! node by node (blocks `(u_i, θ_i)`, [`ThermalMatrices::coupled`]) with its block `LDLᵀ`
-//! (by default its twisted twin, [`crate::linalg::block_tridiag_fast`]), and
+//! (by default its twisted twin, [`crate::linalg::kernels::block_tridiag_fast`]), and
 //! one more factor per non-empty set of active ends (their displacement rows and columns
 //! replaced by identity ones), all formed once per exchange state. `A_χ` is quasi-definite,
 //! not positive definite; what the enumeration needs holds all the same: `E A_χ⁻¹ Eᵀ` on
 //! displacement unknowns is the inverse's block `(C + γ²/4 G H_χ⁻¹ Gᵀ)⁻¹`, positive definite,
 //! so the contact step stays an exact convex LCP (`docs/thermal.md`).
 
-use crate::linalg::block_tridiag::{BlockLdlt, BlockTridiag, SingularBlock};
-use crate::linalg::block_tridiag_fast::TwistedBlockLdlt;
+use crate::linalg::kernels::block_tridiag::{BlockLdlt, BlockTridiag, SingularBlock};
+use crate::linalg::kernels::block_tridiag_fast::TwistedBlockLdlt;
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::end_enumeration::EndSystem;
 use crate::step::schur::{constraint_rows, row_product};
@@ -55,7 +55,7 @@ pub struct CoupledEnds {
 impl CoupledEnds {
     /// `A_χ` of exchange state `mask` (`c`: the bar's `C`), constrained at the displacement
     /// unknowns `unknowns` (at most two); solved by the twisted twin of the block factor
-    /// when `twisted` ([`crate::linalg::block_tridiag_fast`]).
+    /// when `twisted` ([`crate::linalg::kernels::block_tridiag_fast`]).
     pub fn new(
         m: &ThermalMatrices,
         c: &SymTridiag,

@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod alloc;
+
 use proptest::prelude::*;
 use viscobar::Scene;
 use viscobar::linalg::tridiag::SymTridiag;
@@ -68,6 +70,14 @@ pub fn fresh_dir(group: &str, name: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("viscobar-{group}-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     d
+}
+
+/// The width and height in a PNG's IHDR chunk.
+pub fn png_size(bytes: &[u8]) -> (u32, u32) {
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "PNG signature");
+    assert_eq!(&bytes[12..16], b"IHDR");
+    let be = |b: &[u8]| u32::from_be_bytes(b.try_into().unwrap());
+    (be(&bytes[16..20]), be(&bytes[20..24]))
 }
 
 /// `viscobar run SCENE --out OUT --set …` for each case `(what, settings, text)`: exit code 2,

@@ -4,7 +4,7 @@
 //! against the talk's form of the step.
 
 use viscobar::bar::{Discretisation, Simulation};
-use viscobar::linalg::ldlt_fast::TwistedLdlt;
+use viscobar::linalg::kernels::ldlt_fast::TwistedLdlt;
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::scene::Scene;
 use viscobar::scheme::RunError;

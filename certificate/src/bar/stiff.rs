@@ -604,13 +604,13 @@ pub fn low_ratio_notes(results: &[CaseResult]) -> String {
 /// result.
 pub const UNIT_ROUNDOFF: f64 = 0.5 * f64::EPSILON;
 /// Rounding depth of one entry of the computed solve residual `ρ̂ = C z − b̂ − r` and of the
-/// right-hand side `b̂` (`src/bar/rhs.rs`): a difference-form row is two differences, three
-/// products and two sums (5 roundings in sequence), then two subtractions; `b̂`'s rows are the
-/// same depth (the `R y` and `M w` rows, the scaling by `1/Δt²`, two sums, the load).
+/// right-hand side `b̂` (`src/bar/kernels/rhs.rs`): a difference-form row is two differences,
+/// three products and two sums (5 roundings in sequence), then two subtractions; `b̂`'s rows
+/// are the same depth (the `R y` and `M w` rows, the scaling by `1/Δt²`, two sums, the load).
 /// `γ_8 = 8u/(1 − 8u)`, 8.0000001u here; the margin to 9 covers the `O(u²)`.
 pub const RESIDUAL_ROUNDINGS: f64 = 9.0;
-/// Rounding depth of one term of the energy sums (`src/bar/energy.rs`): a difference, two
-/// products and the accumulation into its lane, plus the combination of the sums into the
+/// Rounding depth of one term of the energy sums (`src/bar/kernels/energy.rs`): a difference,
+/// two products and the accumulation into its lane, plus the combination of the sums into the
 /// energy (scaling, two sums) and of the energies into the residual (four sums).
 pub const SUM_TERM_ROUNDINGS: f64 = 10.0;
 /// Roundings in forming the residual from the sums: three in each energy
@@ -737,8 +737,9 @@ impl StepTerms {
     /// what the solver tests on the `z` it returns.
     ///
     /// *The gap's rounding.* The simulation forms `lo_j = fl(−a_j − û^n_j)`, stores
-    /// `û^{n+1}_j = fl(û^n_j + z_j)` and measures `fl(û^{n+1}_j + a_j)` (`fill_lower`,
-    /// `fill_contact`). If `z_j >= lo_j`, then `û^n_j + z_j + a_j >= (−a_j − û^n_j) δ_1` and
+    /// `û^{n+1}_j = fl(û^n_j + z_j)` and measures `fl(û^{n+1}_j + a_j)`
+    /// (`ContactSet::lower_bounds_into`, `ContactSet::measure`). If `z_j >= lo_j`, then
+    /// `û^n_j + z_j + a_j >= (−a_j − û^n_j) δ_1` and
     /// `û^{n+1}_j + a_j >= −u (|lo_j| + |û^{n+1}_j|)/(1 − u)`; the last rounding keeps the sign
     /// and adds a factor `1 + u`, so the computed gap is at least
     /// `−γ_2 (|lo_j| + |û^{n+1}_j|)` (Higham, Lemma 3.1). No forward error of the solve enters

@@ -17,7 +17,7 @@ use std::cell::RefCell;
 use std::rc::Rc;
 use viscobar::bar::body::make_solver;
 use viscobar::bar::{Discretisation, Simulation};
-use viscobar::linalg::ldlt::Ldlt;
+use viscobar::linalg::kernels::ldlt::Ldlt;
 use viscobar::linalg::norms::{max_abs, max_distance};
 use viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS;
 use viscobar::linalg::tridiag::SymTridiag;
@@ -346,7 +346,7 @@ fn step_terms(
     let mut node = Worst::default();
     let (mut node_gap, mut node_allowance) = (0.0, 0.0);
     for (j, (&l, c)) in locals.iter().zip(&d.constraints).enumerate() {
-        // The gap as the simulation forms it (`fill_contact`): `û^{n+1}_j + a_j`.
+        // The gap as the simulation forms it (`ContactSet::measure`): `û^{n+1}_j + a_j`.
         let violation = (-(u1[l] + c.gap)).max(0.0);
         let gap = sum_rounding(GAP_ROUNDINGS, t.lower[j].abs() + u1[l].abs());
         let allowance = match (&forward, t.reactions[j] > 0.0) {

@@ -3,7 +3,7 @@
 //! balance along the tangent and the audit at every step of the built-in friction scenes, the
 //! exact solver against OSQP's Tresca fixed point, the rigid-limit closed forms
 //! ([`crate::friction::rigid`]) and the frictional drop's convergence against a finer exact run.
-//! The tests (`tests/friction.rs`) assert on the same computations.
+//! The tests (`tests/plane_coulomb_friction.rs`) assert on the same computations.
 
 pub mod rigid;
 

@@ -12,7 +12,7 @@
 
 use osqp::Status;
 use std::fmt::Write;
-use viscobar::linalg::ldlt::Ldlt;
+use viscobar::linalg::kernels::ldlt::Ldlt;
 use viscobar::linalg::norms::{max_abs, max_distance};
 use viscobar::linalg::tridiag::SymTridiag;
 use viscobar::output::run_in_memory;

@@ -84,8 +84,8 @@ pub const SOLVE_ULPS: f64 = 4.0;
 /// worst `|x̂ − x|∞` of either over its own bound `SOLVE_ULPS ε ‖A‖∞ ‖x‖₂ / λ_min(A)` (λ_min by
 /// bisection), and the worst `|x̂ − x|∞`.
 pub fn ldlt_family_worst() -> (f64, f64) {
-    use viscobar::linalg::ldlt::Ldlt;
-    use viscobar::linalg::ldlt_fast::TwistedLdlt;
+    use viscobar::linalg::kernels::ldlt::Ldlt;
+    use viscobar::linalg::kernels::ldlt_fast::TwistedLdlt;
     use viscobar::linalg::spectrum::smallest_eigenvalue_spd;
     let (mut ratio, mut worst) = (0.0f64, 0.0f64);
     for n in 1..40usize {

@@ -101,7 +101,8 @@ pub fn plane_worst() -> Result<PlaneWorst, RunError> {
     for (name, scene) in identity_scenes() {
         let (records, summary, checks) = checked_run(&name, &scene).map_err(plane_run_error)?;
         let sim_has_contact = !scene.edges.gaps()?.iter().all(Option::is_none);
-        // The friction scenes' gaps are held by their audit (tests/friction.rs), as in the test.
+        // The friction scenes' gaps are held by their audit (tests/plane_coulomb_friction.rs),
+        // as in the test.
         let frictional = scene.edges.frictions()?.iter().any(|mu| *mu > 0.0);
         for r in records.iter().skip(1) {
             w.identity = w.identity.max(r.identity_residual);

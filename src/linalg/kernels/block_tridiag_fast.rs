@@ -8,10 +8,10 @@
 //! [`BlockLdlt`] to round-off, not bit for bit; what it buys on a thermal step is measured in
 //! benches/README.md, "Plain kernels and their twins".
 
-use crate::linalg::block_tridiag::{
+use crate::linalg::kernels::block_tridiag::{
     Block, BlockLdlt, BlockTridiag, SingularBlock, d_inv_mul, mul, mul_transposed,
 };
-use crate::linalg::dispatch;
+use crate::linalg::kernels::dispatch;
 use std::ops::Range;
 
 /// `A` factorised from both ends: `top` the block `LDLᵀ` of `A` (rows `0..m` used), `bottom`

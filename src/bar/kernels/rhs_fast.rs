@@ -3,8 +3,8 @@
 //! vectorises them, compiled for AVX when the CPU has it ([`dispatch`]). The same bits as
 //! the plain [`rhs_into`](super::rhs::rhs_into) (up to the sign of a zero).
 
-use crate::bar::rhs::row_of;
-use crate::linalg::dispatch;
+use crate::bar::kernels::rhs::row_of;
+use crate::linalg::kernels::dispatch;
 use crate::linalg::tridiag::{SymTridiag, Uniform};
 
 /// [`rhs_into`](super::rhs::rhs_into) on a uniform mesh, `(mi, ri)` the interior coefficients
@@ -114,8 +114,8 @@ impl<const LOAD: bool, const S_R: bool> dispatch::Kernel for RhsInterior<'_, LOA
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bar::kernels::rhs::rhs_into;
     use crate::bar::matrices::{self, MatrixVariant};
-    use crate::bar::rhs::rhs_into;
 
     /// The twin gives the bits of the plain right-hand side on every row, with and without a
     /// load, for every tail length of the vector loop, on data with large common parts and

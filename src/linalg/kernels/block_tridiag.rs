@@ -218,8 +218,8 @@ impl BlockLdlt {
 impl BlockTridiag {
     /// The interleaved scalar matrix: block row `i` is rows `2i, 2i + 1` (the tests' reference,
     /// a banded `LDLᵀ` of the same matrix).
-    pub(crate) fn to_banded(&self) -> crate::linalg::banded::SymBanded<3> {
-        let mut s = crate::linalg::banded::SymBanded::<3>::zeros(2 * self.blocks());
+    pub(crate) fn to_banded(&self) -> crate::linalg::kernels::banded::SymBanded<3> {
+        let mut s = crate::linalg::kernels::banded::SymBanded::<3>::zeros(2 * self.blocks());
         for i in 0..self.blocks() {
             for r in 0..2 {
                 for c in 0..=r {
@@ -239,7 +239,7 @@ impl BlockTridiag {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::linalg::banded::BandedLdlt;
+    use crate::linalg::kernels::banded::BandedLdlt;
 
     /// A quasi-definite block-tridiagonal matrix (an SPD field, a negative definite one, full
     /// couplings): the block factor's inertia and solve agree with the banded `LDLᵀ` of the

@@ -1,14 +1,14 @@
 //! The instruction set of the optimised twins' streaming loops, chosen at run time.
 //!
 //! The build targets baseline x86-64 (SSE2, two doubles per vector) and uses no target-cpu
-//! flags. On a CPU with AVX (four doubles per vector) the uniform right-hand sides
-//! (`bar::rhs_fast`, the thermal heat rows), the step's update `u += z` (`step::solver`) and
-//! the twisted solves' sweeps (`ldlt_fast`, `block_tridiag_fast`) run through `run` (compiled
-//! with AVX's three-operand instructions, the streaming loops vectorised) and the uniform
-//! energy sums (`bar::energy_fast`) as AVX intrinsics behind [`has_avx`]. The bits do not
-//! change: AVX without FMA performs the same IEEE operations in the same order (Rust never
-//! contracts `a * b + c` into a fused multiply-add), and every sum has its lane order fixed in
-//! the source. The twins' tests compare the AVX and the portable paths bit for bit.
+//! flags. On a CPU with AVX (four doubles per vector) the uniform right-hand side
+//! (`bar::kernels::rhs_fast`), the uniform energy sums (`bar::kernels::energy_fast`) and the
+//! twisted solves' sweeps ([`super::ldlt_fast`], [`super::block_tridiag_fast`]) run through
+//! `run`, compiled with AVX's three-operand instructions, their streaming loops vectorised.
+//! The bits do not change: AVX without FMA performs the same IEEE operations in the same order
+//! (Rust never contracts `a * b + c` into a fused multiply-add), and every sum has its lane
+//! order fixed in the source. The twins' tests compare the AVX and the portable paths bit for
+//! bit.
 
 /// A streaming kernel with its arguments. `call` must be `#[inline(always)]`: it is then
 /// compiled into each caller, including the AVX one (a closure would be compiled once, for
@@ -28,18 +28,6 @@ pub(crate) fn run<K: Kernel>(kernel: K) -> K::Output {
         return unsafe { with_avx(kernel) };
     }
     kernel.call()
-}
-
-/// Whether `run` takes the AVX path on this CPU.
-pub fn has_avx() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
 }
 
 #[cfg(target_arch = "x86_64")]

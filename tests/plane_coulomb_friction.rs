@@ -126,7 +126,7 @@ fn the_frictional_drop_converges_against_a_finer_exact_run() {
 const FRICTION_ORDER_FULL_BAND: (f64, f64) = (0.8, 1.67);
 
 #[test]
-#[ignore = "about 25 s: cargo test --release --test friction -- --ignored"]
+#[ignore = "about 25 s: cargo test --release --test plane_coulomb_friction -- --ignored"]
 fn the_frictional_drop_converges_on_three_levels_against_level_3() {
     let levels = full_convergence().unwrap();
     for p in viscobar_certificate::plane::contact::orders(&levels) {

@@ -3,8 +3,10 @@
 //! chains at once, each link covering two nodes of the bar. Solutions agree with the plain
 //! [`Ldlt`](super::ldlt::Ldlt) to round-off (both backward stable), not bit for bit.
 
-use crate::linalg::dispatch;
-use crate::linalg::ldlt::{NotPositiveDefinite, RowChange, changed_entries, checked_pivot};
+use crate::linalg::kernels::dispatch;
+use crate::linalg::kernels::ldlt::{
+    NotPositiveDefinite, RowChange, changed_entries, checked_pivot,
+};
 use crate::linalg::tridiag::SymTridiag;
 use std::cell::Cell;
 
@@ -405,8 +407,8 @@ impl Half {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::linalg::dispatch::Kernel;
-    use crate::linalg::ldlt::Ldlt;
+    use crate::linalg::kernels::dispatch::Kernel;
+    use crate::linalg::kernels::ldlt::Ldlt;
     use crate::linalg::tridiag::backward_error;
 
     /// Normwise backward error allowed of either solve, in units of ε: Higham's `γ₃`-type
