@@ -15,7 +15,7 @@
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use std::time::Instant;
-use viscobar::linalg::cholesky::SparseCholesky;
+use viscobar::internals::linalg::cholesky::SparseCholesky;
 use viscobar::plane::PlaneSimulation;
 use viscobar::scene::plane::PlaneScene;
 use viscobar::scene::{SolverMethod, SolverSpec};

@@ -7,9 +7,9 @@
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use viscobar::Scene;
-use viscobar::bar::discretisation::Discretisation;
-use viscobar::linalg::system::TridiagSystem;
-use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::internals::bar::discretisation::Discretisation;
+use viscobar::internals::linalg::system::TridiagSystem;
+use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::step::{
     BlockPivoting, CondensedLcp, Constraints, EndEnumeration, EndPenalty, PenaltySettings,
     StepSolver,

@@ -85,7 +85,7 @@ fn main() {
 
 /// One converged solve repeated: the cost of a whole-bar iteration against the plain solve.
 #[allow(dead_code)]
-pub fn repeated(c: &viscobar::linalg::tridiag::SymTridiag) {
+pub fn repeated(c: &viscobar::internals::linalg::tridiag::SymTridiag) {
     let n = c.dim();
     let nodes: Vec<usize> = (0..n).collect();
     let b: Vec<f64> = (0..n)
@@ -96,7 +96,7 @@ pub fn repeated(c: &viscobar::linalg::tridiag::SymTridiag) {
     let (mut z, mut r) = (vec![0.0; n], vec![0.0; n]);
     s.solve(&b, &lo, &mut z, &mut r).unwrap();
     let reps: usize = std::env::var("REPS").map_or(50, |v| v.parse().unwrap());
-    let f = viscobar::linalg::kernels::ldlt::Ldlt::factor(c).unwrap();
+    let f = viscobar::internals::linalg::kernels::ldlt::Ldlt::factor(c).unwrap();
     let (mut per, mut plain) = (f64::INFINITY, f64::INFINITY);
     for _ in 0..7 {
         let t = Instant::now();

@@ -53,3 +53,32 @@ pub mod study {
         pub use crate::study::sampled_run::*;
     }
 }
+
+/// `crate::linalg`, whole: the tridiagonal and sparse matrices, their factorisations and
+/// their optimised twins.
+pub mod linalg {
+    pub use crate::linalg::*;
+}
+
+/// Internals of [`crate::bar`].
+pub mod bar {
+    pub mod body {
+        pub use crate::bar::body::*;
+    }
+    pub mod discretisation {
+        pub use crate::bar::discretisation::*;
+    }
+}
+
+/// Internals of [`crate::plane`].
+pub mod plane {
+    pub mod matrices {
+        pub use crate::plane::matrices::*;
+    }
+    pub mod mesh {
+        pub use crate::plane::mesh::*;
+    }
+    pub mod stress {
+        pub use crate::plane::stress::*;
+    }
+}

@@ -6,7 +6,7 @@
 //! plane-strain body (Q1), Signorini conditions at the bar's ends, under it, or on the body's
 //! edges; the implicit three-level scheme (VI)_h, each step a constrained quadratic programme.
 //!
-//! Layers, imports pointing down this list only (`tests/layers.rs`): [`linalg`] (matrices,
+//! Layers, imports pointing down this list only (`tests/layers.rs`): `linalg` (matrices,
 //! factorisations, per-step kernels and their twins) → [`step`] (the step's solvers, their
 //! audit) → [`scene`] (input) → [`scheme`] (the talk's scheme, for any body) → [`bar`] (P1,
 //! closed forms) → [`thermal`] (the bar with a temperature) → [`plane`] (Q1, sparse Cholesky)
@@ -17,7 +17,7 @@
 pub mod bar;
 #[doc(hidden)]
 pub mod internals;
-pub mod linalg;
+pub(crate) mod linalg;
 pub mod output;
 pub mod plane;
 pub mod scene;

@@ -8,7 +8,7 @@ use viscobar_certificate::tolerances::oracle_agreement;
 
 use proptest::prelude::*;
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
-use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::block_pivot::BlockPivoting;
 use viscobar_certificate::solvers::oracle::brute_force;

@@ -15,11 +15,11 @@ mod common;
 
 use common::{amax, inf_norm, ratio};
 use nalgebra::{DMatrix, DVector};
-use viscobar::linalg::SymTridiag;
-use viscobar::linalg::sparse::Pattern;
-use viscobar::linalg::system::{SparseSystem, SpdSystem, TridiagSystem};
-use viscobar::plane::matrices::{Material, assemble};
-use viscobar::plane::mesh::Grid;
+use viscobar::internals::linalg::SymTridiag;
+use viscobar::internals::linalg::sparse::Pattern;
+use viscobar::internals::linalg::system::{SparseSystem, SpdSystem, TridiagSystem};
+use viscobar::internals::plane::matrices::{Material, assemble};
+use viscobar::internals::plane::mesh::Grid;
 use viscobar::step::audit::{KktAudit, Law};
 use viscobar::step::report::{AuditReport, StepFailure};
 use viscobar::step::solver::Constraints;

@@ -7,7 +7,7 @@ mod common;
 use viscobar_certificate::tolerances::{TIE_TOL, exact_tie, oracle_agreement};
 
 use proptest::prelude::*;
-use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::end_enumeration::EndEnumeration;
 

@@ -16,10 +16,10 @@ mod common;
 
 use common::{amax, inf_norm, ratio};
 use nalgebra::{DMatrix, DVector};
-use viscobar::linalg::sparse::Pattern;
-use viscobar::linalg::system::{SparseSystem, inverse_norm_estimate};
-use viscobar::plane::matrices::{Material, assemble};
-use viscobar::plane::mesh::Grid;
+use viscobar::internals::linalg::sparse::Pattern;
+use viscobar::internals::linalg::system::{SparseSystem, inverse_norm_estimate};
+use viscobar::internals::plane::matrices::{Material, assemble};
+use viscobar::internals::plane::mesh::Grid;
 use viscobar::step::friction_audit::{FrictionAudit, FrictionLaw, Thresholds};
 use viscobar::step::report::{AuditReport, StepFailure};
 use viscobar::step::solver::{Constraints, Friction};

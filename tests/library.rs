@@ -56,7 +56,7 @@ fn bad_fields_built_in_code_are_named() {
 fn with_solver_validates_its_scene() {
     let scene = impact();
     let disc = Discretisation::new(&scene).unwrap();
-    let solver = viscobar::bar::body::make_solver(&scene, &disc).unwrap();
+    let solver = viscobar::internals::bar::body::make_solver(&scene, &disc).unwrap();
     let mut bad = scene.clone();
     bad.time.end = f64::NAN;
     let e = Simulation::with_solver(&bad, disc, solver).err().unwrap();
@@ -67,7 +67,7 @@ fn with_solver_validates_its_scene() {
 /// names the `[solver]` key.
 #[test]
 fn osqp_settings_are_validated_by_the_solver() {
-    use viscobar::linalg::SymTridiag;
+    use viscobar::internals::linalg::SymTridiag;
     use viscobar::step::{Osqp, OsqpSettings, SetupError};
     let c = SymTridiag::new(vec![2.0; 4], vec![-1.0; 3]);
     let cases = [

@@ -135,8 +135,8 @@ fn factorisation_is_backward_stable_on_the_step_matrices() {
 
 mod mass_variants {
     use viscobar::bar::matrices::{MassVariant, MatrixVariant, mass_matrix, stiffness};
-    use viscobar::linalg::kernels::ldlt::Ldlt;
-    use viscobar::linalg::tridiag::SymTridiag;
+    use viscobar::internals::linalg::kernels::ldlt::Ldlt;
+    use viscobar::internals::linalg::tridiag::SymTridiag;
     use viscobar::scene::{
         REDISTRIBUTED_MIN_ELEMENTS_ONE_END, REDISTRIBUTED_MIN_ELEMENTS_TWO_ENDS,
     };

@@ -9,9 +9,9 @@
 mod common;
 
 use proptest::prelude::*;
-use viscobar::linalg::kernels::ldlt::Ldlt;
-use viscobar::linalg::norms::{max_abs, max_distance};
-use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::internals::linalg::kernels::ldlt::Ldlt;
+use viscobar::internals::linalg::norms::{max_abs, max_distance};
+use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
 use viscobar::step::block_pivot::BlockPivoting;

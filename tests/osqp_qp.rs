@@ -5,8 +5,8 @@
 mod common;
 
 use proptest::prelude::*;
-use viscobar::linalg::norms::max_abs;
-use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::internals::linalg::norms::max_abs;
+use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
 use viscobar::step::audit::AUDIT_MARGIN;
 use viscobar::step::end_enumeration::EndEnumeration;

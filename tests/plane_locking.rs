@@ -3,8 +3,8 @@
 //! the rules give the same `K`, bit for bit); the energy identity keeps its form (the `K`-forms
 //! follow the rule).
 
-use viscobar::plane::matrices::{Integration, Material, assemble_with};
-use viscobar::plane::mesh::Grid;
+use viscobar::internals::plane::matrices::{Integration, Material, assemble_with};
+use viscobar::internals::plane::mesh::Grid;
 use viscobar_certificate::plane::locking::{
     LOCKED_BELOW, PATCH_TOL, SELECTIVE_BAND, cantilever_table, identity_ratio, patch_worst,
 };

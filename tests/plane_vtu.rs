@@ -4,9 +4,9 @@
 //! sampled and bounded as the other outputs, written whole or not at all.
 
 use std::path::{Path, PathBuf};
+use viscobar::internals::plane::stress::von_mises;
 use viscobar::output::run_plane_to_dir;
 use viscobar::plane::PlaneSimulation;
-use viscobar::plane::stress::von_mises;
 use viscobar::scene::plane::{PlaneScene, plane_builtin_text};
 use viscobar::scheme::Body;
 use vtkio::model::{Attribute, DataSet, IOBuffer, Vtk};

@@ -15,8 +15,8 @@ use insta::with_settings;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use viscobar::internals::linalg::norms::max_abs;
 use viscobar::internals::study::sampled_run::{self, Sampling};
-use viscobar::linalg::norms::max_abs;
 use viscobar::study::figures;
 
 mod common;

@@ -11,7 +11,7 @@ use std::fmt::Write;
 use std::sync::OnceLock;
 use viscobar::bar::closed_form;
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
-use viscobar::linalg::norms::max_abs;
+use viscobar::internals::linalg::norms::max_abs;
 use viscobar::output::run_in_memory;
 use viscobar::scene;
 use viscobar::scheme::RunError;
@@ -167,7 +167,7 @@ fn matrices_section() -> Section {
             let r = stiffness(variant, nodes, dx);
             let total: f64 = m.mul(&vec![1.0; nodes]).iter().sum();
             let r1 = max_abs(&r.mul(&vec![1.0; nodes]));
-            let sym = |a: &viscobar::linalg::tridiag::SymTridiag| {
+            let sym = |a: &viscobar::internals::linalg::tridiag::SymTridiag| {
                 let d = a.to_dense();
                 d == d.transpose()
             };
@@ -224,14 +224,16 @@ pub fn solve_study(nodes: &[usize]) -> Vec<SolveCase> {
                 mass(MatrixVariant::Consistent, n, dx),
                 stiffness(MatrixVariant::Consistent, n, dx),
             );
-            let c = viscobar::linalg::tridiag::SymTridiag::combine(
+            let c = viscobar::internals::linalg::tridiag::SymTridiag::combine(
                 1.0 / (dt * dt),
                 &m,
                 0.5 + alpha / (2.0 * dt),
                 &r,
             );
             let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() + 0.1).collect();
-            let Ok(factor) = viscobar::linalg::kernels::ldlt_fast::TwistedLdlt::factor(&c) else {
+            let Ok(factor) =
+                viscobar::internals::linalg::kernels::ldlt_fast::TwistedLdlt::factor(&c)
+            else {
                 continue;
             };
             let mut x = b.clone();
@@ -242,7 +244,7 @@ pub fn solve_study(nodes: &[usize]) -> Vec<SolveCase> {
                 alpha,
                 dt_over_dx: ratio,
                 nodes: n,
-                backward_error: viscobar::linalg::tridiag::backward_error(&c, &x, &b),
+                backward_error: viscobar::internals::linalg::tridiag::backward_error(&c, &x, &b),
                 into_same_bits: x.iter().zip(&y).all(|(p, q)| p.to_bits() == q.to_bits()),
             });
         }

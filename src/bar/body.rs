@@ -36,9 +36,9 @@ pub struct Kernels {
     pub twisted_solve: bool,
     /// The exact end solver tries the previous step's active set first.
     pub warm_start: bool,
-    /// On a uniform mesh, the right-hand side by [`rhs_into_uniform`].
+    /// On a uniform mesh, the right-hand side by `rhs_into_uniform`.
     pub uniform_rhs: bool,
-    /// On a uniform mesh, the energy sums by [`energy_sums_uniform`].
+    /// On a uniform mesh, the energy sums by `energy_sums_uniform`.
     pub uniform_energy: bool,
 }
 
@@ -117,7 +117,7 @@ impl Body for BarBody {
         self.disc.alpha
     }
 
-    /// The optimised twins on a uniform mesh ([`rhs_into_uniform`], [`energy_sums_uniform`]),
+    /// The optimised twins on a uniform mesh (`rhs_into_uniform`, `energy_sums_uniform`),
     /// else the plain kernels.
     fn rhs_into(&self, u: &[f64], w: &[f64], force: Option<&[f64]>, b: &mut [f64]) {
         let (mass, stiffness) = (&self.disc.mass, &self.disc.stiffness);

@@ -289,7 +289,7 @@ impl Body for PlaneBody {
         self.disc.index[dof]
     }
 
-    /// [`crate::plane::stress`]: the cell-centre stresses, averaged at the nodes.
+    /// `crate::plane::stress`: the cell-centre stresses, averaged at the nodes.
     fn nodal_stress(&self, u: &[f64], v: &[f64]) -> Option<Vec<[f64; 4]>> {
         let d = &self.disc;
         let (mut uf, mut vf) = (vec![0.0; d.grid.dofs()], vec![0.0; d.grid.dofs()]);

@@ -2,7 +2,7 @@
 //! its validation and the expressions it holds (initial data, loads, gaps), with
 //! [`SceneError`] naming the field at fault.
 //!
-//! Imports [`crate::linalg`] and [`crate::step`] (solver settings).
+//! Imports `crate::linalg` and [`crate::step`] (solver settings).
 
 pub(crate) mod error;
 pub(crate) mod expr;

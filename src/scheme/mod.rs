@@ -5,7 +5,7 @@
 //! kernels through [`Body`] — the bar's in `crate::bar::body` (tridiagonal), the plane body's
 //! in `crate::plane::body` (sparse) — and its constraints as a [`ContactSet`].
 //!
-//! Imports [`crate::linalg`], [`crate::step`] and [`crate::scene`].
+//! Imports `crate::linalg`, [`crate::step`] and [`crate::scene`].
 
 pub(crate) mod body;
 pub mod certify;

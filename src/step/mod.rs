@@ -5,7 +5,7 @@
 //! OSQP's Tresca fixed point; with the independent audits of their answers. Which one serves a
 //! scene's `[solver] method` on each body is the table of [`algorithm`].
 //!
-//! Imports only [`crate::linalg`].
+//! Imports only `crate::linalg`.
 
 pub mod algorithm;
 pub mod audit;

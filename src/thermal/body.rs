@@ -614,7 +614,7 @@ impl Body for ThermalBody {
         self.bar.unknown_of(dof)
     }
 
-    /// The exchange state read off the step's bounds by [`exchange_state`], as the step solver
+    /// The exchange state read off the step's bounds by `exchange_state`, as the step solver
     /// reads it (the gaps of `u^n` against the obstacles where the step puts them),
     /// `θ_obs(t_n)`, the fixed ends' `θ_end(t_{n∓1/2})` and the source's `Q^n`. Allocates
     /// nothing.

@@ -5,7 +5,7 @@ pub mod alloc;
 
 use proptest::prelude::*;
 use viscobar::Scene;
-use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::scene;
 use viscobar_certificate::solvers::agreement::{MAX_MARGIN, diagonally_dominant};
 

@@ -4,8 +4,8 @@
 //! against the talk's form of the step.
 
 use viscobar::bar::{Discretisation, Simulation};
-use viscobar::linalg::kernels::ldlt_fast::TwistedLdlt;
-use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::internals::linalg::kernels::ldlt_fast::TwistedLdlt;
+use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::scene::Scene;
 use viscobar::scheme::RunError;
 use viscobar::study::accuracy::lockstep;

@@ -15,12 +15,12 @@ use crate::bar::stiff::{
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::rc::Rc;
-use viscobar::bar::body::make_solver;
 use viscobar::bar::{Discretisation, Simulation};
-use viscobar::linalg::kernels::ldlt::Ldlt;
-use viscobar::linalg::norms::{max_abs, max_distance};
-use viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS;
-use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::internals::bar::body::make_solver;
+use viscobar::internals::linalg::kernels::ldlt::Ldlt;
+use viscobar::internals::linalg::norms::{max_abs, max_distance};
+use viscobar::internals::linalg::spectrum::reference::STURM_ERROR_ULPS;
+use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::output::Tracker;
 use viscobar::scheme::RunError;
 use viscobar::scheme::StepRecord;
@@ -689,12 +689,13 @@ pub fn run_case(case: &Case) -> CaseResult {
                     if kappa.is_none() {
                         let d = sim.discretisation();
                         let c = &d.step_matrix;
-                        kappa = viscobar::linalg::spectrum::condition_number(c);
+                        kappa = viscobar::internals::linalg::spectrum::condition_number(c);
                         // The bisection's error bound, tested against the double-double
                         // reference in `linalg::spectrum`.
-                        lambda_min = (viscobar::linalg::spectrum::smallest_eigenvalue_spd(c)
-                            - STURM_ERROR_ULPS * f64::EPSILON * c.inf_norm())
-                        .max(0.0);
+                        lambda_min =
+                            (viscobar::internals::linalg::spectrum::smallest_eigenvalue_spd(c)
+                                - STURM_ERROR_ULPS * f64::EPSILON * c.inf_norm())
+                            .max(0.0);
                         max_gap = d.constraints.iter().fold(0.0, |m, c| m.max(c.gap));
                         schur = d.ends_only().then(|| inverse_diagonal_range(d)).flatten();
                     }

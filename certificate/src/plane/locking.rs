@@ -5,11 +5,11 @@
 //! from 0.3 to 0.4999 at the scene's `μ`: full integration locks, selective does not.
 
 use std::fmt::Write;
-use viscobar::linalg::cholesky::SparseCholesky;
-use viscobar::linalg::sparse::Pattern;
+use viscobar::internals::linalg::cholesky::SparseCholesky;
+use viscobar::internals::linalg::sparse::Pattern;
+use viscobar::internals::plane::matrices::{Integration, Material, assemble, assemble_with};
+use viscobar::internals::plane::mesh::Grid;
 use viscobar::plane::PlaneDiscretisation;
-use viscobar::plane::matrices::{Integration, Material, assemble, assemble_with};
-use viscobar::plane::mesh::Grid;
 use viscobar::scene::plane::{PlaneScene, plane_builtin_text};
 use viscobar::scheme::RunError;
 

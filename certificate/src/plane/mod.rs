@@ -14,13 +14,13 @@ pub mod symmetry;
 
 use std::fmt::Write;
 use viscobar::bar::Simulation;
+use viscobar::internals::linalg::cholesky::SparseCholesky;
+use viscobar::internals::plane::matrices::{Material, assemble};
+use viscobar::internals::plane::mesh::Grid;
 use viscobar::internals::scene::schema::number_text;
-use viscobar::linalg::cholesky::SparseCholesky;
 use viscobar::output::run_plane_in_memory;
 use viscobar::plane::PlaneSimulation;
 use viscobar::plane::closed_form::Manufactured;
-use viscobar::plane::matrices::{Material, assemble};
-use viscobar::plane::mesh::Grid;
 use viscobar::scene::plane::{
     Body, EdgeCondition, EdgeSpec, Edges, PLANE_BUILTIN, PlaneInitial, PlaneLoad, PlaneMesh,
     PlaneScene, Vector, plane_builtin_text,

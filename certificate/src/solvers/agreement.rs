@@ -12,9 +12,9 @@
 
 use osqp::Status;
 use std::fmt::Write;
-use viscobar::linalg::kernels::ldlt::Ldlt;
-use viscobar::linalg::norms::{max_abs, max_distance};
-use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::internals::linalg::kernels::ldlt::Ldlt;
+use viscobar::internals::linalg::norms::{max_abs, max_distance};
+use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::output::run_in_memory;
 use viscobar::scene::{self, Scene};
 use viscobar::scheme::RunError;
@@ -378,7 +378,7 @@ fn random_problems(md: &mut String) -> Result<(), RunError> {
 /// One step problem `min ½zᵀCz − bᵀz, z_j >= lo_j` with the exact solver's answer `(z, r)`.
 #[derive(Clone, Debug)]
 pub struct StepProblem {
-    pub c: viscobar::linalg::tridiag::SymTridiag,
+    pub c: viscobar::internals::linalg::tridiag::SymTridiag,
     /// Local indices of the constrained nodes.
     pub nodes: Vec<usize>,
     pub b: Vec<f64>,
@@ -392,8 +392,8 @@ pub struct StepProblem {
 pub fn start_up_problem(scene: &Scene) -> Result<StepProblem, RunError> {
     use std::cell::RefCell;
     use std::rc::Rc;
-    use viscobar::bar::body::make_solver;
     use viscobar::bar::{Discretisation, Simulation};
+    use viscobar::internals::bar::body::make_solver;
     use viscobar::step::{SolveInfo, StepFailure};
 
     /// Wraps the exact solver and keeps the first problem it is given, with its answer.

@@ -1,7 +1,7 @@
 //! Contact at scale: the sparse penalty solver (the penalty law beyond the condensed switch,
 //! `viscobar::step::SemismoothPenalty`) against the condensed one on the same step problems.
 
-use viscobar::linalg::system::SparseSystem;
+use viscobar::internals::linalg::system::SparseSystem;
 use viscobar::plane::{PlaneDiscretisation, PlaneSimulation};
 use viscobar::scene::plane::{PlaneScene, plane_builtin_text};
 use viscobar::scheme::RunError;

@@ -2,8 +2,8 @@
 //! spectrum's condition number (the tests of `src/linalg/spectrum.rs`), each beside the
 //! measurement of what it guards.
 
-use viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS;
-use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::internals::linalg::spectrum::reference::STURM_ERROR_ULPS;
+use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::scene::{self, MassVariant};
 
 /// The step matrices of `linalg::spectrum`'s κ test, `(α, Δt/Δx)` on 21 nodes, κ from 4 to
@@ -15,7 +15,7 @@ pub const KAPPA_CASES: [(f64, f64); 4] = [(0.0, 1e-3), (0.0, 1.0), (1e3, 100.0),
 /// `STURM_ERROR_ULPS ε ‖C‖∞ (1/λ_min + 1/λ_max)`.
 pub fn kappa_reference_worst() -> (f64, f64) {
     use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
-    use viscobar::linalg::spectrum::{
+    use viscobar::internals::linalg::spectrum::{
         condition_number, extreme_eigenvalues, reference::eigenvalue_dd, smallest_eigenvalue_spd,
     };
     let nodes = 21;
@@ -84,9 +84,9 @@ pub const SOLVE_ULPS: f64 = 4.0;
 /// worst `|x̂ − x|∞` of either over its own bound `SOLVE_ULPS ε ‖A‖∞ ‖x‖₂ / λ_min(A)` (λ_min by
 /// bisection), and the worst `|x̂ − x|∞`.
 pub fn ldlt_family_worst() -> (f64, f64) {
-    use viscobar::linalg::kernels::ldlt::Ldlt;
-    use viscobar::linalg::kernels::ldlt_fast::TwistedLdlt;
-    use viscobar::linalg::spectrum::smallest_eigenvalue_spd;
+    use viscobar::internals::linalg::kernels::ldlt::Ldlt;
+    use viscobar::internals::linalg::kernels::ldlt_fast::TwistedLdlt;
+    use viscobar::internals::linalg::spectrum::smallest_eigenvalue_spd;
     let (mut ratio, mut worst) = (0.0f64, 0.0f64);
     for n in 1..40usize {
         for shift in [0.05, 1.0] {

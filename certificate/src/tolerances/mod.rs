@@ -26,7 +26,7 @@ pub use thermal::*;
 use crate::bar::stiff::{CaseResult, checks};
 use crate::bar::viscous_contact;
 use std::fmt::Write;
-use viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS;
+use viscobar::internals::linalg::spectrum::reference::STURM_ERROR_ULPS;
 use viscobar::scene::{self, MassVariant};
 use viscobar::scheme::RunError;
 

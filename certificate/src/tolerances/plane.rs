@@ -2,7 +2,7 @@
 //! `plane_contact_cli.rs`, `plane_symmetry.rs`), each beside the measurement of what it guards.
 
 use super::{AGREEMENT_ULPS_PER_STEP, Measured};
-use viscobar::plane::matrices::Integration;
+use viscobar::internals::plane::matrices::Integration;
 use viscobar::scheme::RunError;
 
 // ---- tests/plane.rs, tests/plane_contact.rs, tests/plane_cli.rs, tests/plane_contact_cli.rs ----

@@ -5,7 +5,7 @@
 //! `exact_solver.rs`).
 
 use super::exact_sample_error;
-use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::scheme::RunError;
 
 // ---- proptests on random SPD tridiagonal problems: tests/active_set.rs, osqp_many_bounds.rs ----
@@ -38,7 +38,7 @@ pub fn sample_spd_tridiag(max_n: usize, rnd: &mut impl FnMut() -> f64) -> SymTri
 /// relative to the data: stationarity `‖Cz − b − Σ r_j e_j‖∞`, feasibility, sign and
 /// complementarity, over `1 + max(‖b‖∞, ‖lo‖∞, ‖z‖∞)`.
 pub fn kkt(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64], z: &[f64], r: &[f64]) -> f64 {
-    use viscobar::linalg::norms::max_abs;
+    use viscobar::internals::linalg::norms::max_abs;
     let scale = 1.0 + max_abs(b).max(max_abs(lo)).max(max_abs(z));
     let mut rho = c.mul(z);
     for (ri, bi) in rho.iter_mut().zip(b) {
@@ -75,7 +75,7 @@ pub fn kkt_ratio(
     z: &[f64],
     r: &[f64],
 ) -> f64 {
-    use viscobar::linalg::norms::max_abs;
+    use viscobar::internals::linalg::norms::max_abs;
     let scale = 1.0 + max_abs(b).max(max_abs(lo)).max(max_abs(z));
     let data =
         (c.inf_norm() * max_abs(z) + max_abs(b) + max_abs(r)).max(max_abs(z).max(max_abs(lo)));
@@ -184,8 +184,10 @@ pub fn oracle_distance_bound(
         .map(|(x, s)| x.abs() + RESIDUAL_ENTRY_ROUNDINGS * u * s)
         .collect();
     let c_norm = c.inf_norm();
-    let lambda = viscobar::linalg::spectrum::smallest_eigenvalue_spd(c)
-        - viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS * f64::EPSILON * c_norm;
+    let lambda = viscobar::internals::linalg::spectrum::smallest_eigenvalue_spd(c)
+        - viscobar::internals::linalg::spectrum::reference::STURM_ERROR_ULPS
+            * f64::EPSILON
+            * c_norm;
     if lambda <= 0.0 || !lambda.is_finite() {
         return (f64::INFINITY, vec![f64::INFINITY; nodes.len()]);
     }
@@ -227,7 +229,7 @@ pub fn oracle_agreement(
     z: &[f64],
     r: &[f64],
 ) -> f64 {
-    let zscale = 1.0 + viscobar::linalg::norms::max_abs(z);
+    let zscale = 1.0 + viscobar::internals::linalg::norms::max_abs(z);
     let Ok(Some(oracle)) = crate::solvers::oracle::brute_force(
         &c.to_dense(),
         b,

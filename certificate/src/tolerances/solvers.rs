@@ -3,7 +3,7 @@
 //! each beside the measurement of what it guards.
 
 use super::{GAP_TOL, IDENTITY_TOL, exact_sample_error};
-use viscobar::linalg::tridiag::SymTridiag;
+use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::scene::{self, MassVariant, Scene, SolverMethod, builtin_names};
 use viscobar::scheme::RunError;
 use viscobar::step::audit::AUDIT_MARGIN;
