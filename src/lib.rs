@@ -13,6 +13,10 @@
 //! → [`output`] (runs and their files) → [`study`] (refinement, comparison, figures). The
 //! certificate is the member crate `viscobar-certificate`. Use as a library: [`run_in_memory`]
 //! runs a scene built in code (its doc, a tested example).
+//!
+//! Public: what a user calls (scenes, runs, each body's simulation, records and summaries, the
+//! closed forms, the studies) and the seams a researcher extends ([`Body`], [`StepSolver`]).
+//! The hidden module `internals` opens the rest to the certificate, tests and benches: not API.
 
 pub mod bar;
 #[doc(hidden)]
@@ -33,6 +37,6 @@ pub use output::{
 };
 pub use plane::PlaneSimulation;
 pub use scene::{AnyScene, PlaneScene, Scene, SceneError, SolverMethod};
-pub use scheme::{RunError, StepRecord};
+pub use scheme::{Body, RunError, StepRecord};
 pub use step::{StepFailure, StepSolver};
 pub use thermal::ThermalSimulation;
