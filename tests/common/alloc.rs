@@ -49,17 +49,22 @@ pub fn reset_peak() {
     PEAK.with(|p| p.set(live_bytes()));
 }
 
+// SAFETY: every call is forwarded unchanged to the system allocator, which upholds
+// `GlobalAlloc`'s contract; the counting touches thread-locals only and never allocates.
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         track(true, layout.size() as isize);
+        // SAFETY: the caller's `layout` contract is passed on as is.
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         track(false, -(layout.size() as isize));
+        // SAFETY: `ptr` came from `System` through this allocator, with this `layout`.
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         track(true, new_size as isize - layout.size() as isize);
+        // SAFETY: as for `dealloc`, with the caller's `new_size` contract passed on.
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 }
