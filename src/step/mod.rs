@@ -2,7 +2,8 @@
 //! seam, for every body: condensation onto the constraints with an exact LCP solve (any body),
 //! enumeration over the bar's two ends and block pivoting for its obstacle (tridiagonal
 //! kernels), penalty and OSQP; with Coulomb friction, Lemke's method on the condensed LCP and
-//! OSQP's Tresca fixed point; with the independent audits of their answers.
+//! OSQP's Tresca fixed point; the contact laws, and the independent audit of every answer
+//! against its law.
 //!
 //! Imports only [`crate::linalg`].
 
@@ -11,7 +12,7 @@ pub mod block_pivot;
 pub mod condensed;
 pub mod exact;
 pub mod friction;
-pub mod friction_audit;
+pub mod law;
 pub mod lcp;
 pub mod lemke;
 pub mod osqp;
