@@ -1,19 +1,13 @@
-//! The audit's bounds, checked at their edges: for each check of `step::audit` under each law and
-//! each way a solver calls it, an answer whose checked value is `(1 − DELTA)` times the check's
-//! tolerance is accepted and one at `(1 + DELTA)` is refused by that check, so that a loosened or
-//! mis-scaled bound fails. The cases: OSQP's Signorini answers (tolerances with `AUDIT_MARGIN`)
-//! on the bar's tridiagonal `C` and the plane body's sparse `C`; the penalty law and Signorini at
-//! the round-off floors on the bar's matrix (tridiagonal and sparse); on a frictional plane body
-//! the exact solver's Coulomb and frictionless start-up answers (slack 0) and OSQP's Tresca
-//! answers (its stopping slack, also inaccurate).
-//!
-//! Each expected tolerance is computed here from the documented formulas (docs/step-solvers.md,
-//! "KKT audit"; docs/friction.md, "Audit"; the systems' `roundoff_ulps` as documented) on
-//! independent dense copies of `C` and `C⁻¹` (nalgebra), never read back from the audit.
-//! Stationarity holds by construction, `b = C z − Eᵀ r − extra` (`extra` the residual placed by
-//! the stationarity tests), and every check but the one under test stays far inside its bound;
-//! the bounds depend on the answer's norms, so each answer is placed by a fixed-point iteration
-//! and its ratio re-measured before it is audited. Constraints push both ways, `s = ±1`.
+//! The audit's bounds at their edges: for each check of `step::audit`, under each law and each
+//! way a solver calls it, an answer at `(1 − DELTA)` times the check's tolerance is accepted and
+//! one at `(1 + DELTA)` is refused by that check, so that a loosened or mis-scaled bound fails.
+//! Cases: OSQP's Signorini answers on the bar's tridiagonal and the plane's sparse `C`; the
+//! penalty law and Signorini at round-off on the bar's matrix (tridiagonal and sparse); on a
+//! frictional plane, the exact solver's Coulomb and start-up answers and OSQP's Tresca answers.
+//! Each tolerance is computed here from the documented formulas (docs/step-solvers.md, "KKT
+//! audit"; docs/friction.md, "Audit") on dense copies of `C` and `C⁻¹` (nalgebra), never read
+//! from the audit. `b = C z − Eᵀ r − extra` makes the residual `extra`; every other check stays
+//! far inside; answers are placed by a fixed-point iteration (the bounds move with the norms).
 
 mod common;
 
@@ -29,28 +23,19 @@ use viscobar::step::law::{Law, LawFamily, Slip};
 use viscobar::step::report::{AuditReport, StepFailure};
 use viscobar::step::solver::{Constraints, Friction};
 
-/// Answers sit at `(1 ∓ DELTA)` times a tolerance: far beyond the round-off of evaluating the
-/// formula twice (about 1e-12 relative), close enough that any mis-scaling of a bound by more
-/// than 0.1 % turns one of the two verdicts.
+/// Answers sit at `(1 ∓ DELTA)` times a tolerance: far above round-off (1e-12), below any
+/// mis-scaling worth catching (0.1 %).
 const DELTA: f64 = 1e-3;
-/// An answer is placed at its intended ratio to within a tenth of `DELTA` (the fixed point
-/// converges; the dyadic penalty answers round their bound `lo` by about 2e-6 of their value,
-/// the frictional ones round to ulps of the thresholds and gaps they sit next to).
+/// An answer is placed at its ratio to a tenth of `DELTA` (dyadic answers round by about 2e-6).
 const PLACEMENT: f64 = 1e-4;
-/// Rounds of the placement's fixed-point iteration: a bound moves with the placed quantity by at
-/// most `10·EPS_REL` = 1e-5 times it (through the norms), so each round divides the error by 1e5.
+/// Rounds of the placement: a bound moves by at most 1e-5 times the placed quantity.
 const PLACEMENT_ROUNDS: usize = 4;
-/// The audit's own ratios (its report and its error) agree with the independent ones to a tenth
-/// of `DELTA`: the same formulas in f64 from the same data; the only other difference, Hager's
-/// estimate of `‖C⁻¹‖∞` (a lower bound), is exact for the bar's M-matrix and on the frictional
-/// body (to `HAGER_EXACT`), and weighs less than `HAGER_SHARE` of the displacement tolerance in
-/// the plane's Signorini answers.
+/// The audit's ratios agree with these to a tenth of `DELTA`: the same formulas on the same data,
+/// Hager's `‖C⁻¹‖∞` exact (bar, `HAGER_EXACT`) or below `HAGER_SHARE` of the bound (plane).
 const AGREEMENT: f64 = 1e-4;
-/// Bound on `‖C⁻¹‖∞ floor_f / tol_dz` in OSQP's Signorini answers (asserted), so that Hager's
-/// estimate falling short of the true norm cannot move the displacement bound by `AGREEMENT`.
+/// Bound on `‖C⁻¹‖∞ floor_f / tol_dz` in OSQP's Signorini answers, so Hager's may fall short.
 const HAGER_SHARE: f64 = 1e-5;
-/// Hager's estimate against the dense `‖C⁻¹‖∞` on the frictional body, relative: a few hundred
-/// ulps of round-off.
+/// Hager's estimate against the dense `‖C⁻¹‖∞` on the frictional body: round-off.
 const HAGER_EXACT: f64 = 1e-12;
 /// Every check but the one under test stays below half its tolerance: a verdict is that check's.
 const FAR_INSIDE: f64 = 0.5;
@@ -62,72 +47,48 @@ const INACCURATE: f64 = 10.0;
 const TRIDIAG_ULPS: f64 = 32.0;
 /// `SparseSystem::roundoff_ulps` as documented (18-term rows and the sparse solve, margin two).
 const SPARSE_ULPS: f64 = 64.0;
-/// OSQP's tolerances for the Signorini answers: distinct, so that swapping or dropping either
-/// term of a bound moves it by more than `DELTA`; large enough that the round-off floors stay
-/// below `HAGER_SHARE` of each bound (the round-off-level answers test the force floors alone).
+/// OSQP's tolerances: distinct (a swapped term moves a bound), above the floors' `HAGER_SHARE`.
 const EPS_ABS: f64 = 1e-7;
 const EPS_REL: f64 = 1e-6;
 /// OSQP's default `eps_abs` and `eps_rel` (`OSQP_DEFAULT_EPS`), which the Tresca solver runs with.
 const OSQP_EPS: f64 = 1e-10;
 
-/// The audit's checks, in its order.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Check {
-    Primal,
-    Negative,
-    Complementarity,
-    PenaltyLaw,
-    Cone,
-    Slip,
-    Stationarity,
-    Displacement,
-}
-
-const CHECKS: [Check; 8] = [
-    Check::Primal,
-    Check::Negative,
-    Check::Complementarity,
-    Check::PenaltyLaw,
-    Check::Cone,
-    Check::Slip,
-    Check::Stationarity,
-    Check::Displacement,
+/// The audit's checks, in its order, by index: their names under a normal and a frictional law.
+const PRIMAL: usize = 0;
+const NEGATIVE: usize = 1;
+const COMPLEMENTARITY: usize = 2;
+const PENALTY_LAW: usize = 3;
+const CONE: usize = 4;
+const SLIP: usize = 5;
+const STATIONARITY: usize = 6;
+const DISPLACEMENT: usize = 7;
+const NAMES: [[&str; 2]; 8] = [
+    ["primal violation (lo_k - s_k z_k)+"; 2],
+    ["negative reaction (-r_k)+", "negative reaction (-r_N)+"],
+    [
+        "complementarity |r_k (s_k z_k - lo_k)|",
+        "complementarity |r_N (s_k z_k - lo_k)|",
+    ],
+    ["penalty law |eps r_k - (lo_k - s_k z_k)+|"; 2],
+    ["friction cone (|r_T| - mu r_N)+"; 2],
+    ["slip law |mu r_N |delta| + r_T delta|"; 2],
+    ["stationarity |Cz - b - r|", "stationarity |Cz - b - E^T r|"],
+    [
+        "stationarity in displacement |C^-1 (Cz - b - r)|",
+        "stationarity in displacement |C^-1 (Cz - b - E^T r)|",
+    ],
 ];
 
-impl Check {
-    /// The name the audit gives the check in `StepFailure::AuditFailed`, under a normal or a
-    /// frictional law.
-    fn what(self, frictional: bool) -> &'static str {
-        match (self, frictional) {
-            (Check::Primal, _) => "primal violation (lo_k - s_k z_k)+",
-            (Check::Negative, false) => "negative reaction (-r_k)+",
-            (Check::Negative, true) => "negative reaction (-r_N)+",
-            (Check::Complementarity, false) => "complementarity |r_k (s_k z_k - lo_k)|",
-            (Check::Complementarity, true) => "complementarity |r_N (s_k z_k - lo_k)|",
-            (Check::PenaltyLaw, _) => "penalty law |eps r_k - (lo_k - s_k z_k)+|",
-            (Check::Cone, _) => "friction cone (|r_T| - mu r_N)+",
-            (Check::Slip, _) => "slip law |mu r_N |delta| + r_T delta|",
-            (Check::Stationarity, false) => "stationarity |Cz - b - r|",
-            (Check::Stationarity, true) => "stationarity |Cz - b - E^T r|",
-            (Check::Displacement, false) => "stationarity in displacement |C^-1 (Cz - b - r)|",
-            (Check::Displacement, true) => "stationarity in displacement |C^-1 (Cz - b - E^T r)|",
-        }
-    }
-
-    /// The worst ratio the audit's report holds for the check (`None` when the law omits it).
-    fn reported(self, report: &AuditReport) -> Option<f64> {
-        let worst = match self {
-            Check::Primal => report.primal_violation,
-            Check::Negative => Some(report.negative_reaction),
-            Check::Complementarity => report.complementarity,
-            Check::PenaltyLaw => report.penalty_law,
-            Check::Cone => report.friction_cone,
-            Check::Slip => report.slip_law,
-            Check::Stationarity => Some(report.stationarity),
-            Check::Displacement => Some(report.stationarity_displacement),
-        };
-        worst.map(|w| w.max_over_tolerance)
-    }
+/// The worst ratio the audit's report holds for each check (`None` when the law omits it).
+fn reported(r: &AuditReport) -> [Option<f64>; 8] {
+    let (ng, st, dz) = (
+        r.negative_reaction,
+        r.stationarity,
+        r.stationarity_displacement,
+    );
+    let (pr, co, pe) = (r.primal_violation, r.complementarity, r.penalty_law);
+    let [ng, st, dz] = [ng, st, dz].map(Some);
+    [pr, ng, co, pe, r.friction_cone, r.slip_law, st, dz].map(|w| w.map(|w| w.max_over_tolerance))
 }
 
 /// The law of a case, as the test states it (the thresholds `g_j` of friction).
@@ -145,106 +106,58 @@ enum Kind {
 #[derive(Clone, Copy, Debug)]
 enum Stop {
     Exact,
-    Osqp { eps_abs: f64, eps_rel: f64 },
+    Osqp,
     Tresca(f64),
 }
 
-/// One way a solver calls the audit.
+/// One way a solver calls the audit (the exact or OSQP's, inaccurate at start-up); `previous`:
+/// whether the previous increment is known (no slip law at the start-up step).
 #[derive(Clone, Copy, Debug)]
-struct Case {
-    name: &'static str,
-    kind: Kind,
-    /// Whether the previous increment is known (no slip law at the start-up step).
-    previous: bool,
-    stop: Stop,
+struct Case(&'static str, Kind, bool, Stop);
+
+const SIGNORINI: Case = Case("OSQP", Kind::Signorini, false, Stop::Osqp);
+const SIGNORINI_EXACT: Case = Case("round-off", Kind::Signorini, false, Stop::Exact);
+const COULOMB: Case = Case("Coulomb", Kind::Coulomb, true, Stop::Exact);
+const START: Case = Case("start-up", Kind::Frictionless, false, Stop::Exact);
+const TRESCA: Case = Case("Tresca", Kind::Tresca(&GIVEN), true, Stop::Tresca(MARGIN));
+const LATE: Stop = Stop::Tresca(MARGIN * INACCURATE);
+const TRESCA_START: Case = Case("Tresca start-up", Kind::Tresca(&ZERO), false, LATE);
+const FRICTION_CASES: [Case; 4] = [COULOMB, START, TRESCA, TRESCA_START];
+
+fn penalty(epsilon: f64) -> Case {
+    Case("penalty", Kind::Penalty(epsilon), false, Stop::Exact)
 }
 
 impl Case {
     fn frictional(&self) -> bool {
-        matches!(
-            self.kind,
-            Kind::Frictionless | Kind::Coulomb | Kind::Tresca(_)
-        )
+        matches!(self.1, Kind::Frictionless | Kind::Coulomb | Kind::Tresca(_))
     }
 
-    fn family<'a>(&self, friction: &'a Option<Friction>) -> LawFamily<'a> {
-        match (self.kind, friction) {
-            (Kind::Penalty(_), _) => LawFamily::Penalty,
-            (Kind::Signorini, _) => LawFamily::Signorini,
-            (_, Some(f)) => LawFamily::Frictional(f),
-            (_, None) => panic!("{}: a frictional law on a body without friction", self.name),
-        }
+    fn previous(&self) -> bool {
+        self.2
     }
 
-    /// The law handed to the audit for answer `a`.
-    fn law<'a>(&self, body_mu: &'a [f64], a: &'a Answer) -> Law<'a> {
+    /// The law handed to the audit for answer `a`, and the family the audit is set up for.
+    fn law<'a, S>(&self, body: &'a Body<S>, a: &'a Answer) -> (Law<'a>, LawFamily<'a>) {
         let slip = Slip { previous: &a.w };
-        match self.kind {
+        let law = match self.1 {
             Kind::Signorini => Law::Signorini,
             Kind::Penalty(epsilon) => Law::Penalty { epsilon },
             Kind::Frictionless => Law::Frictionless,
-            Kind::Coulomb => Law::Coulomb { mu: body_mu, slip },
+            Kind::Coulomb => Law::Coulomb { mu: &body.mu, slip },
             Kind::Tresca(g) => Law::Tresca {
                 thresholds: g,
-                slip: self.previous.then_some(slip),
+                slip: self.2.then_some(slip),
             },
-        }
-    }
-
-    /// Whether the bounds are round-off floors only.
-    fn roundoff_level(&self) -> bool {
-        matches!(self.stop, Stop::Exact)
-    }
-}
-
-const SIGNORINI: Case = Case {
-    name: "OSQP, Signorini",
-    kind: Kind::Signorini,
-    previous: false,
-    stop: Stop::Osqp {
-        eps_abs: EPS_ABS,
-        eps_rel: EPS_REL,
-    },
-};
-const SIGNORINI_EXACT: Case = Case {
-    name: "Signorini at round-off",
-    kind: Kind::Signorini,
-    previous: false,
-    stop: Stop::Exact,
-};
-fn penalty(epsilon: f64) -> Case {
-    Case {
-        name: "penalty",
-        kind: Kind::Penalty(epsilon),
-        previous: false,
-        stop: Stop::Exact,
+        };
+        let family = match (self.1, &body.friction) {
+            (Kind::Penalty(_), _) => LawFamily::Penalty,
+            (Kind::Signorini, _) | (_, None) => LawFamily::Signorini,
+            (_, Some(f)) => LawFamily::Frictional(f),
+        };
+        (law, family)
     }
 }
-const COULOMB: Case = Case {
-    name: "exact solver, Coulomb",
-    kind: Kind::Coulomb,
-    previous: true,
-    stop: Stop::Exact,
-};
-const START: Case = Case {
-    name: "exact solver, start-up",
-    kind: Kind::Frictionless,
-    previous: false,
-    stop: Stop::Exact,
-};
-const TRESCA: Case = Case {
-    name: "OSQP, Tresca",
-    kind: Kind::Tresca(&GIVEN),
-    previous: true,
-    stop: Stop::Tresca(MARGIN),
-};
-const TRESCA_START: Case = Case {
-    name: "OSQP, start-up, inaccurate",
-    kind: Kind::Tresca(&GIVEN_ZERO),
-    previous: false,
-    stop: Stop::Tresca(MARGIN * INACCURATE),
-};
-const FRICTION_CASES: [Case; 4] = [COULOMB, START, TRESCA, TRESCA_START];
 
 /// A step matrix with its independent dense copies, the constraints (and frictional nodes) of
 /// the answers, and the vectors the answers are built from.
@@ -258,99 +171,95 @@ struct Body<S> {
     ulps: f64,
     constraints: Constraints,
     friction: Option<Friction>,
+    /// The numbers of normals and of frictional nodes, and the latter's `μ`.
+    m: usize,
+    p: usize,
+    mu: Vec<f64>,
     /// `(i, s)` of every row of `E`: the normals, then the tangents (`s = +1`).
     rows: Vec<(usize, f64)>,
     /// `σ = max_k S_kk`, `S = E C⁻¹ Eᵀ`: the Tresca solver's scale.
     sigma: f64,
-    /// The displacement of the answers.
     z: Vec<f64>,
     /// `w` with `‖C w‖∞` small (a soft mode) and large (a stiff mode), `‖w‖∞ = 1`.
     soft: Vec<f64>,
     stiff: Vec<f64>,
-    system: fn() -> S,
+    system: fn(&DMatrix<f64>) -> S,
 }
+
+/// `C`, the round-off ulps of its system, and how the solvers hold it.
+type Matrix<S> = (DMatrix<f64>, f64, fn(&DMatrix<f64>) -> S);
 
 impl<S: SpdSystem> Body<S> {
     fn new(
         name: &'static str,
-        c: DMatrix<f64>,
-        ulps: f64,
+        (c, ulps, system): Matrix<S>,
         (constraints, friction): (Constraints, Option<Friction>),
         z: Vec<f64>,
-        system: fn() -> S,
     ) -> Self {
         assert_eq!(c, c.transpose(), "{name}: C is symmetric");
         let c_inv = c.clone().try_inverse().expect("C is invertible");
-        let all = friction
-            .as_ref()
-            .map_or_else(|| constraints.clone(), |f| f.rows(&constraints));
+        let all = (friction.as_ref()).map_or(constraints.clone(), |f| f.rows(&constraints));
         let rows: Vec<(usize, f64)> = all.unknowns.into_iter().zip(all.directions).collect();
         let sigma = rows.iter().map(|&(i, _)| c_inv[(i, i)]).fold(0.0, f64::max);
-        let (soft, stiff) = extreme_modes(&c);
+        let eigen = c.clone().symmetric_eigen();
+        let mode = |j: usize| {
+            let w = eigen.eigenvectors.column(j);
+            w.iter().map(|x| x / w.amax()).collect()
+        };
+        let mu = friction.as_ref().map_or(vec![], |f| f.coefficients.clone());
         Self {
             name,
             c_norm: inf_norm(&c),
             inv_norm: inf_norm(&c_inv),
+            m: constraints.len(),
+            p: mu.len(),
+            soft: mode(eigen.eigenvalues.imin()),
+            stiff: mode(eigen.eigenvalues.imax()),
             c,
             c_inv,
             ulps,
             constraints,
             friction,
+            mu,
             rows,
             sigma,
             z,
-            soft,
-            stiff,
             system,
         }
     }
 }
 
-impl<S> Body<S> {
-    fn m(&self) -> usize {
-        self.constraints.len()
-    }
-
-    fn p(&self) -> usize {
-        self.friction.as_ref().map_or(0, Friction::len)
-    }
-
-    fn mu(&self) -> &[f64] {
-        self.friction.as_ref().map_or(&[], |f| &f.coefficients)
-    }
-}
-
-/// The eigenvectors of `C`'s smallest and largest eigenvalues, scaled to `‖w‖∞ = 1`.
-fn extreme_modes(c: &DMatrix<f64>) -> (Vec<f64>, Vec<f64>) {
-    let eigen = c.clone().symmetric_eigen();
-    let mode = |j: usize| {
-        let w = eigen.eigenvectors.column(j);
-        w.iter().map(|x| x / w.amax()).collect()
-    };
-    (
-        mode(eigen.eigenvalues.imin()),
-        mode(eigen.eigenvalues.imax()),
-    )
-}
-
-/// The dense copy of a matrix on a pattern.
-fn dense(pattern: &Pattern, values: &[f64]) -> DMatrix<f64> {
-    let mut c = DMatrix::zeros(pattern.n, pattern.n);
-    for row in 0..pattern.n {
-        for at in pattern.row_ptr[row]..pattern.row_ptr[row + 1] {
-            c[(row, pattern.cols[at])] = values[at];
+/// `c` as the plane body's solvers hold theirs, a `SparseSystem` on the pattern of its nonzeros.
+fn sparse(c: &DMatrix<f64>) -> SparseSystem {
+    let (mut row_ptr, mut cols, mut values) = (vec![0], vec![], vec![]);
+    for i in 0..c.nrows() {
+        for j in (0..c.ncols()).filter(|&j| c[(i, j)] != 0.0) {
+            cols.push(j);
+            values.push(c[(i, j)]);
         }
+        row_ptr.push(cols.len());
     }
-    c
+    let n = c.nrows();
+    let pattern = Pattern { n, row_ptr, cols };
+    SparseSystem::new(&pattern, &values, "C").expect("C is positive definite")
+}
+
+fn constraints(unknowns: Vec<usize>, directions: Vec<f64>) -> Constraints {
+    Constraints {
+        unknowns,
+        directions,
+    }
 }
 
 /// The bar: `n` nodes, `C = m I + k L` with `L` the free bar's difference matrix (rows `1, −1`
 /// at the ends, `−1, 2, −1` inside). Dyadic entries, so that products with dyadic `z` are exact;
 /// an M-matrix with `C 1 = m 1`, so `C⁻¹ >= 0` and `‖C⁻¹‖∞ = 1/m` (= 64: soft, so that the
-/// displacement check can bind before the force check), and Hager's estimate is exact.
+/// displacement check can bind before the force check), and Hager's estimate is exact. A lower
+/// bound at its left end (`s = +1`) and an upper one at its right end.
 const BAR_NODES: usize = 8;
 const BAR_MASS: f64 = 1.0 / 64.0;
 const BAR_STIFFNESS: f64 = 4.0;
+const BAR_Z: [f64; BAR_NODES] = [0.5, 0.625, 0.75, 0.8125, 0.75, 0.5, 0.125, -0.25];
 
 fn bar_matrix() -> SymTridiag {
     let n = BAR_NODES;
@@ -369,53 +278,25 @@ fn bar_dense() -> DMatrix<f64> {
     })
 }
 
-/// A lower bound at the bar's left end (`s = +1`) and an upper one at its right end.
-fn bar_constraints() -> (Constraints, Option<Friction>) {
-    let constraints = Constraints {
-        unknowns: vec![0, BAR_NODES - 1],
-        directions: vec![1.0, -1.0],
-    };
-    (constraints, None)
+fn bar_rows() -> (Constraints, Option<Friction>) {
+    (constraints(vec![0, BAR_NODES - 1], vec![1.0, -1.0]), None)
 }
 
-const BAR_Z: [f64; BAR_NODES] = [0.5, 0.625, 0.75, 0.8125, 0.75, 0.5, 0.125, -0.25];
-
-/// The bar as the bar's solvers hold it, a `TridiagSystem`.
+/// The bar as the bar's solvers hold it (`TridiagSystem`), and as a `SparseSystem`: its dyadic
+/// entries make the sparse floors testable.
 fn bar() -> Body<TridiagSystem> {
-    let system = || TridiagSystem::new(&bar_matrix()).expect("C is positive definite");
-    let (c, z) = (bar_dense(), BAR_Z.to_vec());
-    Body::new("bar", c, TRIDIAG_ULPS, bar_constraints(), z, system)
+    let system = |_: &_| TridiagSystem::new(&bar_matrix()).expect("C is positive definite");
+    Body::new(
+        "bar",
+        (bar_dense(), TRIDIAG_ULPS, system),
+        bar_rows(),
+        BAR_Z.to_vec(),
+    )
 }
 
-/// The bar's matrix held as the plane body's solvers hold theirs, a `SparseSystem` on a
-/// `Pattern`: its dyadic entries make the sparse system's round-off floors testable.
 fn sparse_bar() -> Body<SparseSystem> {
-    let system = || {
-        let c = bar_dense();
-        let (mut row_ptr, mut cols, mut values) = (vec![0], Vec::new(), Vec::new());
-        for i in 0..BAR_NODES {
-            for j in i.saturating_sub(1)..(i + 2).min(BAR_NODES) {
-                cols.push(j);
-                values.push(c[(i, j)]);
-            }
-            row_ptr.push(cols.len());
-        }
-        let pattern = Pattern {
-            n: BAR_NODES,
-            row_ptr,
-            cols,
-        };
-        SparseSystem::new(&pattern, &values, "C").expect("C is positive definite")
-    };
-    let (c, z) = (bar_dense(), BAR_Z.to_vec());
-    Body::new(
-        "bar on a pattern",
-        c,
-        SPARSE_ULPS,
-        bar_constraints(),
-        z,
-        system,
-    )
+    let c = (bar_dense(), SPARSE_ULPS, sparse as fn(&_) -> _);
+    Body::new("bar on a pattern", c, bar_rows(), BAR_Z.to_vec())
 }
 
 /// The plane body: Q1 matrices on a grid of square cells (all degrees of freedom kept),
@@ -432,46 +313,37 @@ const VISCOSITY: f64 = 0.5;
 const X: usize = 0;
 const Y: usize = 1;
 
-fn plane_matrix(grid: &Grid) -> (Pattern, Vec<f64>) {
+fn plane_dense(grid: &Grid) -> DMatrix<f64> {
     let m = assemble(grid, MATERIAL);
     let (a, b) = (1.0 / (DT * DT), 0.5 + VISCOSITY / (2.0 * DT));
-    let values = (m.mass.iter().zip(&m.stiffness))
-        .map(|(m, k)| a * m + b * k)
-        .collect();
-    (m.pattern, values)
+    let (n, pattern) = (m.pattern.n, &m.pattern);
+    let mut c = DMatrix::zeros(n, n);
+    for row in 0..n {
+        for at in pattern.row_ptr[row]..pattern.row_ptr[row + 1] {
+            c[(row, pattern.cols[at])] = a * m.mass[at] + b * m.stiffness[at];
+        }
+    }
+    c
 }
 
 /// The plane body on 2 × 2 cells of the unit square, with the bottom edge's middle node pushed
-/// up (`u_y`, `s = +1`) and the top edge's middle node pushed down (`s = −1`).
+/// up (`u_y`, `s = +1`) and the top edge's middle node pushed down (`s = −1`); `z` a rigid
+/// motion and a little shear, so that `C z` stays small next to the reactions.
 fn plane_grid() -> Grid {
     Grid::new(1.0, 1.0, 2, 2, 1.0)
 }
 
 fn plane() -> Body<SparseSystem> {
-    let grid = plane_grid();
-    let (pattern, values) = plane_matrix(&grid);
-    let z = (0..pattern.n)
-        .map(|d| {
-            // A rigid motion and a little shear: C z stays small next to the reactions.
-            let (i, j) = grid.position(d / 2);
-            let (x, y) = (grid.xs[i], grid.ys[j]);
-            if d % 2 == 0 {
-                0.2 - 0.3 * y + 0.05 * x * y
-            } else {
-                -0.1 + 0.3 * x
-            }
-        })
-        .collect();
-    let constraints = Constraints {
-        unknowns: vec![2 * grid.node(1, 0) + Y, 2 * grid.node(1, 2) + Y],
-        directions: vec![1.0, -1.0],
-    };
-    let system = || {
-        let (pattern, values) = plane_matrix(&plane_grid());
-        SparseSystem::new(&pattern, &values, "C").expect("C is positive definite")
-    };
-    let c = dense(&pattern, &values);
-    Body::new("plane", c, SPARSE_ULPS, (constraints, None), z, system)
+    let (grid, c) = (plane_grid(), plane_dense(&plane_grid()));
+    let z = (0..c.nrows()).map(|d| {
+        let (i, j) = grid.position(d / 2);
+        let (x, y) = (grid.xs[i], grid.ys[j]);
+        [0.2 - 0.3 * y + 0.05 * x * y, -0.1 + 0.3 * x][d % 2]
+    });
+    let (bottom, top) = (2 * grid.node(1, 0) + Y, 2 * grid.node(1, 2) + Y);
+    let rows = constraints(vec![bottom, top], vec![1.0, -1.0]);
+    let c = (c, SPARSE_ULPS, sparse as fn(&_) -> _);
+    Body::new("plane", c, (rows, None), z.collect())
 }
 
 /// The frictional plane body on 4 × 6 cells: the normal constraints `(i, j, s)` at `u_y` of node
@@ -508,7 +380,7 @@ const PRESSED: f64 = 0.5;
 /// reading the wrong ones refuses the base answer.
 const GIVEN: [f64; P] = [0.125, 0.25, 0.0625];
 /// The start-up Tresca problem's thresholds (`g = 0`).
-const GIVEN_ZERO: [f64; P] = [0.0; P];
+const ZERO: [f64; P] = [0.0; P];
 /// A residual along the left edge's `u_x` with alternating signs (rows where `C z = 0`, so that
 /// `b = −residual` is exact): a stiff load, whose displacement stays small.
 const STIFF_ROWS: [(usize, usize, f64); 3] = [(0, 2, 1.0), (0, 3, -1.0), (0, 4, 1.0)];
@@ -522,33 +394,29 @@ fn dof(i: usize, j: usize, axis: usize) -> usize {
 }
 
 fn friction_plane() -> Body<SparseSystem> {
-    let (pattern, values) = plane_matrix(&friction_grid());
-    let c = dense(&pattern, &values);
-    let constraints = Constraints {
-        unknowns: NORMALS.iter().map(|&(i, j, _)| dof(i, j, Y)).collect(),
-        directions: NORMALS.iter().map(|&(.., s)| s).collect(),
-    };
+    let c = plane_dense(&friction_grid());
+    let normals = constraints(
+        NORMALS.iter().map(|&(i, j, _)| dof(i, j, Y)).collect(),
+        NORMALS.iter().map(|&(.., s)| s).collect(),
+    );
+    let tangents = FRICTIONAL
+        .iter()
+        .map(|&k| dof(NORMALS[k].0, NORMALS[k].1, X));
     let friction = Friction {
         normals: FRICTIONAL.to_vec(),
-        tangents: (FRICTIONAL.iter())
-            .map(|&k| dof(NORMALS[k].0, NORMALS[k].1, X))
-            .collect(),
+        tangents: tangents.collect(),
         coefficients: MU.to_vec(),
     };
-    let mut z = vec![0.0; pattern.n];
+    let mut z = vec![0.0; c.nrows()];
     for (i, j, axis, v) in Z_ENTRIES {
         z[dof(i, j, axis)] = v;
     }
-    for i in 0..pattern.n {
-        let terms = (0..pattern.n).filter(|&l| c[(i, l)] != 0.0 && z[l] != 0.0);
+    for i in 0..c.nrows() {
+        let terms = (0..c.nrows()).filter(|&l| c[(i, l)] != 0.0 && z[l] != 0.0);
         assert!(terms.count() <= 1, "row {i} of C meets two entries of z");
     }
-    let system = || {
-        let (pattern, values) = plane_matrix(&friction_grid());
-        SparseSystem::new(&pattern, &values, "C").expect("C is positive definite")
-    };
-    let rows = (constraints, Some(friction));
-    Body::new("frictional plane", c, SPARSE_ULPS, rows, z, system)
+    let c = (c, SPARSE_ULPS, sparse as fn(&_) -> _);
+    Body::new("frictional plane", c, (normals, Some(friction)), z)
 }
 
 /// An answer: `z`, the reactions `r` (normals, then tangents), the bounds `lo`, the previous
@@ -565,7 +433,7 @@ struct Answer {
 impl Answer {
     /// `δ_j = (z + w)_{t_j}`, as the audit rounds it.
     fn slip<S>(&self, body: &Body<S>, j: usize) -> f64 {
-        self.z[body.rows[body.m() + j].0] + self.w[j]
+        self.z[body.rows[body.m + j].0] + self.w[j]
     }
 
     /// Constraint `k` active (`lo_k = s_k z_{i_k}`).
@@ -578,21 +446,21 @@ impl Answer {
     /// positive part): `−g sign δ` where it slides, `g/2` where it sticks.
     fn settle<S>(&mut self, body: &Body<S>, case: &Case, j: usize) {
         let g = threshold(body, case, self, j).max(0.0);
-        let delta = if case.previous {
+        let delta = if case.previous() {
             self.slip(body, j)
         } else {
             0.0
         };
-        self.r[body.m() + j] = if delta != 0.0 {
-            -g * delta.signum()
-        } else {
+        self.r[body.m + j] = if delta == 0.0 {
             g / 2.0
+        } else {
+            -g * delta.signum()
         };
     }
 
     /// The tangential reactions of the frictional nodes of normal `k` settled again.
     fn settle_normal<S>(&mut self, body: &Body<S>, case: &Case, k: usize) {
-        for j in (0..body.p()).filter(|&j| FRICTIONAL[j] == k) {
+        for j in (0..body.p).filter(|&j| FRICTIONAL[j] == k) {
             self.settle(body, case, j);
         }
     }
@@ -600,17 +468,17 @@ impl Answer {
 
 /// `g_j` of the answer under the case's law, as documented: `μ_j r_N,k_j`, given, or 0.
 fn threshold<S>(body: &Body<S>, case: &Case, a: &Answer, j: usize) -> f64 {
-    match case.kind {
-        Kind::Coulomb => body.mu()[j] * a.r[FRICTIONAL[j]],
+    match case.1 {
+        Kind::Coulomb => body.mu[j] * a.r[FRICTIONAL[j]],
         Kind::Tresca(g) => g[j],
         _ => 0.0,
     }
 }
 
-/// The penalty answers are exact in f64 (every value dyadic with few bits, sums without
-/// rounding): their bounds are round-off floors, tens of ulps, so an answer rounded on the way
-/// would move by a few percent of its bound. This `z` makes `(C z)_i` exactly 0 at both ends and
-/// at node 3 (`C_00 z_0 = 4 z_1`, `z_2 = −z_4`), where a tiny reaction or residual stays exact.
+/// The round-off-level answers are exact in f64 (every value dyadic with few bits, sums without
+/// rounding): their bounds are tens of ulps, so an answer rounded on the way would move by a few
+/// percent of its bound. This `z` makes `(C z)_i` exactly 0 at both ends and at `FREE_NODE`
+/// (`C_00 z_0 = 4 z_1`, `z_2 = −z_4`), where a tiny reaction or residual stays exact.
 const EXACT_Z: [f64; BAR_NODES] = [
     0.5,
     0.5 + 1.0 / 512.0,
@@ -621,67 +489,66 @@ const EXACT_Z: [f64; BAR_NODES] = [
     -0.5 - 1.0 / 512.0,
     -0.5,
 ];
-/// The node of the exact stationarity residual.
 const FREE_NODE: usize = 3;
 
 /// The base answer of a case. Normal laws: every constraint active (`lo_k = s_k z_{i_k}`) under
-/// a unit reaction, at the round-off level on `EXACT_Z`, the penalty law's springs compressed by
-/// exactly `ε` (the law holds without rounding). Friction: the normals as `REACTIONS` and `GAPS`,
-/// the tangential reactions by the case's law, `w = PREVIOUS`.
+/// a unit reaction, on `EXACT_Z` at the round-off level, the penalty law's springs compressed
+/// by exactly `ε` (the law holds without rounding). Friction: the normals as `REACTIONS` and
+/// `GAPS`, the tangential reactions by the case's law, `w = PREVIOUS`.
 fn base<S>(body: &Body<S>, case: &Case) -> Answer {
     let friction = body.friction.is_some();
-    let z = match case.stop {
+    let z = match case.3 {
         Stop::Exact if !friction => EXACT_Z.to_vec(),
         _ => body.z.clone(),
     };
-    let (mut r, gaps) = if friction {
-        (REACTIONS.to_vec(), GAPS.to_vec())
-    } else {
-        (vec![1.0; body.m()], vec![0.0; body.m()])
+    let (mut r, gaps) = match friction {
+        true => (REACTIONS.to_vec(), GAPS.to_vec()),
+        false => (vec![1.0; body.m], vec![0.0; body.m]),
     };
-    r.resize(body.m() + body.p(), 0.0);
-    let epsilon = if let Kind::Penalty(e) = case.kind {
+    r.resize(body.m + body.p, 0.0);
+    let epsilon = if let Kind::Penalty(e) = case.1 {
         e
     } else {
         0.0
     };
-    let mut a = Answer {
-        lo: (body.rows[..body.m()].iter().zip(gaps))
-            .map(|(&(i, s), gap)| s * z[i] - gap + epsilon)
-            .collect(),
-        extra: vec![0.0; z.len()],
-        w: PREVIOUS[..body.p()].to_vec(),
-        z,
-        r,
-    };
-    for j in 0..body.p() {
+    let lo = (body.rows[..body.m].iter().zip(gaps)).map(|(&(i, s), gap)| s * z[i] - gap + epsilon);
+    let (lo, w, extra) = (
+        lo.collect(),
+        PREVIOUS[..body.p].to_vec(),
+        vec![0.0; z.len()],
+    );
+    let mut a = Answer { z, r, lo, w, extra };
+    for j in 0..body.p {
         a.settle(body, case, j);
     }
     a
 }
 
-/// The audit's quantities for one answer, from the documented formulas.
+/// The audit's quantities for one answer, from the documented formulas: `(value, tolerance)` of
+/// each check, the right-hand side, the solver's slacks `(s_f, s_z)` as the Tresca solver passes
+/// them, the force floor, the penalty law's bound of each constraint, and whether the recomputed
+/// stationarity residual is `extra`, bit for bit.
 struct Eval {
-    b: Vec<f64>,
-    /// The solver's slacks `(s_f, s_z)` as the Tresca solver passes them.
-    slack: (f64, f64),
-    tol_f: f64,
-    tol_z: f64,
-    tol_dz: f64,
-    floor_f: f64,
-    /// The penalty law's round-off bound of each constraint.
-    law_tol: Vec<f64>,
-    /// `(value, tolerance)` of each check, in the order of [`CHECKS`].
     checks: [(f64, f64); 8],
-    /// Whether the recomputed stationarity residual is `extra`, bit for bit.
+    tol: Tol,
+    b: Vec<f64>,
+    slack: (f64, f64),
+    floor_f: f64,
+    law_tol: Vec<f64>,
     exact: bool,
 }
 
 impl Eval {
-    fn ratio(&self, check: Check) -> f64 {
-        let (value, tolerance) = self.checks[check as usize];
-        ratio(value, tolerance)
+    fn ratio(&self, check: usize) -> f64 {
+        ratio(self.checks[check].0, self.checks[check].1)
     }
+}
+
+/// `τ_f`, `τ_z`, `τ_dz`.
+struct Tol {
+    f: f64,
+    z: f64,
+    dz: f64,
 }
 
 /// OSQP's stopping slack as the Tresca solver passes it (docs/friction.md, "Audit"):
@@ -691,12 +558,10 @@ fn tresca_slack<S>(body: &Body<S>, case: &Case, factor: f64, a: &Answer, b: &[f6
     let z0 = &body.c_inv * DVector::from_column_slice(b);
     let mut q = 0.0f64;
     for (k, &(i, s)) in body.rows.iter().enumerate() {
-        let w = if k < M || !case.previous {
-            0.0
-        } else {
-            a.w[k - M]
+        let (lo, w) = match k.checked_sub(M) {
+            None => (a.lo[k], 0.0),
+            Some(j) => (0.0, if case.previous() { a.w[j] } else { 0.0 }),
         };
-        let lo = if k < M { a.lo[k] } else { 0.0 };
         q = q.max(((s * z0[i] + w - lo) / body.sigma).abs());
     }
     let r_norm = amax(&a.r);
@@ -705,9 +570,16 @@ fn tresca_slack<S>(body: &Body<S>, case: &Case, factor: f64, a: &Answer, b: &[f6
     (factor * eps, factor * body.sigma * eps_q.max(eps))
 }
 
+/// Keeps in `worst` the pair `(value, tolerance)` with the larger ratio.
+fn keep(worst: &mut (f64, f64), pair: (f64, f64)) {
+    if ratio(pair.0, pair.1) >= ratio(worst.0, worst.1) {
+        *worst = pair;
+    }
+}
+
 /// The audit's checks of `a` under `case`, computed independently (see the module doc).
 fn evaluate<S>(body: &Body<S>, case: &Case, a: &Answer) -> Eval {
-    let (n, m) = (a.z.len(), body.m());
+    let (n, m) = (a.z.len(), body.m);
     let cz = &body.c * DVector::from_column_slice(&a.z);
     let mut b: Vec<f64> = (0..n).map(|i| cz[i] - a.extra[i]).collect();
     for (k, &(i, s)) in body.rows.iter().enumerate() {
@@ -723,10 +595,10 @@ fn evaluate<S>(body: &Body<S>, case: &Case, a: &Answer) -> Eval {
     let p_scale = (body.rows[..m].iter().zip(&a.lo))
         .fold(0.0f64, |s, (&(i, _), lo)| s.max(a.z[i].abs()).max(lo.abs()));
     // The slack in force, displacement and gaps.
-    let (s_f, s_dz, s_z, slack) = match case.stop {
+    let (e_a, e_r) = (MARGIN * EPS_ABS, MARGIN * EPS_REL);
+    let (s_f, s_dz, s_z, slack) = match case.3 {
         Stop::Exact => (0.0, 0.0, 0.0, (0.0, 0.0)),
-        Stop::Osqp { eps_abs, eps_rel } => {
-            let (e_a, e_r) = (MARGIN * eps_abs, MARGIN * eps_rel);
+        Stop::Osqp => {
             let force = e_a + e_r * cz_norm.max(b_norm).max(r_norm);
             (force, e_a + e_r * z_norm, e_a + e_r * p_scale, (0.0, 0.0))
         }
@@ -738,7 +610,7 @@ fn evaluate<S>(body: &Body<S>, case: &Case, a: &Answer) -> Eval {
     let ulp = body.ulps * f64::EPSILON;
     let floor_f = ulp * (body.c_norm * z_norm + b_norm + r_norm);
     let tol_f = s_f + floor_f;
-    // τ_dz and τ_z: with friction the rounding of the condensed problem's z (docs/friction.md).
+    // τ_dz and τ_z: with friction also the rounding of the condensed problem's z.
     let (tol_dz, tol_z) = if case.frictional() {
         let r_sum: f64 = a.r.iter().map(|v| v.abs()).sum();
         let floor = body.inv_norm * (tol_f + ulp * r_sum) + ulp * z_norm;
@@ -748,64 +620,54 @@ fn evaluate<S>(body: &Body<S>, case: &Case, a: &Answer) -> Eval {
     };
     let (mut primal, mut negative, mut comp, mut law) = (0.0f64, 0.0f64, (0.0, 0.0), (0.0, 0.0));
     let mut law_tol = vec![0.0; m];
-    let keep = |worst: &mut (f64, f64), pair: (f64, f64)| {
-        if ratio(pair.0, pair.1) >= ratio(worst.0, worst.1) {
-            *worst = pair;
-        }
-    };
     for (k, &(i, s)) in body.rows[..m].iter().enumerate() {
         let gap = s * a.z[i] - a.lo[k];
         negative = negative.max(-a.r[k]);
-        if let Kind::Penalty(epsilon) = case.kind {
-            let value = (epsilon * a.r[k] - (-gap).max(0.0)).abs();
-            let coupled: f64 = (body.rows[..m].iter().zip(&a.r))
-                .map(|(&(l, _), r)| body.c_inv[(i, l)].abs() * r.abs())
-                .sum();
-            // The reaction taken from stationarity when the spring 1/ε is stiffer than C_ii.
-            let row = if body.c[(i, i)] >= 1.0 / epsilon {
-                0.0
-            } else {
-                let abs_row: f64 = (0..n).map(|l| (body.c[(i, l)] * a.z[l]).abs()).sum();
-                epsilon * (abs_row + b[i].abs())
-            };
-            law_tol[k] =
-                ulp * (a.z[i].abs() + coupled + a.lo[k].abs() + (epsilon * a.r[k]).abs() + row);
-            keep(&mut law, (value, law_tol[k]));
-        } else {
+        let Kind::Penalty(epsilon) = case.1 else {
             primal = primal.max(-gap);
             let t = tol_z * a.r[k].abs() + tol_f * gap.abs();
             keep(&mut comp, ((a.r[k] * gap).abs(), t));
-        }
+            continue;
+        };
+        let value = (epsilon * a.r[k] - (-gap).max(0.0)).abs();
+        let coupled: f64 = (body.rows[..m].iter().zip(&a.r))
+            .map(|(&(l, _), r)| body.c_inv[(i, l)].abs() * r.abs())
+            .sum();
+        // The reaction taken from stationarity when the spring 1/ε is stiffer than C_ii.
+        let abs_row: f64 = (0..n).map(|l| (body.c[(i, l)] * a.z[l]).abs()).sum();
+        let from_gap = body.c[(i, i)] >= 1.0 / epsilon;
+        let row = if from_gap { 0.0 } else { abs_row + b[i].abs() };
+        law_tol[k] = ulp
+            * (a.z[i].abs() + coupled + a.lo[k].abs() + (epsilon * a.r[k]).abs() + epsilon * row);
+        keep(&mut law, (value, law_tol[k]));
     }
     let (mut cone, mut slip) = ((0.0, 0.0), (0.0, 0.0));
-    for j in 0..body.p() {
+    for j in 0..body.p {
         let (g, rt) = (threshold(body, case, a, j), a.r[m + j]);
         keep(&mut cone, ((rt.abs() - g).max(0.0), tol_f + ulp * g.abs()));
-        if case.previous {
+        if case.previous() {
             let delta = a.slip(body, j);
             let t = tol_f * delta.abs() + (tol_z + ulp * a.w[j].abs()) * (g.abs() + rt.abs());
             keep(&mut slip, ((g * delta.abs() + rt * delta).abs(), t));
         }
     }
+    let (stationarity, displacement) = ((residual.amax(), tol_f), (dz.amax(), tol_dz));
+    let exact = residual.iter().zip(&a.extra).all(|(x, y)| x == y);
+    let (pr, ng) = ((primal, tol_z), (negative, tol_f));
+    let checks = [pr, ng, comp, law, cone, slip, stationarity, displacement];
+    let tol = Tol {
+        f: tol_f,
+        z: tol_z,
+        dz: tol_dz,
+    };
     Eval {
+        checks,
+        tol,
         b,
         slack,
-        tol_f,
-        tol_z,
-        tol_dz,
         floor_f,
         law_tol,
-        exact: residual.iter().zip(&a.extra).all(|(x, y)| x == y),
-        checks: [
-            (primal, tol_z),
-            (negative, tol_f),
-            comp,
-            law,
-            cone,
-            slip,
-            (residual.amax(), tol_f),
-            (dz.amax(), tol_dz),
-        ],
+        exact,
     }
 }
 
@@ -816,17 +678,20 @@ fn audit<S: SpdSystem>(
     a: &Answer,
     e: &Eval,
 ) -> (KktAudit, Result<(), StepFailure>) {
-    let mut system = (body.system)();
-    let mut audit = KktAudit::new(&mut system, &body.constraints, case.family(&body.friction));
-    let slack = match case.stop {
+    let mut system = (body.system)(&body.c);
+    let (law, family) = case.law(body, a);
+    let mut audit = KktAudit::new(&mut system, &body.constraints, family);
+    let slack = match case.3 {
         Stop::Exact => Slack::NONE,
-        Stop::Osqp { eps_abs, eps_rel } => Slack::Osqp { eps_abs, eps_rel },
+        Stop::Osqp => Slack::Osqp {
+            eps_abs: EPS_ABS,
+            eps_rel: EPS_REL,
+        },
         Stop::Tresca(_) => Slack::Bounds {
             force: e.slack.0,
             displacement: e.slack.1,
         },
     };
-    let law = case.law(body.mu(), a);
     let verdict = audit.check(&mut system, law, slack, &e.b, &a.lo, &a.z, &a.r);
     (audit, verdict)
 }
@@ -836,41 +701,33 @@ fn audit<S: SpdSystem>(
 /// the second by `refused` (`placed` but for the frictional displacement check); then that the
 /// audit's ratios are the documented ones.
 fn bracket<S: SpdSystem>(
-    body: &Body<S>,
-    case: &Case,
-    (placed, refused): (Check, Check),
-    label: &str,
+    (body, case, label): (&Body<S>, &Case, &str),
+    (placed, refused): (usize, usize),
     base: &Answer,
     place: impl Fn(&mut Answer, f64, &Eval),
 ) {
+    let frictional = case.frictional();
+    let [placed_name, name] = [placed, refused].map(|c| NAMES[c][usize::from(frictional)]);
     let [inside, outside] = [1.0 - DELTA, 1.0 + DELTA].map(|f| {
-        let at = format!(
-            "{}, {} ({label}): {placed:?} at {f} × its tolerance",
-            body.name, case.name
-        );
+        let at = format!("{}, {} ({label}): {placed_name} at {f}", body.name, case.0);
         let mut a = base.clone();
         for _ in 0..PLACEMENT_ROUNDS {
             let e = evaluate(body, case, &a);
             place(&mut a, f, &e);
         }
         let e = evaluate(body, case, &a);
-        let at_ratio = e.ratio(placed);
-        assert!(
-            (at_ratio - f).abs() <= PLACEMENT,
-            "{at}: placed at {at_ratio}"
-        );
-        for other in CHECKS.into_iter().filter(|&c| c != placed && c != refused) {
-            let r = e.ratio(other);
-            assert!(r <= FAR_INSIDE, "{at}: {other:?} not far inside ({r})");
+        let off = (e.ratio(placed) - f).abs();
+        assert!(off <= PLACEMENT, "{at}: placed off by {off}");
+        for c in (0..8).filter(|&c| c != placed && c != refused) {
+            let (r, what) = (e.ratio(c), NAMES[c][0]);
+            assert!(r <= FAR_INSIDE, "{at}: {what} at {r}");
         }
         // The normal laws' answers: exact at round-off, Hager's share small otherwise.
-        match (case.frictional(), case.roundoff_level()) {
+        let share = body.inv_norm * e.floor_f / e.tol.dz;
+        match (frictional, case.3) {
             (true, _) => {}
-            (false, true) => assert!(e.exact, "{at}: the round-off-level answer is not exact"),
-            (false, false) => {
-                let share = body.inv_norm * e.floor_f / e.tol_dz;
-                assert!(share <= HAGER_SHARE, "{at}: floor share {share:e}");
-            }
+            (false, Stop::Exact) => assert!(e.exact, "{at}: the answer is not exact"),
+            (false, _) => assert!(share <= HAGER_SHARE, "{at}: floor share {share:e}"),
         }
         let (audit, verdict) = audit(body, case, &a, &e);
         (at, e, audit, verdict)
@@ -878,127 +735,113 @@ fn bracket<S: SpdSystem>(
     if let Err(err) = &inside.3 {
         panic!("{}: refused: {err}", inside.0);
     }
-    let name = refused.what(case.frictional());
-    let (what, value, tolerance) = match &outside.3 {
-        Err(StepFailure::AuditFailed {
-            what,
-            value,
-            tolerance,
-        }) => (*what, *value, *tolerance),
-        other => panic!("{}: not refused by `{name}`: {other:?}", outside.0),
+    let Err(StepFailure::AuditFailed {
+        what,
+        value,
+        tolerance,
+    }) = outside.3
+    else {
+        panic!("{}: not refused by `{name}`: {:?}", outside.0, outside.3);
     };
     assert_eq!(what, name, "{}: refused by another check", outside.0);
-    for c in CHECKS {
-        if let Some(reported) = c.reported(inside.2.report()) {
-            let expected = inside.1.ratio(c);
+    for (c, reported) in reported(inside.2.report()).into_iter().enumerate() {
+        if let Some(reported) = reported {
+            let (at, expected) = (&inside.0, inside.1.ratio(c));
+            let off = (reported - expected).abs();
             assert!(
-                (reported - expected).abs() <= AGREEMENT,
-                "{}: the audit's {c:?} ratio {reported} is not the documented {expected}",
-                inside.0
+                off <= AGREEMENT,
+                "{at}: {} ratio {reported}, not {expected}",
+                NAMES[c][0]
             );
         }
     }
-    let (v, t) = outside.1.checks[refused as usize];
+    let (v, t) = outside.1.checks[refused];
+    let off = (tolerance / t - 1.0).abs().max((value / v - 1.0).abs());
+    let at = &outside.0;
     assert!(
-        (tolerance / t - 1.0).abs() <= AGREEMENT && (value / v - 1.0).abs() <= AGREEMENT,
-        "{}: the audit's {value:e} against {tolerance:e} is not the documented {v:e} against {t:e}",
-        outside.0
+        off <= AGREEMENT,
+        "{at}: {value:e} against {tolerance:e}, not {v:e} against {t:e}"
     );
 }
 
-/// Constraint `k` and its direction, as a label.
-fn label<S>(body: &Body<S>, k: usize) -> String {
-    format!("constraint {k}, s = {}", body.rows[k].1)
-}
-
-/// Constraint `k` inactive (`r_k = 0`, its node's `r_T` by the law), its bound raised past
-/// `s_k z_{i_k}` by the violation.
-fn primal_violation_on<S: SpdSystem>(body: &Body<S>, cases: &[Case]) {
-    for case in cases {
-        for k in 0..body.m() {
-            let (i, s) = body.rows[k];
-            let mut a = base(body, case);
-            a.r[k] = 0.0;
-            a.settle_normal(body, case, k);
-            let checks = (Check::Primal, Check::Primal);
-            bracket(body, case, checks, &label(body, k), &a, |a, f, e| {
-                a.lo[k] = s * a.z[i] + f * e.tol_z;
-            });
-        }
-    }
-}
-
-#[test]
-fn primal_violation() {
-    primal_violation_on(&bar(), &[SIGNORINI]);
-    primal_violation_on(&plane(), &[SIGNORINI]);
-    primal_violation_on(&friction_plane(), &FRICTION_CASES);
-}
-
-/// Constraint `k` of `prepare`'s answer active with the reaction `−v`; under Coulomb its node's
-/// `r_T = 0` (the threshold `μ r_N` is negative, and the cone and slip law stay at `μ` times the
-/// ratio).
-fn negative_reaction_on<S: SpdSystem>(
+/// For each constraint `k` of each case: primal violation (`k` inactive, `r_k = 0`, its node's
+/// `r_T` by the law, its bound raised past `s_k z_{i_k}` by the violation); negative reaction
+/// (`k` of `prepare`'s answer active with the reaction `−v`; under Coulomb its node's `r_T = 0`,
+/// the threshold `μ r_N` being negative); complementarity (`k` pressed, `r > 0`, at a gap `g`:
+/// `r g = f (τ_z r + τ_f g)`, both with `r` of order 1 and with `g` of order 1).
+fn normal_checks<S: SpdSystem>(
     body: &Body<S>,
     cases: &[Case],
-    prepare: impl Fn(&mut Answer, &Case, usize),
+    checks: &[usize],
+    prepare: impl Fn(&mut Answer, usize),
 ) {
     for case in cases {
-        for k in 0..body.m() {
+        for k in 0..body.m {
+            let (i, s) = body.rows[k];
+            let label = format!("constraint {k}, s = {s}");
+            let at = (body, case, label.as_str());
             let mut a = base(body, case);
-            prepare(&mut a, case, k);
-            let checks = (Check::Negative, Check::Negative);
-            bracket(body, case, checks, &label(body, k), &a, |a, f, e| {
-                a.r[k] = -f * e.tol_f;
+            if checks.contains(&PRIMAL) {
+                a.r[k] = 0.0;
                 a.settle_normal(body, case, k);
-            });
+                bracket(at, (PRIMAL, PRIMAL), &a, |a, f, e| {
+                    a.lo[k] = s * a.z[i] + f * e.tol.z
+                });
+            }
+            if checks.contains(&NEGATIVE) {
+                let mut a = base(body, case);
+                prepare(&mut a, k);
+                bracket(at, (NEGATIVE, NEGATIVE), &a, |a, f, e| {
+                    a.r[k] = -f * e.tol.f;
+                    a.settle_normal(body, case, k);
+                });
+            }
+            if checks.contains(&COMPLEMENTARITY) {
+                let mut a = base(body, case);
+                if a.r[k] == 0.0 {
+                    a.r[k] = PRESSED;
+                    a.settle_normal(body, case, k);
+                }
+                bracket(at, (COMPLEMENTARITY, COMPLEMENTARITY), &a, |a, f, e| {
+                    let r = a.r[k];
+                    a.lo[k] = s * a.z[i] - f * e.tol.z * r / (r - f * e.tol.f);
+                });
+                // Inactive at a gap `G` under a small reaction: `r G = f (τ_z r + τ_f G)`.
+                let (mut a, gap) = (base(body, case), 0.25);
+                a.lo[k] = s * a.z[i] - gap;
+                bracket(at, (COMPLEMENTARITY, COMPLEMENTARITY), &a, |a, f, e| {
+                    a.r[k] = f * e.tol.f * gap / (gap - f * e.tol.z);
+                    a.settle_normal(body, case, k);
+                });
+            }
         }
     }
 }
 
-/// The penalty and round-off cases bound a negative reaction by the force floor `floor_f` (64
-/// ulps on the sparse system): a reaction `−v` at an end whose row of `C z` is exactly 0, for
-/// the penalty law with the constraint inactive (gap ¼).
+const ALL_NORMAL: [usize; 3] = [PRIMAL, NEGATIVE, COMPLEMENTARITY];
+
 #[test]
-fn negative_reaction() {
-    let (bar, plane, friction) = (bar(), plane(), friction_plane());
-    negative_reaction_on(&bar, &[SIGNORINI, SIGNORINI_EXACT], |_, _, _| {});
-    negative_reaction_on(&sparse_bar(), &[SIGNORINI_EXACT], |_, _, _| {});
-    negative_reaction_on(&bar, &[penalty(STIFF_SPRINGS)], |a, _, k| {
-        a.lo[k] -= STIFF_SPRINGS + 0.25;
-        a.r[k] = 0.0;
-    });
-    negative_reaction_on(&plane, &[SIGNORINI], |_, _, _| {});
-    negative_reaction_on(&friction, &FRICTION_CASES, |a, _, k| {
+fn primal_violation_negative_reaction_and_complementarity() {
+    normal_checks(&bar(), &[SIGNORINI], &ALL_NORMAL, |_, _| {});
+    normal_checks(&plane(), &[SIGNORINI], &ALL_NORMAL, |_, _| {});
+    let friction = friction_plane();
+    normal_checks(&friction, &FRICTION_CASES, &ALL_NORMAL, |a, k| {
         a.activate(&friction, k)
     });
 }
 
-/// Constraint `k` pressed (`r > 0`) at a gap `g`: `r g = f (τ_z r + τ_f g)`.
-fn complementarity_on<S: SpdSystem>(body: &Body<S>, cases: &[Case]) {
-    for case in cases {
-        for k in 0..body.m() {
-            let (i, s) = body.rows[k];
-            let mut a = base(body, case);
-            if a.r[k] == 0.0 {
-                a.r[k] = PRESSED;
-                a.settle_normal(body, case, k);
-            }
-            let checks = (Check::Complementarity, Check::Complementarity);
-            bracket(body, case, checks, &label(body, k), &a, |a, f, e| {
-                let r = a.r[k];
-                let gap = f * e.tol_z * r / (r - f * e.tol_f);
-                a.lo[k] = s * a.z[i] - gap;
-            });
-        }
-    }
-}
-
+/// At round-off a negative reaction is bounded by the force floor `floor_f` (64 ulps on the
+/// sparse system): a reaction `−v` at an end whose row of `C z` is exactly 0; for the penalty law
+/// with the constraint inactive (gap ¼).
 #[test]
-fn complementarity() {
-    complementarity_on(&bar(), &[SIGNORINI]);
-    complementarity_on(&plane(), &[SIGNORINI]);
-    complementarity_on(&friction_plane(), &FRICTION_CASES);
+fn negative_reaction_at_round_off() {
+    let bar = bar();
+    normal_checks(&bar, &[SIGNORINI_EXACT], &[NEGATIVE], |_, _| {});
+    normal_checks(&sparse_bar(), &[SIGNORINI_EXACT], &[NEGATIVE], |_, _| {});
+    normal_checks(&bar, &[penalty(STIFF_SPRINGS)], &[NEGATIVE], |a, k| {
+        a.lo[k] -= STIFF_SPRINGS + 0.25;
+        a.r[k] = 0.0;
+    });
 }
 
 /// Penalty parameters: `1/ε` softer than the bar's end entry `C_00 = 4 + 1/64` (reaction taken
@@ -1015,19 +858,16 @@ const STIFF_SPRINGS: f64 = 1.0 / 64.0;
 #[test]
 fn penalty_law() {
     let bar = bar();
-    for case in [penalty(SOFT_SPRINGS), penalty(STIFF_SPRINGS)] {
-        let Kind::Penalty(epsilon) = case.kind else {
-            unreachable!()
-        };
-        for k in 0..bar.m() {
+    for epsilon in [SOFT_SPRINGS, STIFF_SPRINGS] {
+        for k in 0..bar.m {
             let (i, s) = bar.rows[k];
-            let mut a = base(&bar, &case);
+            let mut a = base(&bar, &penalty(epsilon));
             a.z[i] = s / 1024.0;
             a.r[k] = 1.0 / 2048.0 / epsilon;
             a.lo[k] = s * a.z[i] + epsilon * a.r[k];
-            let at = format!("epsilon = {epsilon}, {}", label(&bar, k));
-            let checks = (Check::PenaltyLaw, Check::PenaltyLaw);
-            bracket(&bar, &case, checks, &at, &a, |a, f, e| {
+            let label = format!("epsilon = {epsilon}, constraint {k}, s = {s}");
+            let at = (&bar, &penalty(epsilon), label.as_str());
+            bracket(at, (PENALTY_LAW, PENALTY_LAW), &a, |a, f, e| {
                 a.lo[k] = (s * a.z[i] + epsilon * a.r[k]) - f * e.law_tol[k];
             });
         }
@@ -1046,11 +886,11 @@ fn friction_cone() {
             a.w[j] = -a.z[body.rows[M + j].0];
             let sign = if j % 2 == 0 { 1.0 } else { -1.0 };
             let label = format!("node {j}, sign {sign}");
-            let checks = (Check::Cone, Check::Cone);
-            bracket(&body, case, checks, &label, &a, |a, f, e| {
+            let at = (&body, case, label.as_str());
+            bracket(at, (CONE, CONE), &a, |a, f, e| {
                 let g = threshold(&body, case, a, j);
                 let ulp = SPARSE_ULPS * f64::EPSILON;
-                a.r[M + j] = sign * (g + f * (e.tol_f + ulp * g.abs()));
+                a.r[M + j] = sign * (g + f * (e.tol.f + ulp * g.abs()));
             });
         }
     }
@@ -1062,7 +902,7 @@ fn friction_cone() {
 #[test]
 fn slip_law() {
     let body = friction_plane();
-    for case in FRICTION_CASES.iter().filter(|c| c.previous) {
+    for case in FRICTION_CASES.iter().filter(|c| c.previous()) {
         for j in 0..P {
             let k = FRICTIONAL[j];
             let mut a = base(&body, case);
@@ -1075,12 +915,12 @@ fn slip_law() {
             assert_eq!(a.slip(&body, j), delta, "the slip is exact");
             a.settle(&body, case, j);
             let label = format!("node {j}, delta = {delta}");
-            let checks = (Check::Slip, Check::Slip);
-            bracket(&body, case, checks, &label, &a, |a, f, e| {
+            let at = (&body, case, label.as_str());
+            bracket(at, (SLIP, SLIP), &a, |a, f, e| {
                 let g = threshold(&body, case, a, j);
                 let ulp = SPARSE_ULPS * f64::EPSILON;
-                let t = e.tol_f * delta.abs()
-                    + (e.tol_z + ulp * a.w[j].abs()) * (g.abs() + a.r[M + j].abs());
+                let t = e.tol.f * delta.abs()
+                    + (e.tol.z + ulp * a.w[j].abs()) * (g.abs() + a.r[M + j].abs());
                 a.r[M + j] = -delta.signum() * (g - f * t / delta.abs());
             });
         }
@@ -1090,33 +930,31 @@ fn slip_law() {
 /// A residual `extra = v d` with `‖d‖∞ = 1`, placed at the force tolerance.
 fn stationarity_on<S: SpdSystem>(body: &Body<S>, cases: &[Case], label: &str, d: &[f64]) {
     for case in cases {
-        let a = base(body, case);
-        let checks = (Check::Stationarity, Check::Stationarity);
-        bracket(body, case, checks, label, &a, |a, f, e| {
+        let (a, at) = (base(body, case), (body, case, label));
+        bracket(at, (STATIONARITY, STATIONARITY), &a, |a, f, e| {
             for (x, y) in a.extra.iter_mut().zip(d) {
-                *x = f * e.tol_f * y;
+                *x = f * e.tol.f * y;
             }
         });
     }
 }
 
-/// OSQP's answers: a residual along the stiff mode `w`, `C w / ‖C w‖∞`, whose displacement stays
-/// small. At round-off (the penalty law, Signorini on the sparse system's 64 ulps) and with
-/// friction: a residual at rows where `C z` is exactly 0, so that it is exact (the bar's node 3;
-/// `±1` at `STIFF_ROWS`). The penalty answers' displacement check, `‖C⁻¹ ρ‖∞ <= ‖C⁻¹‖∞ floor_f`,
-/// cannot fail while stationarity holds (Hager's estimate is exact for the bar's `C`).
 /// `C w / ‖C w‖∞` along the stiff mode `w`.
 fn stiff<S>(body: &Body<S>) -> Vec<f64> {
     let cw = &body.c * DVector::from_column_slice(&body.stiff);
     cw.iter().map(|y| y / cw.amax()).collect()
 }
 
+/// OSQP's answers: a residual along the stiff mode, whose displacement stays small. At round-off
+/// (the penalty law, Signorini on the sparse system's 64 ulps) and with friction: a residual at
+/// rows where `C z` is exactly 0, so that it is exact (the bar's `FREE_NODE`; `±1` at
+/// `STIFF_ROWS`). The penalty answers' displacement check, `‖C⁻¹ ρ‖∞ <= ‖C⁻¹‖∞ floor_f`, cannot
+/// fail while stationarity holds (Hager's estimate is exact for the bar's `C`).
 #[test]
 fn stationarity() {
     let (bar, plane) = (bar(), plane());
     stationarity_on(&bar, &[SIGNORINI], "stiff residual", &stiff(&bar));
-    let plane_d = stiff(&plane);
-    stationarity_on(&plane, &[SIGNORINI], "stiff residual", &plane_d);
+    stationarity_on(&plane, &[SIGNORINI], "stiff residual", &stiff(&plane));
     let mut free = vec![0.0; BAR_NODES];
     free[FREE_NODE] = 1.0;
     stationarity_on(&bar, &[penalty(STIFF_SPRINGS)], "exact residual", &free);
@@ -1135,11 +973,10 @@ fn stationarity() {
 /// displacement is `d`, `‖d‖∞ = v`, while `‖C d‖∞ = v ‖C w‖∞` stays far below the force bound.
 fn soft_residual<S: SpdSystem>(body: &Body<S>) {
     let cw = &body.c * DVector::from_column_slice(&body.soft);
-    let a = base(body, &SIGNORINI);
-    let checks = (Check::Displacement, Check::Displacement);
-    bracket(body, &SIGNORINI, checks, "soft residual", &a, |a, f, e| {
+    let (a, at) = (base(body, &SIGNORINI), (body, &SIGNORINI, "soft residual"));
+    bracket(at, (DISPLACEMENT, DISPLACEMENT), &a, |a, f, e| {
         for (x, y) in a.extra.iter_mut().zip(cw.iter()) {
-            *x = f * e.tol_dz * y;
+            *x = f * e.tol.dz * y;
         }
     });
 }
@@ -1153,34 +990,30 @@ fn soft_residual<S: SpdSystem>(body: &Body<S>) {
 #[test]
 fn stationarity_in_displacement() {
     let bar = bar();
-    assert!(
-        (bar.inv_norm * BAR_MASS - 1.0).abs() <= 1e-12,
-        "‖C⁻¹‖∞ = 1/m"
-    );
+    let off = (bar.inv_norm * BAR_MASS - 1.0).abs();
+    assert!(off <= 1e-12, "‖C⁻¹‖∞ = 1/m");
     soft_residual(&bar);
     soft_residual(&plane());
     let body = friction_plane();
     let row_sum = |i: usize| body.c_inv.row(i).iter().map(|v| v.abs()).sum::<f64>();
-    let top = (0..body.z.len())
-        .max_by(|&p, &q| row_sum(p).total_cmp(&row_sum(q)))
-        .expect("C has rows");
-    let signs: Vec<f64> = body.c_inv.row(top).iter().map(|v| v.signum()).collect();
-    for case in FRICTION_CASES.iter().filter(|c| c.roundoff_level()) {
+    let top = (0..body.z.len()).max_by(|&p, &q| row_sum(p).total_cmp(&row_sum(q)));
+    let row = body.c_inv.row(top.expect("C has rows"));
+    let signs: Vec<f64> = row.iter().map(|v| v.signum()).collect();
+    for case in FRICTION_CASES.iter().filter(|c| matches!(c.3, Stop::Exact)) {
         let mut a = base(&body, case);
         a.r.fill(0.0);
         for k in 0..M {
             a.activate(&body, k);
         }
-        let checks = (Check::Displacement, Check::Stationarity);
-        let label = "residual along C⁻¹'s largest row";
-        bracket(&body, case, checks, label, &a, |a, f, e| {
+        let at = (&body, case, "residual along C⁻¹'s largest row");
+        bracket(at, (DISPLACEMENT, STATIONARITY), &a, |a, f, e| {
             // The residual is `extra` up to the rounding of `b` where `C z ≠ 0`: rescale by the
             // measured ratio.
-            let (v, ratio) = (amax(&a.extra), e.checks[Check::Displacement as usize]);
+            let (v, (value, tol)) = (amax(&a.extra), e.checks[DISPLACEMENT]);
             let v = if v == 0.0 {
-                f * e.tol_dz / body.inv_norm
+                f * tol / body.inv_norm
             } else {
-                v * f * ratio.1 / ratio.0
+                v * f * tol / value
             };
             for (x, s) in a.extra.iter_mut().zip(&signs) {
                 *x = s * v;
@@ -1192,98 +1025,52 @@ fn stationarity_in_displacement() {
 #[test]
 fn hager_estimate_is_exact_on_the_frictional_body() {
     let body = friction_plane();
-    let estimate = inverse_norm_estimate(&mut (body.system)());
+    let estimate = inverse_norm_estimate(&mut (body.system)(&body.c));
+    let (error, norm) = ((estimate / body.inv_norm - 1.0).abs(), body.inv_norm);
     assert!(
-        (estimate / body.inv_norm - 1.0).abs() <= HAGER_EXACT,
-        "Hager's {estimate} against ‖C⁻¹‖∞ = {}",
-        body.inv_norm
+        error <= HAGER_EXACT,
+        "Hager's {estimate} against ‖C⁻¹‖∞ = {norm}"
     );
 }
 
-/// Every body with the cases it is audited under.
-fn for_each_case(mut f: impl FnMut(&dyn Fn(&Case) -> Outcome, &Case)) {
-    let (bar, sparse, plane, friction) = (bar(), sparse_bar(), plane(), friction_plane());
-    let cases = [
-        SIGNORINI,
-        SIGNORINI_EXACT,
-        penalty(SOFT_SPRINGS),
-        penalty(STIFF_SPRINGS),
-    ];
-    for case in &cases {
-        f(&|c| outcome(&bar, c), case);
-    }
-    f(&|c| outcome(&sparse, c), &SIGNORINI_EXACT);
-    f(&|c| outcome(&plane, c), &SIGNORINI);
-    for case in &FRICTION_CASES {
-        f(&|c| outcome(&friction, c), case);
-    }
-}
-
-/// A case's base answer: its evaluation, the audit's report and verdict, and the verdicts on
-/// the answer with a NaN `z`, an infinite normal and a NaN last reaction.
-struct Outcome {
-    eval: Eval,
-    report: AuditReport,
-    verdict: Result<(), StepFailure>,
-    non_finite: Vec<Result<(), StepFailure>>,
-}
-
-fn outcome<S: SpdSystem>(body: &Body<S>, case: &Case) -> Outcome {
-    let a = base(body, case);
-    let eval = evaluate(body, case, &a);
-    let (checked, verdict) = audit(body, case, &a, &eval);
-    let non_finite = [(0, f64::NAN), (1, f64::INFINITY), (2, f64::NAN)].map(|(what, value)| {
-        let mut bad = a.clone();
-        match what {
-            0 => bad.z[0] = value,
-            1 => bad.r[0] = value,
-            _ => *bad.r.last_mut().expect("reactions") = value,
+/// Each case's base answer satisfies its law: the audit accepts it with every ratio far inside,
+/// and its report lists exactly the law's checks. A non-finite `z`, normal or last (with friction
+/// tangential) reaction is refused before any check.
+fn base_answers<S: SpdSystem>(body: &Body<S>, cases: &[Case]) {
+    for case in cases {
+        let a = base(body, case);
+        let e = evaluate(body, case, &a);
+        let at = format!("{}, {}", body.name, case.0);
+        for (c, [what, _]) in NAMES.iter().enumerate() {
+            assert!(e.ratio(c) <= FAR_INSIDE, "{at}: {what}");
         }
-        audit(body, case, &bad, &eval).1
-    });
-    Outcome {
-        eval,
-        report: checked.report().clone(),
-        verdict,
-        non_finite: non_finite.to_vec(),
-    }
-}
-
-/// The base answers satisfy their laws: the audit accepts them with every ratio far inside,
-/// and its report lists exactly the law's checks.
-#[test]
-fn base_answers_are_accepted_and_reported() {
-    for_each_case(|run, case| {
-        let o = run(case);
-        for c in CHECKS {
-            assert!(o.eval.ratio(c) <= FAR_INSIDE, "{}: {c:?}", case.name);
-        }
-        o.verdict
-            .unwrap_or_else(|err| panic!("{}: {err}", case.name));
-        let penalty = matches!(case.kind, Kind::Penalty(_));
-        let listed = [
-            (Check::Primal, !penalty),
-            (Check::Complementarity, !penalty),
-            (Check::PenaltyLaw, penalty),
-            (Check::Cone, case.frictional()),
-            (Check::Slip, case.frictional()),
-            (Check::Negative, true),
-        ];
-        for (c, expected) in listed {
-            let reported = c.reported(&o.report).is_some();
-            assert_eq!(reported, expected, "{}: {c:?} listed", case.name);
-        }
-    });
-}
-
-/// A non-finite `z`, normal or last (with friction tangential) reaction is refused before any
-/// check.
-#[test]
-fn non_finite_answers() {
-    for_each_case(|run, case| {
-        for verdict in run(case).non_finite {
+        let (checked, verdict) = audit(body, case, &a, &e);
+        verdict.unwrap_or_else(|err| panic!("{at}: {err}"));
+        let (penalty, friction) = (matches!(case.1, Kind::Penalty(_)), case.frictional());
+        let (normal, all) = (!penalty, true);
+        let listed = [normal, all, normal, penalty, friction, friction, all, all];
+        let reported = reported(checked.report()).map(|r| r.is_some());
+        assert_eq!(reported, listed, "{at}: the checks the report lists");
+        for what in 0..3 {
+            let mut bad = a.clone();
+            match what {
+                0 => bad.z[0] = f64::NAN,
+                1 => bad.r[0] = f64::INFINITY,
+                _ => *bad.r.last_mut().expect("reactions") = f64::NAN,
+            }
+            let verdict = audit(body, case, &bad, &e).1;
             let refused = matches!(verdict, Err(StepFailure::NonFinite));
-            assert!(refused, "{}: {verdict:?}", case.name);
+            assert!(refused, "{at}: {verdict:?}");
         }
-    });
+    }
+}
+
+#[test]
+fn base_answers_are_accepted_and_non_finite_ones_refused() {
+    let penalties = [penalty(SOFT_SPRINGS), penalty(STIFF_SPRINGS)];
+    base_answers(&bar(), &[SIGNORINI, SIGNORINI_EXACT]);
+    base_answers(&bar(), &penalties);
+    base_answers(&sparse_bar(), &[SIGNORINI_EXACT]);
+    base_answers(&plane(), &[SIGNORINI]);
+    base_answers(&friction_plane(), &FRICTION_CASES);
 }
