@@ -14,6 +14,7 @@
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::sparse::Pattern;
 use crate::linalg::system::SparseSystem;
+use crate::step::law::Law;
 use crate::step::solver::Constraints;
 use crate::step::{SetupError, SolveInfo, StepFailure, StepSolver};
 
@@ -87,7 +88,10 @@ impl Objective<'_> {
         }
         for k in 0..self.constraints.len() {
             let (i, s) = (self.constraints.unknowns[k], self.constraints.directions[k]);
-            let r = compression(self.constraints, k, self.lower, z).max(0.0) / self.epsilon;
+            let r = Law::penalty_reaction(
+                compression(self.constraints, k, self.lower, z),
+                self.epsilon,
+            );
             g -= r * s * d[i];
         }
         g
@@ -247,7 +251,7 @@ impl StepSolver for SparsePenaltySolver {
             minimiser = alpha == 1.0;
         }
         for (k, r) in reactions.iter_mut().enumerate() {
-            *r = compression(&self.constraints, k, lower, z).max(0.0) / self.epsilon;
+            *r = Law::penalty_reaction(compression(&self.constraints, k, lower, z), self.epsilon);
         }
         Ok(SolveInfo { iterations })
     }
