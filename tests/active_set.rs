@@ -10,7 +10,9 @@ use proptest::prelude::*;
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
 use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::step::StepSolver;
+use viscobar::step::audit::Slack;
 use viscobar::step::block_pivot::BlockPivoting;
+use viscobar::step::law::Law;
 use viscobar_certificate::solvers::oracle::brute_force;
 
 fn solve(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64]) -> (Vec<f64>, Vec<f64>, u32) {
@@ -253,6 +255,7 @@ struct Checked {
     fast: BlockPivoting,
     reference: BlockPivoting,
     audit: viscobar::step::audit::KktAudit,
+    system: viscobar::internals::linalg::system::TridiagSystem,
     z_ref: Vec<f64>,
     r_ref: Vec<f64>,
     steps: std::rc::Rc<std::cell::Cell<usize>>,
@@ -283,11 +286,8 @@ impl StepSolver for Checked {
                 .zip(&self.r_ref)
                 .all(|(a, b)| a.to_bits() == b.to_bits())
         );
-        let law = viscobar::step::audit::Law::Signorini {
-            eps_abs: 0.0,
-            eps_rel: 0.0,
-        };
-        self.audit.check(law, rhs, lower, z, reactions)?;
+        let (law, slack) = (Law::Signorini, Slack::NONE);
+        (self.audit).check(&mut self.system, law, slack, rhs, lower, z, reactions)?;
         self.steps.set(self.steps.get() + 1);
         Ok(info)
     }
@@ -300,6 +300,7 @@ impl StepSolver for Checked {
 fn obstacle_runs_meet_kkt_at_the_round_off_floors_at_every_step() {
     use viscobar::bar::Discretisation;
     use viscobar::step::audit::KktAudit;
+    use viscobar::step::law::LawFamily;
     let bench = |elements: u64, ratio: f64| {
         let dt = ratio / elements as f64;
         common::builtin(
@@ -340,10 +341,16 @@ fn obstacle_runs_meet_kkt_at_the_round_off_floors_at_every_step() {
         let nodes = disc.constrained_locals();
         let c = &disc.step_matrix;
         let steps = std::rc::Rc::new(std::cell::Cell::new(0));
+        let mut system = viscobar::internals::linalg::system::TridiagSystem::new(c).unwrap();
         let checked = Checked {
             fast: BlockPivoting::new(c, &nodes).unwrap(),
             reference: BlockPivoting::new(c, &nodes).unwrap().with_full_solves(),
-            audit: KktAudit::new(c, &nodes, false).unwrap(),
+            audit: KktAudit::new(
+                &mut system,
+                &viscobar::step::Constraints::lower_bounds(&nodes),
+                LawFamily::Signorini,
+            ),
+            system,
             z_ref: vec![0.0; c.dim()],
             r_ref: vec![0.0; nodes.len()],
             steps: steps.clone(),

@@ -7,12 +7,13 @@
 //! `r = 0` without it. The start-up step (no `u^{−1}`) is the frictionless projection (the
 //! normals' SPD LCP, [`DenseLcp`]). On the cone's boundary `r_T` is set to `∓μ r_N` exactly;
 //! `z` then comes from `C z = b + Eᵀ r` by a second solve. Every answer is audited
-//! ([`crate::step::friction_audit`]). Derivation, termination, audit:
+//! ([`crate::step::audit`]). Derivation, termination, audit:
 //! `docs/friction.md`.
 
 use crate::linalg::system::SpdSystem;
+use crate::step::audit::{KktAudit, Slack};
 use crate::step::condensed_lcp::condensed_matrix;
-use crate::step::friction_audit::{FrictionAudit, FrictionLaw, Thresholds};
+use crate::step::law::{Law, LawFamily, Slip};
 use crate::step::lcp::{DenseLcp, LcpError};
 use crate::step::lemke::Lemke;
 use crate::step::solver::{Constraints, Friction};
@@ -77,7 +78,7 @@ pub struct CondensedLemke<S: SpdSystem> {
     x: Vec<f64>,
     q_normal: Vec<f64>,
     w_normal: Vec<f64>,
-    audit: FrictionAudit,
+    audit: KktAudit,
 }
 
 impl<S: SpdSystem> CondensedLemke<S> {
@@ -102,7 +103,7 @@ impl<S: SpdSystem> CondensedLemke<S> {
         let sigma = (0..k).map(|i| s[i * k + i]).fold(0.0, f64::max);
         let matrix = stewart_trinkle_matrix(&s, m, &friction, sigma);
         let n = m + 3 * p;
-        let audit = FrictionAudit::new(&mut system, &constraints, &friction);
+        let audit = KktAudit::new(&mut system, &constraints, LawFamily::Frictional(&friction));
         Ok(Self {
             system,
             constraints,
@@ -216,17 +217,18 @@ impl<S: SpdSystem> StepSolver for CondensedLemke<S> {
             }
             self.system.solve_in_place(z);
         }
-        let law = FrictionLaw {
-            thresholds: if self.slip_known {
-                Thresholds::Coulomb
-            } else {
-                Thresholds::Zero
-            },
-            previous: self.slip_known.then_some(&self.previous[..]),
-            slack_force: 0.0,
-            slack_displacement: 0.0,
+        let law = if self.slip_known {
+            Law::Coulomb {
+                mu: &self.friction.coefficients,
+                slip: Slip {
+                    previous: &self.previous,
+                },
+            }
+        } else {
+            Law::Frictionless
         };
-        (self.audit).check(&mut self.system, law, rhs, lower, z, reactions)?;
+        let slack = Slack::NONE;
+        (self.audit).check(&mut self.system, law, slack, rhs, lower, z, reactions)?;
         Ok(SolveInfo { iterations })
     }
 

@@ -15,12 +15,15 @@
 //! stable: `docs/step-solvers.md#end-penalty`.
 
 use crate::linalg::kernels::ldlt::RowChange;
+use crate::linalg::system::TridiagSystem;
 use crate::linalg::tridiag::SymTridiag;
-use crate::step::audit::{KktAudit, Law, reaction_from_gap};
+use crate::step::audit::{KktAudit, Slack};
+use crate::step::law::{Law, LawFamily, reaction_from_gap};
 use crate::step::schur::{
     StepFactor, constraint_rows, factor_each_subset, least_violating, masked_solve, row_product,
     schur_complement,
 };
+use crate::step::solver::Constraints;
 use crate::step::{SettingsError, SetupError, SolveInfo, SolverReport, StepFailure, StepSolver};
 
 /// ε of the penalised problem unless set: penetration ≈ ε × reaction, so about 1e-6 for the
@@ -77,6 +80,8 @@ pub struct EndPenalty {
     springs: Vec<StepFactor>,
     /// The support of the last answer, tried first.
     previous: u8,
+    /// `C` with its factorisation, for the audit.
+    system: TridiagSystem,
     audit: KktAudit,
 }
 
@@ -103,7 +108,9 @@ impl EndPenalty {
         }
         let stiffness = 1.0 / epsilon;
         let springs = factor_each_subset(c, nodes, RowChange::AddToDiagonal(stiffness), true)?;
-        let audit = KktAudit::new(c, nodes, true)?;
+        let mut system = TridiagSystem::new(c)?;
+        let constraints = Constraints::lower_bounds(nodes);
+        let audit = KktAudit::new(&mut system, &constraints, LawFamily::Penalty);
         Ok(Self {
             epsilon,
             factor,
@@ -118,6 +125,7 @@ impl EndPenalty {
             }),
             springs,
             previous: 0,
+            system,
             audit,
         })
     }
@@ -226,8 +234,8 @@ impl StepSolver for EndPenalty {
         let law = Law::Penalty {
             epsilon: self.epsilon,
         };
-        self.audit
-            .check(law, rhs, &lower[..k], z, &reactions[..k])?;
+        let (lower, reactions) = (&lower[..k], &reactions[..k]);
+        (self.audit).check(&mut self.system, law, Slack::NONE, rhs, lower, z, reactions)?;
         Ok(SolveInfo { iterations: tried })
     }
 

@@ -2,8 +2,9 @@
 //! seam, for every body: condensation onto the constraints with an exact LCP solve (any body),
 //! enumeration over the bar's two ends and block pivoting for its obstacle (tridiagonal
 //! kernels), penalty and OSQP; with Coulomb friction, Lemke's method on the condensed LCP and
-//! OSQP's Tresca fixed point; with the independent audits of their answers. Which one serves a
-//! scene's `[solver] method` on each body is the table of [`algorithm`].
+//! OSQP's Tresca fixed point; the contact laws, and the independent audit of every answer
+//! against its law. Which one serves a scene's `[solver] method` on each body is the table of
+//! [`algorithm`].
 //!
 //! Imports only `crate::linalg`.
 
@@ -14,7 +15,7 @@ pub mod condensed_lcp;
 pub mod condensed_lemke;
 pub mod end_enumeration;
 pub mod end_penalty;
-pub mod friction_audit;
+pub mod law;
 pub mod lcp;
 pub mod lemke;
 pub mod osqp;

@@ -14,7 +14,8 @@
 
 use crate::linalg::system::{Csc, SpdSystem, TridiagSystem};
 use crate::linalg::tridiag::SymTridiag;
-use crate::step::audit::{AUDIT_MARGIN, INACCURATE_FACTOR, KktAudit, Law};
+use crate::step::audit::{AUDIT_MARGIN, INACCURATE_FACTOR, KktAudit, Slack};
+use crate::step::law::{Law, LawFamily};
 use crate::step::solver::Constraints;
 use crate::step::{
     OsqpStatus, SettingsError, SetupError, SolveInfo, SolverReport, StepFailure, StepSolver,
@@ -108,7 +109,9 @@ pub struct Osqp<S: SpdSystem = TridiagSystem> {
     q: Vec<f64>,
     x_prev: Vec<f64>,
     y_prev: Vec<f64>,
-    audit: KktAudit<S>,
+    /// `C` with its factorisation, for the audit.
+    system: S,
+    audit: KktAudit,
     inaccurate_steps: u64,
 }
 
@@ -238,7 +241,7 @@ impl Osqp<TridiagSystem> {
 impl<S: SpdSystem> Osqp<S> {
     /// Sets OSQP up for `C` (with its factorisation, for the audit) and the constraints.
     pub fn with_system(
-        system: S,
+        mut system: S,
         constraints: Constraints,
         settings: OsqpSettings,
     ) -> Result<Self, SetupError> {
@@ -269,7 +272,8 @@ impl<S: SpdSystem> Osqp<S> {
             q,
             x_prev: vec![0.0; n],
             y_prev: vec![0.0; k],
-            audit: KktAudit::with_system(system, constraints, false),
+            audit: KktAudit::new(&mut system, &constraints, LawFamily::Signorini),
+            system,
             inaccurate_steps: 0,
         })
     }
@@ -317,11 +321,12 @@ impl<S: SpdSystem> StepSolver for Osqp<S> {
             reactions[j] = 0.0 - y[j];
         }
         let factor = if inaccurate { INACCURATE_FACTOR } else { 1.0 };
-        let law = Law::Signorini {
+        let slack = Slack::Osqp {
             eps_abs: factor * self.settings.eps_abs,
             eps_rel: factor * self.settings.eps_rel,
         };
-        self.audit.check(law, rhs, lower, z, reactions)?;
+        let law = Law::Signorini;
+        (self.audit).check(&mut self.system, law, slack, rhs, lower, z, reactions)?;
         self.x_prev.copy_from_slice(z);
         self.y_prev.copy_from_slice(y);
         if inaccurate {

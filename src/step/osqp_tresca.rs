@@ -9,15 +9,15 @@
 //! (`S`, `q` of [`crate::step::condensed_lemke`]; its KKT conditions are Signorini on the normals and
 //! Tresca's law on the central slip), solved by OSQP, set up once and warm-started; `z` then
 //! from `C z = b + Eᵀ r`, and each answer audited against the Tresca law it solved
-//! ([`crate::step::friction_audit`]). The iteration starts from the previous step's normal
+//! ([`crate::step::audit`]). The iteration starts from the previous step's normal
 //! reactions and stops when they change by at most [`FIXED_POINT_TOL`] (relative); beyond
 //! [`FIXED_POINT_MAX_ITERATIONS`] it is an error. The start-up step is one QP with `g = 0`.
 
 use crate::linalg::norms::max_abs;
 use crate::linalg::system::{Csc, SpdSystem};
-use crate::step::audit::{AUDIT_MARGIN, INACCURATE_FACTOR};
+use crate::step::audit::{AUDIT_MARGIN, INACCURATE_FACTOR, KktAudit, Slack};
 use crate::step::condensed_lcp::condensed_matrix;
-use crate::step::friction_audit::{FrictionAudit, FrictionLaw, Thresholds};
+use crate::step::law::{Law, LawFamily, Slip};
 use crate::step::osqp::{OSQP_INFTY, OsqpSettings, accepted, identity_allowance, osqp_csc};
 use crate::step::solver::{Constraints, Friction};
 use crate::step::{SetupError, SolveInfo, SolverReport, StepFailure, StepSolver};
@@ -51,7 +51,7 @@ pub struct OsqpTresca<S: SpdSystem> {
     /// The normal reactions before the current Tresca problem.
     r_before: Vec<f64>,
     y_prev: Vec<f64>,
-    audit: FrictionAudit,
+    audit: KktAudit,
     inaccurate_steps: u64,
 }
 
@@ -107,7 +107,7 @@ impl<S: SpdSystem> OsqpTresca<S> {
             &settings.to_osqp(),
         )
         .map_err(|e| SetupError::Osqp(e.to_string()))?;
-        let audit = FrictionAudit::new(&mut system, &constraints, &friction);
+        let audit = KktAudit::new(&mut system, &constraints, LawFamily::Frictional(&friction));
         Ok(Self {
             system,
             constraints,
@@ -167,13 +167,17 @@ impl<S: SpdSystem> OsqpTresca<S> {
         let factor = AUDIT_MARGIN * if inaccurate { INACCURATE_FACTOR } else { 1.0 };
         let eps = self.settings.eps_abs + self.settings.eps_rel * max_abs(&reactions[..]);
         let eps_q = self.settings.eps_abs + self.settings.eps_rel * max_abs(&self.q);
-        let law = FrictionLaw {
-            thresholds: Thresholds::Given(&self.thresholds),
-            previous: self.slip_known.then_some(&self.previous[..]),
-            slack_force: factor * eps,
-            slack_displacement: factor * self.sigma * eps_q.max(eps),
+        let law = Law::Tresca {
+            thresholds: &self.thresholds,
+            slip: (self.slip_known).then_some(Slip {
+                previous: &self.previous,
+            }),
         };
-        (self.audit).check(&mut self.system, law, rhs, lower, z, reactions)?;
+        let slack = Slack::Bounds {
+            force: factor * eps,
+            displacement: factor * self.sigma * eps_q.max(eps),
+        };
+        (self.audit).check(&mut self.system, law, slack, rhs, lower, z, reactions)?;
         Ok(inaccurate)
     }
 }

@@ -14,6 +14,7 @@
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::sparse::Pattern;
 use crate::linalg::system::SparseSystem;
+use crate::step::law::Law;
 use crate::step::solver::Constraints;
 use crate::step::{SetupError, SolveInfo, StepFailure, StepSolver};
 
@@ -53,13 +54,6 @@ fn compression(constraints: &Constraints, k: usize, lower: &[f64], z: &[f64]) ->
     lower[k] - constraints.directions[k] * z[constraints.unknowns[k]]
 }
 
-/// The penalty law's reaction from the compression `lo_k − s_k z_{i_k}` of a constraint: normal
-/// compliance, `ε r_k = (lo_k − s_k z_{i_k})⁺`.
-#[inline]
-pub fn compliance_reaction(compression: f64, epsilon: f64) -> f64 {
-    compression.max(0.0) / epsilon
-}
-
 /// The step problem's `f` and its data.
 struct Objective<'a> {
     pattern: &'a Pattern,
@@ -94,7 +88,7 @@ impl Objective<'_> {
         }
         for k in 0..self.constraints.len() {
             let (i, s) = (self.constraints.unknowns[k], self.constraints.directions[k]);
-            let r = compliance_reaction(
+            let r = Law::penalty_reaction(
                 compression(self.constraints, k, self.lower, z),
                 self.epsilon,
             );
@@ -257,7 +251,7 @@ impl StepSolver for SemismoothPenalty {
             minimiser = alpha == 1.0;
         }
         for (k, r) in reactions.iter_mut().enumerate() {
-            *r = compliance_reaction(compression(&self.constraints, k, lower, z), self.epsilon);
+            *r = Law::penalty_reaction(compression(&self.constraints, k, lower, z), self.epsilon);
         }
         Ok(SolveInfo { iterations })
     }

@@ -20,12 +20,15 @@ use viscobar::internals::bar::body::make_solver;
 use viscobar::internals::linalg::kernels::ldlt::Ldlt;
 use viscobar::internals::linalg::norms::{max_abs, max_distance};
 use viscobar::internals::linalg::spectrum::reference::STURM_ERROR_ULPS;
+use viscobar::internals::linalg::system::TridiagSystem;
 use viscobar::internals::linalg::tridiag::SymTridiag;
 use viscobar::output::Tracker;
 use viscobar::scheme::RunError;
 use viscobar::scheme::StepRecord;
-use viscobar::step::audit::{KktAudit, Law};
+use viscobar::step::Constraints;
+use viscobar::step::audit::{KktAudit, Slack};
 use viscobar::step::block_pivot::TIE_ULPS;
+use viscobar::step::law::{Law, LawFamily};
 use viscobar::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
 
 /// What the last solve formed, shared between a run's [`Traced`] solver and its [`Live`]
@@ -47,7 +50,8 @@ struct Trace {
 /// on).
 struct Traced {
     inner: Box<dyn StepSolver>,
-    audit: Option<KktAudit>,
+    /// The audit with `C`'s factorisation.
+    audit: Option<(KktAudit, TridiagSystem)>,
     trace: Rc<RefCell<Trace>>,
 }
 
@@ -78,21 +82,25 @@ impl StepSolver for Traced {
                 dst.extend_from_slice(src);
             }
         }
-        let Some(audit) = self.audit.as_mut() else {
+        let Some((audit, system)) = self.audit.as_mut() else {
             return Ok(info);
         };
-        let law = Law::Signorini {
-            eps_abs: 0.0,
-            eps_rel: 0.0,
-        };
-        match audit.check(law, rhs, lower, z, reactions) {
+        match audit.check(
+            system,
+            Law::Signorini,
+            Slack::NONE,
+            rhs,
+            lower,
+            z,
+            reactions,
+        ) {
             Err(StepFailure::NonFinite) => Err(StepFailure::NonFinite),
             _ => Ok(info),
         }
     }
 
     fn report(&self) -> Option<SolverReport> {
-        self.audit.as_ref().map(|a| SolverReport {
+        self.audit.as_ref().map(|(a, _)| SolverReport {
             audit: a.report().clone(),
             inaccurate_steps: None,
         })
@@ -128,11 +136,12 @@ fn build(case: &Case, method: &str, trace: Rc<RefCell<Trace>>) -> Result<Simulat
     let disc = Discretisation::new(&scene)?;
     let inner = make_solver(&scene, &disc)?;
     let audit = match method {
-        "exact" => Some(KktAudit::new(
-            &disc.step_matrix,
-            &disc.constrained_locals(),
-            false,
-        )?),
+        "exact" => {
+            let mut system = TridiagSystem::new(&disc.step_matrix)?;
+            let constraints = Constraints::lower_bounds(&disc.constrained_locals());
+            let audit = KktAudit::new(&mut system, &constraints, LawFamily::Signorini);
+            Some((audit, system))
+        }
         _ => None,
     };
     Simulation::with_solver(

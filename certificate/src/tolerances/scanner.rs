@@ -77,8 +77,8 @@ fn reason(name: &str, file: &str) -> &'static str {
              the bound it implies, so a change in the audit's fails the test"
         }
         (
-            "EPS_ABS" | "EPS_REL" | "BAR_MASS" | "BAR_STIFFNESS" | "PLANE_DT" | "PLANE_VISCOSITY"
-            | "SOFT_SPRINGS" | "STIFF_SPRINGS" | "OSQP_EPS" | "DT" | "VISCOSITY" | "PRESSED",
+            "EPS_ABS" | "EPS_REL" | "BAR_MASS" | "BAR_STIFFNESS" | "SOFT_SPRINGS" | "STIFF_SPRINGS"
+            | "OSQP_EPS" | "DT" | "VISCOSITY" | "PRESSED",
             f,
         ) if f.ends_with("audit_bounds.rs") => "test data (a matrix or a setting), not a tolerance",
         ("PLACEMENT" | "AGREEMENT" | "FAR_INSIDE", f) if f.ends_with("audit_bounds.rs") => {
