@@ -7,13 +7,11 @@
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use viscobar::Scene;
-use viscobar::internals::bar::discretisation::Discretisation;
+use viscobar::bar::Discretisation;
 use viscobar::internals::linalg::system::TridiagSystem;
 use viscobar::internals::linalg::tridiag::SymTridiag;
-use viscobar::step::{
-    BlockPivoting, CondensedLcp, Constraints, EndEnumeration, EndPenalty, PenaltySettings,
-    StepSolver,
-};
+use viscobar::internals::step::{BlockPivoting, CondensedLcp, EndEnumeration, EndPenalty};
+use viscobar::step::{Constraints, PenaltySettings, StepSolver};
 
 /// The bar's step matrix at `elements` elements (both ends Signorini at gap 0).
 fn step_matrix(elements: u64) -> SymTridiag {

@@ -10,7 +10,7 @@ use std::cell::RefCell;
 use std::rc::Rc;
 use std::time::Instant;
 use viscobar::bar::Discretisation;
-use viscobar::step::block_pivot::BlockPivoting;
+use viscobar::internals::step::block_pivot::BlockPivoting;
 use viscobar::step::{SolveInfo, StepFailure, StepSolver};
 
 struct Shared(Rc<RefCell<BlockPivoting>>, Rc<RefCell<f64>>);

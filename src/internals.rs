@@ -82,3 +82,45 @@ pub mod plane {
         pub use crate::plane::stress::*;
     }
 }
+
+/// The step solvers of [`crate::step`], each in its module.
+pub mod step {
+    pub mod block_pivot {
+        pub use crate::step::block_pivot::*;
+    }
+    pub mod condensed_lcp {
+        pub use crate::step::condensed_lcp::*;
+    }
+    pub mod condensed_lemke {
+        pub use crate::step::condensed_lemke::*;
+    }
+    pub mod end_enumeration {
+        pub use crate::step::end_enumeration::*;
+    }
+    pub mod end_penalty {
+        pub use crate::step::end_penalty::*;
+    }
+    pub mod lcp {
+        pub use crate::step::lcp::*;
+    }
+    pub mod lemke {
+        pub use crate::step::lemke::*;
+    }
+    pub mod osqp {
+        pub use crate::step::osqp::*;
+    }
+    pub mod osqp_tresca {
+        pub use crate::step::osqp_tresca::*;
+    }
+    pub mod semismooth_penalty {
+        pub use crate::step::semismooth_penalty::*;
+    }
+    pub use crate::step::block_pivot::BlockPivoting;
+    pub use crate::step::condensed_lcp::CondensedLcp;
+    pub use crate::step::condensed_lemke::CondensedLemke;
+    pub use crate::step::end_enumeration::EndEnumeration;
+    pub use crate::step::end_penalty::EndPenalty;
+    pub use crate::step::osqp::Osqp;
+    pub use crate::step::osqp_tresca::OsqpTresca;
+    pub use crate::step::semismooth_penalty::SemismoothPenalty;
+}

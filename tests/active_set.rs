@@ -9,9 +9,9 @@ use viscobar_certificate::tolerances::oracle_agreement;
 use proptest::prelude::*;
 use viscobar::bar::matrices::{MatrixVariant, mass, stiffness};
 use viscobar::internals::linalg::tridiag::SymTridiag;
+use viscobar::internals::step::block_pivot::BlockPivoting;
 use viscobar::step::StepSolver;
 use viscobar::step::audit::Slack;
-use viscobar::step::block_pivot::BlockPivoting;
 use viscobar::step::law::Law;
 use viscobar_certificate::solvers::oracle::brute_force;
 
@@ -165,7 +165,7 @@ fn incremental_matches_reference(
     nodes: &[usize],
     steps: usize,
     mut data: impl FnMut(usize) -> (Vec<f64>, Vec<f64>),
-) -> viscobar::step::block_pivot::PivotWork {
+) -> viscobar::internals::step::block_pivot::PivotWork {
     let n = c.dim();
     let mut fast = BlockPivoting::new(c, nodes).unwrap();
     let mut reference = BlockPivoting::new(c, nodes).unwrap().with_full_solves();

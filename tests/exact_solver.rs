@@ -8,8 +8,8 @@ use viscobar_certificate::tolerances::{TIE_TOL, exact_tie, oracle_agreement};
 
 use proptest::prelude::*;
 use viscobar::internals::linalg::tridiag::SymTridiag;
+use viscobar::internals::step::end_enumeration::EndEnumeration;
 use viscobar::step::StepSolver;
-use viscobar::step::end_enumeration::EndEnumeration;
 
 /// KKT residuals of `(z, r)` against their per-case round-off bound (`kkt_ratio`) and its distance
 /// to the dense brute-force oracle against the a-posteriori bound of both answers

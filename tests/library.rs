@@ -68,7 +68,8 @@ fn with_solver_validates_its_scene() {
 #[test]
 fn osqp_settings_are_validated_by_the_solver() {
     use viscobar::internals::linalg::SymTridiag;
-    use viscobar::step::{Osqp, OsqpSettings, SetupError};
+    use viscobar::internals::step::Osqp;
+    use viscobar::step::{OsqpSettings, SetupError};
     let c = SymTridiag::new(vec![2.0; 4], vec![-1.0; 3]);
     let cases = [
         (

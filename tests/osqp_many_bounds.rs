@@ -12,11 +12,11 @@ use proptest::prelude::*;
 use viscobar::internals::linalg::kernels::ldlt::Ldlt;
 use viscobar::internals::linalg::norms::{max_abs, max_distance};
 use viscobar::internals::linalg::tridiag::SymTridiag;
+use viscobar::internals::step::block_pivot::BlockPivoting;
+use viscobar::internals::step::osqp::OSQP_DEFAULT_EPS;
+use viscobar::internals::step::osqp::{Osqp, OsqpSettings};
 use viscobar::step::StepSolver;
 use viscobar::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
-use viscobar::step::block_pivot::BlockPivoting;
-use viscobar::step::osqp::OSQP_DEFAULT_EPS;
-use viscobar::step::osqp::{Osqp, OsqpSettings};
 
 /// Largest problem drawn: large enough for many simultaneous contact changes, small enough that
 /// 200 cases of two OSQP solves each stay within seconds.

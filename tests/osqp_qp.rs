@@ -7,11 +7,11 @@ mod common;
 use proptest::prelude::*;
 use viscobar::internals::linalg::norms::max_abs;
 use viscobar::internals::linalg::tridiag::SymTridiag;
+use viscobar::internals::step::end_enumeration::EndEnumeration;
+use viscobar::internals::step::osqp::OSQP_DEFAULT_EPS;
+use viscobar::internals::step::osqp::{Osqp, OsqpSettings};
 use viscobar::step::StepSolver;
 use viscobar::step::audit::AUDIT_MARGIN;
-use viscobar::step::end_enumeration::EndEnumeration;
-use viscobar::step::osqp::OSQP_DEFAULT_EPS;
-use viscobar::step::osqp::{Osqp, OsqpSettings};
 
 /// OSQP's tolerance carried to the answer. The audit accepts a displacement-unit stationarity
 /// error and a primal violation up to `t_z = AUDIT_MARGIN·eps·(1 + ‖z‖)` and a multiplier (sign

@@ -12,12 +12,12 @@ use viscobar::RunError;
 use viscobar::Simulation;
 use viscobar::internals::linalg::norms::max_abs;
 use viscobar::internals::linalg::tridiag::SymTridiag;
+use viscobar::internals::step::end_penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::internals::step::end_penalty::PenaltySettings;
+use viscobar::internals::step::osqp::{OSQP_INFTY, Osqp, OsqpSettings, raw_problem};
 use viscobar::output::run_in_memory;
 use viscobar::scene::{MassVariant, Scene};
 use viscobar::step::audit::dual_tolerance;
-use viscobar::step::end_penalty::PENALTY_DEFAULT_EPSILON;
-use viscobar::step::end_penalty::PenaltySettings;
-use viscobar::step::osqp::{OSQP_INFTY, Osqp, OsqpSettings, raw_problem};
 use viscobar::step::{StepFailure, StepSolver};
 use viscobar::study::accuracy::observed_order;
 use viscobar::study::compare::compare;
@@ -645,7 +645,7 @@ fn penalty_solver_refuses_a_bad_epsilon_without_panicking() {
     let c = SymTridiag::new(vec![2.0, 2.0], vec![-1.0]);
     for eps in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         assert!(
-            viscobar::step::end_penalty::EndPenalty::new(
+            viscobar::internals::step::end_penalty::EndPenalty::new(
                 &c,
                 &[0],
                 PenaltySettings { epsilon: eps }

@@ -10,32 +10,36 @@
 
 pub mod algorithm;
 pub mod audit;
-pub mod block_pivot;
-pub mod condensed_lcp;
-pub mod condensed_lemke;
-pub mod end_enumeration;
-pub mod end_penalty;
+pub(crate) mod block_pivot;
+pub(crate) mod condensed_lcp;
+pub(crate) mod condensed_lemke;
+pub(crate) mod end_enumeration;
+pub(crate) mod end_penalty;
 pub mod law;
-pub mod lcp;
-pub mod lemke;
-pub mod osqp;
-pub mod osqp_tresca;
+pub(crate) mod lcp;
+pub(crate) mod lemke;
+pub(crate) mod osqp;
+pub(crate) mod osqp_tresca;
 mod pivot_sweeps;
 pub mod report;
-pub mod schur;
-pub mod semismooth_penalty;
+pub(crate) mod schur;
+pub(crate) mod semismooth_penalty;
 pub mod solver;
 
 pub use algorithm::{Algorithm, Shape, SolverMethod, algorithm_for};
-pub use block_pivot::BlockPivoting;
-pub use condensed_lcp::CondensedLcp;
-pub use condensed_lemke::CondensedLemke;
-pub use end_enumeration::EndEnumeration;
-pub use end_penalty::{EndPenalty, PenaltySettings};
-pub use osqp::{Osqp, OsqpSettings};
-pub use osqp_tresca::OsqpTresca;
+pub use end_penalty::PenaltySettings;
+pub use law::{Law, LawFamily, Slip};
+pub use osqp::OsqpSettings;
 pub use report::{
     AuditReport, OsqpStatus, SettingsError, SetupError, SolveInfo, SolverReport, StepFailure,
 };
-pub use semismooth_penalty::SemismoothPenalty;
 pub use solver::{Constraints, Friction, StepSolver};
+
+pub(crate) use block_pivot::BlockPivoting;
+pub(crate) use condensed_lcp::CondensedLcp;
+pub(crate) use condensed_lemke::CondensedLemke;
+pub(crate) use end_enumeration::EndEnumeration;
+pub(crate) use end_penalty::EndPenalty;
+pub(crate) use osqp::Osqp;
+pub(crate) use osqp_tresca::OsqpTresca;
+pub(crate) use semismooth_penalty::SemismoothPenalty;

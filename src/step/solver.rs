@@ -91,7 +91,7 @@ pub trait StepSolver {
     /// Given `rhs = b` and `lower = lo` (one entry per constraint, in the order given at
     /// construction), writes the minimiser into `z` and the multipliers into `reactions` (a
     /// frictional solver writes, after them, the tangential reaction of each frictional node,
-    /// [`crate::step::condensed_lemke`]).
+    /// `crate::step::condensed_lemke`).
     fn solve(
         &mut self,
         rhs: &[f64],

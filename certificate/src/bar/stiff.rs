@@ -15,11 +15,11 @@
 //! [`crate::bar::stiff_runs`].
 
 use std::fmt::Write;
+use viscobar::internals::step::end_penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::internals::step::osqp::OSQP_DEFAULT_EPS;
 use viscobar::scene::Scene;
 use viscobar::scheme::RunError;
 use viscobar::step::audit::{AUDIT_MARGIN, ROUNDOFF_ULPS};
-use viscobar::step::end_penalty::PENALTY_DEFAULT_EPSILON;
-use viscobar::step::osqp::OSQP_DEFAULT_EPS;
 
 /// Full size (`verify --stiff`) or the reduced size of `tests/stiff.rs`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -22,12 +22,12 @@ use viscobar::internals::linalg::norms::{max_abs, max_distance};
 use viscobar::internals::linalg::spectrum::reference::STURM_ERROR_ULPS;
 use viscobar::internals::linalg::system::TridiagSystem;
 use viscobar::internals::linalg::tridiag::SymTridiag;
+use viscobar::internals::step::block_pivot::TIE_ULPS;
 use viscobar::output::Tracker;
 use viscobar::scheme::RunError;
 use viscobar::scheme::StepRecord;
 use viscobar::step::Constraints;
 use viscobar::step::audit::{KktAudit, Slack};
-use viscobar::step::block_pivot::TIE_ULPS;
 use viscobar::step::law::{Law, LawFamily};
 use viscobar::step::{SolveInfo, SolverReport, StepFailure, StepSolver};
 

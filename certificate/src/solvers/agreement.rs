@@ -15,14 +15,14 @@ use std::fmt::Write;
 use viscobar::internals::linalg::kernels::ldlt::Ldlt;
 use viscobar::internals::linalg::norms::{max_abs, max_distance};
 use viscobar::internals::linalg::tridiag::SymTridiag;
+use viscobar::internals::step::end_enumeration::EndEnumeration;
+use viscobar::internals::step::end_penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::internals::step::osqp::{Osqp, OsqpSettings, raw_problem};
 use viscobar::output::run_in_memory;
 use viscobar::scene::{self, Scene};
 use viscobar::scheme::RunError;
 use viscobar::step::StepSolver;
 use viscobar::step::audit::dual_tolerance;
-use viscobar::step::end_enumeration::EndEnumeration;
-use viscobar::step::end_penalty::PENALTY_DEFAULT_EPSILON;
-use viscobar::step::osqp::{Osqp, OsqpSettings, raw_problem};
 use viscobar::study::accuracy::observed_order;
 use viscobar::study::compare::compare;
 

@@ -2,10 +2,11 @@
 //! `viscobar::step::SemismoothPenalty`) against the condensed one on the same step problems.
 
 use viscobar::internals::linalg::system::SparseSystem;
+use viscobar::internals::step::{CondensedLcp, SemismoothPenalty};
 use viscobar::plane::{PlaneDiscretisation, PlaneSimulation};
 use viscobar::scene::plane::{PlaneScene, plane_builtin_text};
 use viscobar::scheme::RunError;
-use viscobar::step::{CondensedLcp, SemismoothPenalty, StepSolver};
+use viscobar::step::StepSolver;
 
 /// The compliances compared.
 pub const EPSILONS: [f64; 2] = [1e-3, 1e-6];

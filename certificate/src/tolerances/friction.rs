@@ -4,8 +4,8 @@
 use super::{AGREEMENT_ULPS_PER_STEP, Measured};
 use crate::friction::rigid::{RigidRow, STIFFNESSES, closed_form_self_test, rigid_table};
 use crate::friction::{FrictionAgreement, osqp_agreements, scene_checks};
+use viscobar::internals::step::osqp_tresca::FIXED_POINT_TOL;
 use viscobar::scheme::RunError;
-use viscobar::step::osqp_tresca::FIXED_POINT_TOL;
 
 /// `D_f >= −tol · E^{n+1/2}`: a sticking node's central slip is the round-off of the increments,
 /// so its `r_T δ` is a few ulps of the energy's terms (the plane's gap rule, 8 ε).

@@ -62,7 +62,7 @@ pub fn kkt(c: &SymTridiag, b: &[f64], nodes: &[usize], lo: &[f64], z: &[f64], r:
 /// `|ΔC| ≤ 4u|C|` (`|L||D||Lᵀ| = |C|` on SPD tridiagonal matrices, Higham Thm 9.14) after `γ₂`
 /// in its right side; the reactions are rounded rows of `Cz − b` (`γ₃`) and recomputing
 /// `Cz − b − r` here adds `γ₄`: `TIE_ULPS + 6.5` ulps, rounded up.
-pub const KKT_ULPS: f64 = viscobar::step::block_pivot::TIE_ULPS + 8.0;
+pub const KKT_ULPS: f64 = viscobar::internals::step::block_pivot::TIE_ULPS + 8.0;
 
 /// [`kkt`] over its per-case bound: `KKT_ULPS ε` times `‖C‖∞‖z‖∞ + ‖b‖∞ + ‖r‖∞` (stationarity,
 /// clamped reactions) and times `max(‖z‖∞, ‖lo‖∞)` (a free gap), over `kkt`'s scale. The
@@ -92,8 +92,8 @@ pub const KKT_SAMPLE_CASES: usize = 200;
 /// 3000, every node bounded) and `tests/osqp_many_bounds.rs` (n up to 400, every node or a
 /// random half, two problems in a row: the second warm-started).
 pub fn random_kkt_worst() -> Result<(f64, f64), RunError> {
+    use viscobar::internals::step::block_pivot::BlockPivoting;
     use viscobar::step::StepSolver;
-    use viscobar::step::block_pivot::BlockPivoting;
     let mut rnd = stream(2026);
     let (mut ratio, mut worst) = (0.0f64, 0.0f64);
     for case in 0..KKT_SAMPLE_CASES {
@@ -256,8 +256,8 @@ pub fn oracle_agreement(
 /// `tests/exact_solver.rs`'s distribution: n up to 23, no bound, either end or both, two
 /// problems in a row (the second `s b` with bounds moved by `t`: warm-started).
 pub fn oracle_agreement_worst() -> Result<f64, RunError> {
+    use viscobar::internals::step::end_enumeration::EndEnumeration;
     use viscobar::step::StepSolver;
-    use viscobar::step::end_enumeration::EndEnumeration;
     let mut rnd = stream(22);
     let mut worst = 0.0f64;
     for case in 0..KKT_SAMPLE_CASES * 5 {

@@ -4,11 +4,11 @@
 
 use super::{GAP_TOL, IDENTITY_TOL, exact_sample_error};
 use viscobar::internals::linalg::tridiag::SymTridiag;
+use viscobar::internals::step::end_penalty::PENALTY_DEFAULT_EPSILON;
+use viscobar::internals::step::osqp::OSQP_DEFAULT_EPS;
 use viscobar::scene::{self, MassVariant, Scene, SolverMethod, builtin_names};
 use viscobar::scheme::RunError;
 use viscobar::step::audit::AUDIT_MARGIN;
-use viscobar::step::end_penalty::PENALTY_DEFAULT_EPSILON;
-use viscobar::step::osqp::OSQP_DEFAULT_EPS;
 use viscobar::study::compare::{Comparison, compare};
 
 // ---- tests/solvers.rs: the three step solvers on every built-in scene ----------------------
@@ -214,8 +214,8 @@ pub const SMALL_TOL: f64 = 64.0 * f64::EPSILON;
 /// (`z = (2, 7/3, 5/3)`, reaction `2/3`): the worst error of `z` and `r` against these closed
 /// forms, and the number of steps the second solver audited.
 pub fn osqp_small_problems() -> Result<(f64, u64), RunError> {
+    use viscobar::internals::step::osqp::{Osqp, OsqpSettings};
     use viscobar::step::StepSolver;
-    use viscobar::step::osqp::{Osqp, OsqpSettings};
     let c = SymTridiag::new(vec![2.0, 2.0, 2.0], vec![-1.0, -1.0]);
     let b = [1.0, 1.0, 1.0];
     let mut worst = 0.0f64;
@@ -254,8 +254,8 @@ pub const TIE_TOL: f64 = 1e-14;
 /// the worst `|z − 1|` and `r` (`r` must be `>= 0`), whether the bounds held exactly and the
 /// reactions were not negative, and whether every call gave the first call's bits.
 pub fn exact_tie() -> Result<(f64, bool, bool), RunError> {
+    use viscobar::internals::step::end_enumeration::EndEnumeration;
     use viscobar::step::StepSolver;
-    use viscobar::step::end_enumeration::EndEnumeration;
     let c = SymTridiag::new(vec![2.0, 2.0, 2.0], vec![-1.0, -1.0]);
     let z_free = [1.0, 1.0, 1.0];
     let b = c.mul(&z_free);
