@@ -5,7 +5,7 @@
 //! node, bounded by a threshold `g_j` and opposed to the slip `δ_j` ([`Slip`]).
 //!
 //! A new law is a new variant: its conditions in [`Law::threshold`] (or beside the penalty law's
-//! residual), its checks and names in the audit, its bound tests in `tests/audit_bounds.rs`.
+//! residual), its checks and names in the audit, its bound tests in `tests/audit_bounds/`.
 //! [docs/step-solvers.md](../docs/step-solvers.md#kkt-audit) and
 //! [docs/friction.md](../docs/friction.md#audit) derive the audit's tolerances.
 
