@@ -119,25 +119,25 @@ pub fn run_in_memory(
 ) -> Result<(Vec<StepRecord>, Summary, BarSimulation), RunError> {
     if scene.heat.is_some() {
         let (records, summary, sim) = run_thermal_in_memory(name, scene)?;
-        return Ok((records, summary, BarSimulation::Thermal(sim)));
+        return Ok((records, summary, BarSimulation::Thermal(Box::new(sim))));
     }
     let (records, summary, sim) =
         run_scheme_in_memory(name, Simulation::new(scene)?, scene.steps())?;
-    Ok((records, summary, BarSimulation::Mechanical(sim)))
+    Ok((records, summary, BarSimulation::Mechanical(Box::new(sim))))
 }
 
 /// A bar scene's simulation as [`run_in_memory`] leaves it: the bar alone, or the bar with its
 /// temperature (a scene with `[heat]`).
 pub enum BarSimulation {
-    Mechanical(Simulation),
-    Thermal(ThermalSimulation),
+    Mechanical(Box<Simulation>),
+    Thermal(Box<ThermalSimulation>),
 }
 
 impl BarSimulation {
     /// The bar without a temperature; `None` for a scene with `[heat]`.
     pub fn mechanical(&self) -> Option<&Simulation> {
         match self {
-            Self::Mechanical(sim) => Some(sim),
+            Self::Mechanical(sim) => Some(sim.as_ref()),
             Self::Thermal(_) => None,
         }
     }
@@ -146,7 +146,7 @@ impl BarSimulation {
     pub fn thermal(&self) -> Option<&ThermalSimulation> {
         match self {
             Self::Mechanical(_) => None,
-            Self::Thermal(sim) => Some(sim),
+            Self::Thermal(sim) => Some(sim.as_ref()),
         }
     }
 }
