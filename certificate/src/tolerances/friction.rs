@@ -1,5 +1,5 @@
-//! The friction tolerances (`tests/plane_coulomb_friction.rs`), each beside the measurement of
-//! what it guards ([`crate::friction`], [`crate::friction::rigid`]).
+//! The friction tolerances (`tests/plane_coulomb_friction.rs`, `tests/solvers.rs`), each beside
+//! the measurement of what it guards ([`crate::friction`], [`crate::friction::rigid`]).
 
 use super::{AGREEMENT_ULPS_PER_STEP, Measured};
 use crate::friction::rigid::{RigidRow, STIFFNESSES, closed_form_self_test, rigid_table};
@@ -109,7 +109,13 @@ pub fn friction_measured() -> Result<Vec<Measured>, RunError> {
         .into_iter()
         .map(|(name, tolerance, worst, note)| Measured {
             name: name.into(),
-            used_in: "tests/plane_coulomb_friction.rs",
+            // The solver checker's rows; the rigid limit's are the friction tests'.
+            used_in: match name {
+                "RIGID_SELF_TEST_TOL" | "RIGID_LIMIT_BOUND" | "STICK_VELOCITY_BOUND" => {
+                    "tests/plane_coulomb_friction.rs"
+                }
+                _ => "tests/solvers.rs",
+            },
             tolerance,
             worst,
             note,

@@ -170,7 +170,7 @@ pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
     let rows = [
         (
             "PLANE_IDENTITY_TOL",
-            "tests/plane.rs, plane_contact.rs, plane_cli.rs, plane_contact_cli.rs",
+            "tests/plane.rs, plane_cli.rs, plane_contact_cli.rs, solvers.rs",
             PLANE_IDENTITY_TOL,
             w.identity,
             "round-off of the identity's sums (built-in plane scenes and the manufactured one)",
@@ -191,14 +191,14 @@ pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
         ),
         (
             "PLANE_GAP_TOL",
-            "tests/plane_contact.rs, plane_contact_cli.rs",
+            "tests/plane_contact_cli.rs, solvers.rs",
             PLANE_GAP_TOL,
             w.gap,
             "8 ε: the gap's subtraction after a backward-stable solve (also −dissipation / E)",
         ),
         (
             "PLANE_OSQP_AGREEMENT_TOL",
-            "tests/plane_contact.rs",
+            "tests/solvers.rs",
             PLANE_OSQP_AGREEMENT_TOL,
             w.osqp_agreement,
             "the issue's stated requirement (1e-7), kept as the outer contract; the check that \
@@ -206,14 +206,14 @@ pub fn plane_measured() -> Result<Vec<Measured>, RunError> {
         ),
         (
             "plane OSQP relative |Δu|, |Δr| / (steps · AGREEMENT_ULPS_PER_STEP ε)",
-            "tests/plane_contact.rs",
+            "tests/solvers.rs",
             1.0,
             w.osqp_agreement_ratio,
             "two backward-stable solves per step (OSQP polished), accumulated linearly",
         ),
         (
             "plane penalty |u − u_exact| / (PLANE_PENALTY_FACTOR ε r_max), ε = 1e-6",
-            "tests/plane_contact.rs",
+            "tests/solvers.rs",
             1.0,
             w.penalty_ratio,
             "the penetration ε r, doubled at a reflection and again by the delayed release \

@@ -1,4 +1,4 @@
-//! The thermal bar's tolerances (`tests/thermal.rs`), each beside the measurement of what it
+//! The thermal bar's tolerances (`tests/thermal.rs`, `tests/solvers.rs`), each beside the measurement of what it
 //! guards ([`crate::thermal`]).
 
 use super::Measured;
@@ -22,7 +22,7 @@ pub fn thermal_measured() -> Result<Vec<Measured>, RunError> {
     Ok(vec![
         Measured {
             name: "THERMAL_IDENTITY_TOL".into(),
-            used_in: "tests/thermal.rs",
+            used_in: "tests/solvers.rs",
             tolerance: THERMAL_IDENTITY_TOL,
             worst: identity,
             note: "every step of every thermal scene, with contact and exchange",
