@@ -144,7 +144,7 @@ pub const RESIDUAL_ENTRY_ROUNDINGS: f64 = 8.0;
 /// `|r_j − r*_j| <= |ρ_{n_j}| + ‖C‖₂ ‖d‖₂`. `ρ` is the computed residual plus its rounding
 /// (`RESIDUAL_ENTRY_ROUNDINGS · u · (|C||z| + |b| + |r|)` entrywise); `‖C‖₂ <= ‖C‖∞`; `λ` is
 /// the bisection's smallest eigenvalue less its error bound
-/// ([`viscobar::linalg::spectrum::reference::STURM_ERROR_ULPS`] `ε ‖C‖∞`). For an exactly
+/// ([`viscobar::internals::linalg::spectrum::reference::STURM_ERROR_ULPS`] `ε ‖C‖∞`). For an exactly
 /// feasible, complementary answer (`g, r >= 0`, `r·g = 0`) it is the classic `‖ρ‖₂ / λ_min`.
 /// Returns the bound on `‖d‖₂` and the bounds on `|r_j − r*_j|`; infinite when `λ <= 0`.
 pub fn oracle_distance_bound(

@@ -129,8 +129,13 @@ pub fn uncovered(covered: &[(&str, &str)]) -> Vec<Uncovered> {
                 p.display().to_string().trim_start_matches('/').to_string()
             });
         for line in text.lines() {
+            // A constant at any visibility (`pub(super)` in a test split into modules).
             let l = line.trim_start();
-            let Some(rest) = l.strip_prefix("pub const ").or(l.strip_prefix("const ")) else {
+            let l = ["pub(super) ", "pub(crate) ", "pub "]
+                .iter()
+                .find_map(|v| l.strip_prefix(v))
+                .unwrap_or(l);
+            let Some(rest) = l.strip_prefix("const ") else {
                 continue;
             };
             let Some((name, ty)) = rest.split_once(':') else {
