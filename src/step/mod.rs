@@ -20,6 +20,7 @@ pub mod lemke;
 pub mod osqp;
 pub mod osqp_tresca;
 mod pivot_sweeps;
+pub mod pivoting;
 pub mod report;
 pub mod schur;
 pub mod semismooth_penalty;
