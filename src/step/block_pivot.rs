@@ -2,17 +2,15 @@
 //! minimise `½ zᵀCz − bᵀz` subject to `z_i >= lo_i` for `i` in `B`, `C` symmetric positive
 //! definite tridiagonal. With `y = z − lo` this is an LCP with a P-matrix: one solution.
 //!
-//! Method: block principal pivoting (Júdice & Pires 1994) safeguarded by Murty's single
-//! pivoting rule after [`BLOCK_PATIENCE`] block iterations without a new minimum of infeasible
-//! indices, so it terminates; a hard iteration limit ends in an error, never an unverified point.
-//! Each iteration solves `C_FF z_F = b_F − C_FA lo_A` (`z_A = lo_A`) by the plain `L D Lᵀ` sweep
-//! of `C` with the active rows replaced by identity ones; an iteration after the step's first
-//! recomputes each recurrence (pivots, forward chain, backward chain) only from the first
-//! changed row until its carried value meets the stored bits, so every answer is bitwise the
-//! whole-bar sweep's ([`BlockPivoting::with_full_solves`], compared in the tests). The
-//! margins are re-evaluated only where `z` changed. Termination, tie thresholds, how far a flip
-//! reaches and what the code does for speed:
-//! `docs/step-solvers.md#block-principal-pivoting`.
+//! Method: block principal pivoting with Murty's safeguard (greatest node first), the driver
+//! of [`crate::step::pivoting`] (shared with the dense [`crate::step::lcp`]). Each iteration
+//! solves `C_FF z_F = b_F − C_FA lo_A` (`z_A = lo_A`) by the plain `L D Lᵀ` sweep of `C` with
+//! the active rows replaced by identity ones; an iteration after the step's first recomputes
+//! each recurrence (pivots, forward chain, backward chain) only from the first changed row
+//! until its carried value meets the stored bits, so every answer is bitwise the whole-bar
+//! sweep's ([`BlockPivoting::with_full_solves`], compared in the tests). The margins are
+//! re-evaluated only where `z` changed. Termination, tie thresholds, how far a flip reaches
+//! and what the code does for speed: `docs/step-solvers.md#block-principal-pivoting`.
 
 use crate::linalg::kernels::ldlt::NotPositiveDefinite;
 use crate::linalg::kernels::ldlt_fast::TwistedLdlt;
@@ -22,20 +20,14 @@ use crate::step::pivot_sweeps::{
     backward_chain, forward_chain, margins_interior, max_abs_4, max_of, push_merged, row_product,
     run_end, run_start, sweep_down, sweep_up,
 };
+use crate::step::pivoting::{
+    ActiveSetProblem, MurtyOrder, iteration_limit, pivot, round_off_threshold,
+};
 use crate::step::{SolveInfo, StepFailure, StepSolver};
 
-/// Block iterations allowed without a decrease of the number of infeasible indices before the
-/// single-pivot safeguard takes over (Júdice & Pires use a small constant; 10 keeps the fast
-/// block steps through transient increases).
-pub const BLOCK_PATIENCE: u32 = 10;
-/// An index counts as infeasible only beyond this many ulps of the quantities compared
-/// (`max(max|z|, max|lo|)` for `z_i − lo_i`, `‖C‖∞ max|z| + max|b|` for `λ_i`): below it, the
-/// sign is round-off and either choice satisfies KKT. Half the audit's floor
-/// ([`crate::step::audit::ROUNDOFF_ULPS`] = 32, on the same scales), so that an accepted answer
-/// also passes the audit with room for the rounding of its recomputed residuals (64 on
-/// `max|z| + max|lo|`, as before, let the talk's distributed scene end a step 1.4 times over
-/// the audit's primal floor).
-pub const TIE_ULPS: f64 = 16.0;
+/// The tie threshold's ulps (scales: `max(max|z|, max|lo|)` for `z_i − lo_i`,
+/// `‖C‖∞ max|z| + max|b|` for `λ_i`), and the patience, of the shared driver.
+pub use crate::step::pivoting::{BLOCK_PATIENCE, TIE_ULPS};
 /// Nodes per block of the running `max|z|` (a changed window recomputes its blocks, then the
 /// maximum is taken over the blocks: `n / 256` comparisons).
 const MAX_BLOCK: usize = 256;
@@ -157,9 +149,7 @@ impl BlockPivoting {
             factor_valid: false,
             incremental: true,
             work: PivotWork::default(),
-            // Murty's rule is finite but may in theory need many pivots; beyond this the step
-            // fails with an error instead of returning an unverified point.
-            max_iterations: 50 * (nodes.len() as u32).max(1) + 100,
+            max_iterations: iteration_limit(nodes.len()),
         })
     }
 
@@ -561,107 +551,142 @@ impl BlockPivoting {
         z: &mut [f64],
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
-        let eps = f64::EPSILON;
-        let n = z.len();
-        let lower = lo;
-        // `(max|b|, max|lo|)`, taken by the step's first solve.
-        let mut maxima = None;
-        let mut best_count = usize::MAX;
-        let mut patience = BLOCK_PATIENCE;
-        // Whether `t` and `z` hold this step's sweep with `active` before `flips`.
-        let mut swept = false;
         if !self.flips.is_empty() {
             // A failed solve left flips unsolved: the factor no longer matches.
             self.factor_valid = false;
             self.flips.clear();
         }
-        for iteration in 1..=self.max_iterations {
-            let unconstrained = self.active_count == 0;
-            let local = !unconstrained
-                && self.incremental
-                && swept
-                && self.factor_valid
-                && self.flips.len() * FULL_SOLVE_FLIPS <= n;
-            if unconstrained {
-                self.factor.solve_into(rhs, z);
-                self.factor_valid = false;
-                swept = false;
-                self.work.unconstrained_solves += 1;
-                for (b, chunk) in self.block_max.iter_mut().zip(z.chunks(MAX_BLOCK)) {
-                    *b = max_abs(chunk);
-                }
-                maxima.get_or_insert_with(|| (max_abs_4(rhs), max_abs_4(lower)));
-            } else if local {
-                self.solve_local(rhs, lo, z);
-            } else {
-                if !self.incremental || !self.factor_valid || !self.flips.is_empty() {
-                    self.factor_all();
-                }
-                let m = self.solve_all(rhs, lo, z);
-                maxima.get_or_insert(m);
-                swept = true;
+        let max_iterations = self.max_iterations;
+        let mut run = BarIteration {
+            solver: &mut *self,
+            rhs,
+            lo,
+            z: &mut *z,
+            maxima: None,
+            swept: false,
+        };
+        let iterations = pivot(&mut run, max_iterations)?;
+        let n = z.len();
+        let (active, margin) = (&self.active[..n], &self.margin[..n]);
+        // `max(λ_i, 0)` on active nodes, `+0` for `λ_i = −0` and NaN (the bits of the
+        // `maxsd` that `f64::max(λ_i, 0.0)` compiled to), without a branch per node.
+        let reaction = |i: usize| {
+            let m = margin[i];
+            if active[i] & (m > 0.0) { m } else { 0.0 }
+        };
+        if self.all_constrained {
+            let it = reactions[..n].iter_mut().zip(active).zip(margin);
+            for ((r, &a), &m) in it {
+                *r = if a & (m > 0.0) { m } else { 0.0 };
             }
-            let (b_max, lo_max) = maxima.expect("the first iteration is not local");
-            let z_max = max_abs(&self.block_max);
-            if !z_max.is_finite() {
-                return Err(StepFailure::NonFinite);
-            }
-            let tol_z = TIE_ULPS * eps * z_max.max(lo_max);
-            let tol_l = TIE_ULPS * eps * (self.c_norm * z_max + b_max);
-            // The whole-bar solve evaluated every margin itself.
-            if unconstrained {
-                self.margins_all(rhs, lo, z);
-            } else if local {
-                self.margins_changed(rhs, lo, z);
-            }
-            self.select_infeasible(tol_z, tol_l);
-            self.flips.clear();
-            if self.infeasible.is_empty() {
-                let (active, margin) = (&self.active[..n], &self.margin[..n]);
-                // `max(λ_i, 0)` on active nodes, `+0` for `λ_i = −0` and NaN (the bits of the
-                // `maxsd` that `f64::max(λ_i, 0.0)` compiled to), without a branch per node.
-                let reaction = |i: usize| {
-                    let m = margin[i];
-                    if active[i] & (m > 0.0) { m } else { 0.0 }
-                };
-                if self.all_constrained {
-                    let it = reactions[..n].iter_mut().zip(active).zip(margin);
-                    for ((r, &a), &m) in it {
-                        *r = if a & (m > 0.0) { m } else { 0.0 };
-                    }
-                } else {
-                    for (r, &i) in reactions.iter_mut().zip(&self.nodes) {
-                        *r = reaction(i);
-                    }
-                }
-                return Ok(SolveInfo {
-                    iterations: iteration,
-                });
-            }
-            let count = self.infeasible.len();
-            if count < best_count {
-                best_count = count;
-                patience = BLOCK_PATIENCE;
-            } else {
-                patience = patience.saturating_sub(1);
-            }
-            if patience > 0 {
-                self.flips.extend_from_slice(&self.infeasible);
-            } else {
-                self.flips.push(*self.infeasible.last().expect("non-empty"));
-            }
-            for &i in &self.flips {
-                self.active[i] = !self.active[i];
-                if self.active[i] {
-                    self.active_count += 1;
-                } else {
-                    self.active_count -= 1;
-                }
+        } else {
+            for (r, &i) in reactions.iter_mut().zip(&self.nodes) {
+                *r = reaction(i);
             }
         }
-        Err(StepFailure::IterationLimit {
-            iterations: self.max_iterations,
-        })
+        Ok(SolveInfo { iterations })
+    }
+}
+
+/// Flips node `i` (active to free, free to active), keeping the count of active nodes.
+#[inline(always)]
+fn toggle(active: &mut [bool], active_count: &mut usize, i: usize) {
+    active[i] = !active[i];
+    if active[i] {
+        *active_count += 1;
+    } else {
+        *active_count -= 1;
+    }
+}
+
+/// One step's solve: the solver, the step's data and what its first solve found.
+struct BarIteration<'a> {
+    solver: &'a mut BlockPivoting,
+    rhs: &'a [f64],
+    lo: &'a [f64],
+    z: &'a mut [f64],
+    /// `(max|b|, max|lo|)`, taken by the step's first solve.
+    maxima: Option<(f64, f64)>,
+    /// Whether `t` and `z` hold this step's sweep with `active` before `flips`.
+    swept: bool,
+}
+
+impl ActiveSetProblem for BarIteration<'_> {
+    type Error = StepFailure;
+    const MURTY_ORDER: MurtyOrder = MurtyOrder::GreatestIndex;
+
+    #[inline(always)]
+    fn solve_active_set(&mut self) -> Result<(), StepFailure> {
+        let (rhs, lo, z) = (self.rhs, self.lo, &mut *self.z);
+        let s = &mut *self.solver;
+        let n = z.len();
+        let unconstrained = s.active_count == 0;
+        let local = !unconstrained
+            && s.incremental
+            && self.swept
+            && s.factor_valid
+            && s.flips.len() * FULL_SOLVE_FLIPS <= n;
+        if unconstrained {
+            s.factor.solve_into(rhs, z);
+            s.factor_valid = false;
+            self.swept = false;
+            s.work.unconstrained_solves += 1;
+            for (b, chunk) in s.block_max.iter_mut().zip(z.chunks(MAX_BLOCK)) {
+                *b = max_abs(chunk);
+            }
+            self.maxima
+                .get_or_insert_with(|| (max_abs_4(rhs), max_abs_4(lo)));
+        } else if local {
+            s.solve_local(rhs, lo, z);
+        } else {
+            if !s.incremental || !s.factor_valid || !s.flips.is_empty() {
+                s.factor_all();
+            }
+            let m = s.solve_all(rhs, lo, z);
+            self.maxima.get_or_insert(m);
+            self.swept = true;
+        }
+        let (b_max, lo_max) = self.maxima.expect("the first iteration is not local");
+        let z_max = max_abs(&s.block_max);
+        if !z_max.is_finite() {
+            return Err(StepFailure::NonFinite);
+        }
+        let tol_z = round_off_threshold(z_max.max(lo_max));
+        let tol_l = round_off_threshold(s.c_norm * z_max + b_max);
+        // The whole-bar solve evaluated every margin itself.
+        if unconstrained {
+            s.margins_all(rhs, lo, z);
+        } else if local {
+            s.margins_changed(rhs, lo, z);
+        }
+        s.select_infeasible(tol_z, tol_l);
+        s.flips.clear();
+        Ok(())
+    }
+
+    #[inline(always)]
+    fn infeasible(&self) -> &[usize] {
+        &self.solver.infeasible
+    }
+
+    #[inline(always)]
+    fn flip_all_infeasible(&mut self) {
+        let s = &mut *self.solver;
+        s.flips.extend_from_slice(&s.infeasible);
+        for &i in &s.flips {
+            toggle(&mut s.active, &mut s.active_count, i);
+        }
+    }
+
+    #[inline(always)]
+    fn flip_one(&mut self, index: usize) {
+        let s = &mut *self.solver;
+        s.flips.push(index);
+        toggle(&mut s.active, &mut s.active_count, index);
+    }
+
+    fn iteration_limit_error(iterations: u32) -> StepFailure {
+        StepFailure::IterationLimit { iterations }
     }
 }
 

@@ -4,15 +4,16 @@
 //! exists and is unique for every `q` (Cottle, Pang & Stone, *The Linear Complementarity
 //! Problem*, Thm 3.3.7).
 //!
-//! Method: block principal pivoting (Júdice & Pires, Comput. Oper. Res. 21, 1994) safeguarded
-//! by Murty's least-index rule, finite on every P-matrix LCP (Murty 1974), as the bar's
-//! [`crate::step::block_pivot`] on a tridiagonal matrix. For an active set `A`: `S_AA r_A =
-//! −q_A` by a dense Cholesky in a buffer kept for the run, `w_F = q_F + S_FA r_A`; the infeasible
-//! indices (beyond round-off) are flipped all at once while their number decreases (with
-//! [`BLOCK_PATIENCE`] tries of grace), then one at a time by Murty's rule. The active set is
-//! kept for the next call (warm start). [`DenseLcp::solve`] allocates nothing.
+//! Method: block principal pivoting with Murty's least-index safeguard, the driver of
+//! [`crate::step::pivoting`] (shared with the bar's [`crate::step::block_pivot`]). For an active
+//! set `A`: `S_AA r_A = −q_A` by a dense Cholesky in a buffer kept for the run, `w = q + S r`;
+//! an index is infeasible when `r_k S_kk` (active) or `w_k` (free) is below minus the round-off
+//! threshold on `‖S‖∞ max|r| + max|q|`. The active set is kept for the next call (warm start).
+//! [`DenseLcp::solve`] allocates nothing.
 
-use crate::step::block_pivot::{BLOCK_PATIENCE, TIE_ULPS};
+use crate::step::pivoting::{
+    ActiveSetProblem, MurtyOrder, iteration_limit, pivot, round_off_threshold,
+};
 
 /// A dense LCP that could not be solved.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -63,9 +64,7 @@ impl DenseLcp {
             factored: vec![false; m],
             factor_valid: false,
             infeasible: Vec::with_capacity(m),
-            // Murty's rule is finite but may in theory need exponentially many pivots; beyond
-            // this the call fails instead of returning an unverified point.
-            max_iterations: 50 * (m as u32).max(1) + 100,
+            max_iterations: iteration_limit(m),
         };
         // The whole matrix must factorise: S positive definite.
         this.collect_active();
@@ -188,54 +187,77 @@ impl DenseLcp {
             return Ok(1);
         }
         let q_max = q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let mut best = usize::MAX;
-        let mut patience = BLOCK_PATIENCE;
-        for iteration in 1..=self.max_iterations {
-            self.collect_active();
-            self.solve_active(q, r, w)?;
-            let r_max = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            if !r_max.is_finite() {
-                return Err(LcpError::NonFinite);
-            }
-            // Round-off of a row of S r + q (in units of w); r_k is weighed by S_kk.
-            let tol = TIE_ULPS * f64::EPSILON * (self.s_norm * r_max + q_max);
-            self.infeasible.clear();
-            for k in 0..m {
-                let bad = if self.active[k] {
-                    r[k] * self.s[k * m + k] < -tol
-                } else {
-                    w[k] < -tol
-                };
-                if bad {
-                    self.infeasible.push(k);
-                }
-            }
-            if self.infeasible.is_empty() {
-                for v in r.iter_mut() {
-                    *v = v.max(0.0);
-                }
-                return Ok(iteration);
-            }
-            let count = self.infeasible.len();
-            if count < best {
-                best = count;
-                patience = BLOCK_PATIENCE;
+        let max_iterations = self.max_iterations;
+        let mut run = DenseIteration {
+            lcp: self,
+            q,
+            r: &mut *r,
+            w,
+            q_max,
+        };
+        let iterations = pivot(&mut run, max_iterations)?;
+        for v in r.iter_mut() {
+            *v = v.max(0.0);
+        }
+        Ok(iterations)
+    }
+}
+
+/// One call of [`DenseLcp::solve`]: the LCP, its `q` and the answer being built.
+struct DenseIteration<'a> {
+    lcp: &'a mut DenseLcp,
+    q: &'a [f64],
+    r: &'a mut [f64],
+    w: &'a mut [f64],
+    q_max: f64,
+}
+
+impl ActiveSetProblem for DenseIteration<'_> {
+    type Error = LcpError;
+    const MURTY_ORDER: MurtyOrder = MurtyOrder::LeastIndex;
+
+    fn solve_active_set(&mut self) -> Result<(), LcpError> {
+        let lcp = &mut *self.lcp;
+        let m = lcp.m;
+        lcp.collect_active();
+        lcp.solve_active(self.q, self.r, self.w)?;
+        let r_max = self.r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if !r_max.is_finite() {
+            return Err(LcpError::NonFinite);
+        }
+        // Round-off of a row of S r + q (in units of w); r_k is weighed by S_kk.
+        let tol = round_off_threshold(lcp.s_norm * r_max + self.q_max);
+        lcp.infeasible.clear();
+        for k in 0..m {
+            let bad = if lcp.active[k] {
+                self.r[k] * lcp.s[k * m + k] < -tol
             } else {
-                patience = patience.saturating_sub(1);
-            }
-            if patience > 0 {
-                for &k in &self.infeasible {
-                    self.active[k] = !self.active[k];
-                }
-            } else {
-                // Murty: the least infeasible index.
-                let k = self.infeasible[0];
-                self.active[k] = !self.active[k];
+                self.w[k] < -tol
+            };
+            if bad {
+                lcp.infeasible.push(k);
             }
         }
-        Err(LcpError::IterationLimit {
-            iterations: self.max_iterations,
-        })
+        Ok(())
+    }
+
+    fn infeasible(&self) -> &[usize] {
+        &self.lcp.infeasible
+    }
+
+    fn flip_all_infeasible(&mut self) {
+        let lcp = &mut *self.lcp;
+        for &k in &lcp.infeasible {
+            lcp.active[k] = !lcp.active[k];
+        }
+    }
+
+    fn flip_one(&mut self, index: usize) {
+        self.lcp.active[index] = !self.lcp.active[index];
+    }
+
+    fn iteration_limit_error(iterations: u32) -> LcpError {
+        LcpError::IterationLimit { iterations }
     }
 }
 
