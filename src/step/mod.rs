@@ -21,7 +21,7 @@ pub(crate) mod lemke;
 pub(crate) mod osqp;
 pub(crate) mod osqp_tresca;
 mod pivot_sweeps;
-pub mod pivoting;
+pub(crate) mod pivoting;
 pub mod report;
 pub(crate) mod schur;
 pub(crate) mod semismooth_penalty;
