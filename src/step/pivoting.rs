@@ -14,7 +14,7 @@
 /// block steps through transient increases).
 pub const BLOCK_PATIENCE: u32 = 10;
 /// An index counts as infeasible only beyond this many ulps of the scale of the quantity
-/// compared (each solver states its scales; [`round_off_threshold`]): below it, the sign is
+/// compared (each solver states its scales; `round_off_threshold`): below it, the sign is
 /// round-off and either choice satisfies KKT. Half the audit's floor
 /// ([`crate::step::audit::ROUNDOFF_ULPS`] = 32, on the same scales), so that an accepted answer
 /// also passes the audit with room for the rounding of its recomputed residuals (64 on
