@@ -183,7 +183,10 @@ mod tests {
             }
         }
         fn flip_one(&mut self, index: usize) {
-            assert_eq!(index, self.infeasible[0], "Murty's rule flips the least index");
+            assert_eq!(
+                index, self.infeasible[0],
+                "Murty's rule flips the least index"
+            );
             self.active[index] = !self.active[index];
             self.single_pivots += 1;
         }
