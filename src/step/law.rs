@@ -6,8 +6,7 @@
 //!
 //! A new law is a new variant: its conditions in [`Law::threshold`] (or beside the penalty law's
 //! residual), its checks and names in the audit, its bound tests in `tests/audit_bounds/`.
-//! [docs/step-solvers.md](../docs/step-solvers.md#kkt-audit) and
-//! [docs/friction.md](../docs/friction.md#audit) derive the audit's tolerances.
+//! `docs/step-solvers.md#kkt-audit` and `docs/friction.md#audit` derive the audit's tolerances.
 
 /// The slip of the frictional nodes over the step, `δ_j = (z + w)_{t_j}` (the central slip,
 /// `w` the previous increment at the tangents). A sliding obstacle, moving tangentially by

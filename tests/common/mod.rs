@@ -114,7 +114,7 @@ pub fn round_to_digits(x: f64, scale: f64, digits: i32) -> f64 {
     r + 0.0
 }
 
-// ---- the audits' bounds at their edges (audit_bounds.rs) ----------
+// ---- the audits' bounds at their edges (tests/audit_bounds/) ----------
 
 /// `‖a‖∞` of a dense matrix: the largest row sum of magnitudes.
 pub fn inf_norm(a: &nalgebra::DMatrix<f64>) -> f64 {
