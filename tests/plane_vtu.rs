@@ -1,7 +1,10 @@
 //! ParaView output (`[output] format = "vtu"`): `solution.pvd` and one `vtu/step-N.vtu` per kept
 //! step, read back through vtkio (and Python's meshio when it is installed) and checked against
 //! the run's own bits: points, quads, displacement, velocity, stress, reactions and gaps;
-//! sampled and bounded as the other outputs, written whole or not at all.
+//! sampled and bounded as the other outputs, written whole or not at all. With friction: the
+//! obstacle's full force (its normal part the reaction, its tangential part the tangential
+//! reactions, summing to `history.csv`'s totals, inside Coulomb's cone) and the nodes' states
+//! (agreeing with the records' stick and slip counts).
 
 use std::path::{Path, PathBuf};
 use viscobar::internals::plane::stress::von_mises;
@@ -161,6 +164,9 @@ fn check_against_the_run(scene: &PlaneScene, out: &Path) -> usize {
             }
             assert_eq!(reaction[3 * w], 0.0);
         }
+        // Without friction the full force is the normal reaction and every state is 0.
+        assert_eq!(bits(r.array("contact_force")), bits(reaction), "{name}");
+        assert!(r.array("friction_state").iter().all(|&s| s == 0.0));
         // Quads: (cols − 1)(rows − 1) of them, every index a written node.
         assert!(r.connectivity.iter().all(|&i| (i as usize) < nodes.len()));
     }
@@ -277,6 +283,104 @@ fn meshio_reads_the_files_to_the_same_bits() {
         assert_eq!(bits(&parsed), bits(&want), "{name}");
         seen += 1;
     }
-    assert_eq!(seen, 2 + 9, "points, quads and the nine arrays");
+    assert_eq!(seen, 2 + 11, "points, quads and the eleven arrays");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// `|r_T| <= μ r_N` at a node, up to this relative to the step's largest `μ r_N`: the exact
+/// frictional step solves Coulomb's law by Lemke's pivots, exact but for their rounding (its
+/// audit holds the cone to a few ulps of the reactions).
+const CONE_ROUNDING: f64 = 1e-12;
+
+/// The frictional tilted drop written every step: at each step, each written node's
+/// `contact_force` is its `contact_reaction` plus its tangential reaction (the run's bits); the
+/// tangential parts along the floor sum to `history.csv`'s `tangential_reaction_bottom` and lie
+/// in Coulomb's cone; `friction_state` is 1 (stick) or 2 (slip) at as many nodes as the
+/// records' `stick_nodes` and `slip_nodes`, 0 elsewhere; and the run has steps of both.
+#[test]
+fn the_friction_force_and_state_read_back_to_the_run() {
+    let out = fresh("friction");
+    let overrides = ["output.format=\"vtu\"".to_string(), "output.every=1".into()];
+    let text = plane_builtin_text("plane-friction-tilted-drop").unwrap();
+    let scene = PlaneScene::from_toml(text, &overrides).unwrap();
+    run_plane_to_dir("friction", &scene, &out, false).unwrap();
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    let mut lines = history.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let column = |c: &str| header.iter().position(|h| *h == c).expect(c);
+    let (total_at, reaction_at) = (
+        column("tangential_reaction_bottom"),
+        column("reaction_bottom"),
+    );
+    assert_eq!(
+        total_at,
+        reaction_at + 1,
+        "beside reaction_bottom: {header:?}"
+    );
+    let (stick_at, slip_at) = (column("stick_nodes"), column("slip_nodes"));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+
+    let mut sim = PlaneSimulation::new(&scene).unwrap();
+    let body = sim.body();
+    let nodes = viscobar::internals::output::profiles::written_nodes(body.lattice(), 1);
+    let written = |unknown: usize| {
+        let dof = (0..2 * body.nodes())
+            .find(|&d| body.unknown_of(d) == Some(unknown))
+            .unwrap();
+        (nodes.iter().position(|&n| n == dof / 2).unwrap(), dof % 2)
+    };
+    let friction = sim.contact().friction().clone();
+    let tangent_at: Vec<(usize, usize)> = friction.tangents.iter().map(|&t| written(t)).collect();
+    assert!(!friction.is_empty());
+    let (mut stick_steps, mut slip_steps) = (0, 0);
+    for n in 1..=scene.steps() {
+        if n > 1 {
+            sim.step().unwrap();
+        }
+        let name = format!("vtu/step-{n:03}.vtu");
+        let r = read(&out.join(&name));
+        let (force, reaction) = (r.array("contact_force"), r.array("contact_reaction"));
+        let state = r.array("friction_state");
+        let row = &rows[n - 1];
+        let tangential = sim.tangential_reactions();
+        let mut expected = reaction.to_vec();
+        let (mut total, mut largest) = (0.0, 0.0f64);
+        for (j, &(w, c)) in tangent_at.iter().enumerate() {
+            expected[3 * w + c] += tangential[j];
+            // The tangential part as the file has it, summed in the frictional nodes' order.
+            let r_t = force[3 * w + c] - reaction[3 * w + c];
+            total += r_t;
+            let normal = sim.reactions()[friction.normals[j]];
+            largest = largest.max(friction.coefficients[j] * normal);
+        }
+        assert_eq!(bits(force), bits(&expected), "{name}: contact_force");
+        assert_eq!(
+            row[total_at].parse::<f64>().unwrap().to_bits(),
+            total.to_bits(),
+            "{name}"
+        );
+        for (j, &(w, c)) in tangent_at.iter().enumerate() {
+            let r_t = force[3 * w + c] - reaction[3 * w + c];
+            let cone = friction.coefficients[j] * sim.reactions()[friction.normals[j]];
+            assert!(
+                r_t.abs() <= cone + CONE_ROUNDING * largest,
+                "{name}: node {j}: |r_T| = {} > mu r_N = {cone}",
+                r_t.abs()
+            );
+        }
+        let count = |v: f64| state.iter().filter(|&&s| s == v).count();
+        let (stick, slip): (usize, usize) = (
+            row[stick_at].parse().unwrap(),
+            row[slip_at].parse().unwrap(),
+        );
+        assert_eq!((count(1.0), count(2.0)), (stick, slip), "{name}");
+        assert_eq!(count(0.0) + stick + slip, nodes.len(), "{name}");
+        stick_steps += usize::from(stick > 0);
+        slip_steps += usize::from(slip > 0);
+    }
+    assert!(
+        stick_steps > 0 && slip_steps > 0,
+        "{stick_steps} {slip_steps}"
+    );
     let _ = std::fs::remove_dir_all(&out);
 }

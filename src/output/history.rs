@@ -1,7 +1,8 @@
 //! `history.csv`: one row per step, the same columns for both bodies. The energy identity's
 //! terms (empty on steps whose identity was not measured), then per group of constraints its
 //! contact state (a single constraint: `gap_G,reaction_G`; a set: the constraints in contact,
-//! the extent `s` of the contact, the least gap and the total reaction), then the iterations.
+//! the extent `s` of the contact, the least gap and the total reaction, and for an edge with
+//! frictional nodes `tangential_reaction_G`, their tangential total), then the iterations.
 //! Optional columns follow `identity_residual` ([`OptionalColumns`]): `obstacle_work` when an
 //! obstacle moves; with friction, the friction dissipation `D_f` (empty when not measured) and
 //! the frictional nodes that stick and slip; for a bar with a temperature, the identity's
@@ -9,7 +10,7 @@
 
 use crate::output::text::{push_time, push_value};
 use crate::scheme::StepRecord;
-use crate::scheme::contact::Group;
+use crate::scheme::contact::{ContactSet, Group, MAX_GROUPS};
 use std::io::Write;
 
 /// The columns of every run.
@@ -33,6 +34,28 @@ pub struct OptionalColumns {
     /// The body has a temperature: `thermal_energy`, `thermal_dissipation`, `exchange`,
     /// `heat_supply`.
     pub thermal: bool,
+    /// The groups, in order, with frictional nodes: `tangential_reaction_G` after
+    /// `reaction_G`.
+    pub tangential: [bool; MAX_GROUPS],
+}
+
+impl OptionalColumns {
+    /// The columns of a run with the constraints `contact`, of a body with a temperature or
+    /// not.
+    pub fn of(contact: &ContactSet, thermal: bool) -> Self {
+        let mut tangential = [false; MAX_GROUPS];
+        for &k in &contact.friction().normals {
+            if let Some(g) = contact.groups().iter().position(|g| g.range.contains(&k)) {
+                tangential[g] = true;
+            }
+        }
+        Self {
+            moving: contact.is_moving(),
+            friction: !contact.friction().is_empty(),
+            thermal,
+            tangential,
+        }
+    }
 }
 
 /// The header line for a run with the contact `groups` and the `optional` columns.
@@ -47,7 +70,7 @@ pub fn header(groups: &[Group], optional: OptionalColumns) -> String {
     if optional.thermal {
         h.push_str(THERMAL_COLUMNS);
     }
-    for g in groups {
+    for (g, tangential) in groups.iter().zip(optional.tangential) {
         let n = g.name;
         if g.range.len() == 1 {
             h.push_str(&format!(",gap_{n},reaction_{n}"));
@@ -55,6 +78,9 @@ pub fn header(groups: &[Group], optional: OptionalColumns) -> String {
             h.push_str(&format!(
                 ",contact_nodes_{n},contact_s_min_{n},contact_s_max_{n},min_gap_{n},reaction_{n}"
             ));
+        }
+        if tangential {
+            h.push_str(&format!(",tangential_reaction_{n}"));
         }
     }
     h.push_str(",iterations\n");
@@ -101,7 +127,11 @@ pub fn row(r: &StepRecord, groups: &[Group], optional: OptionalColumns, row: &mu
             }
         }
     }
-    for (g, s) in groups.iter().zip(&r.contact.groups) {
+    for ((g, s), tangential) in groups
+        .iter()
+        .zip(&r.contact.groups)
+        .zip(optional.tangential)
+    {
         row.push(b',');
         if g.range.len() == 1 {
             push_value(s.min_gap, row);
@@ -118,6 +148,10 @@ pub fn row(r: &StepRecord, groups: &[Group], optional: OptionalColumns, row: &mu
         }
         row.push(b',');
         push_value(s.reaction, row);
+        if tangential {
+            row.push(b',');
+            push_value(s.tangential_reaction, row);
+        }
     }
     writeln!(row, ",{}", r.iterations).expect("writing to a vector");
 }

@@ -153,11 +153,7 @@ fn record_prepared<B: Body>(
     start: Instant,
 ) -> Result<Recorded, RunError> {
     let groups = prepared.contact().groups().to_vec();
-    let optional = history::OptionalColumns {
-        moving: prepared.contact().is_moving(),
-        friction: !prepared.contact().friction().is_empty(),
-        thermal: B::TEMPERATURE,
-    };
+    let optional = history::OptionalColumns::of(prepared.contact(), B::TEMPERATURE);
     let header = history::header(&groups, optional);
     let history_columns: Vec<String> = header.trim_end().split(',').map(String::from).collect();
     let mut rows = History {

@@ -305,18 +305,24 @@ impl Run<'_> {
         let hist_path = dir.join("history.csv");
         let mut hist = std::io::BufWriter::with_capacity(1 << 16, create(&hist_path)?);
         let groups = prepared.contact().groups().to_vec();
-        let optional = history::OptionalColumns {
-            moving: prepared.contact().is_moving(),
-            friction: !prepared.contact().friction().is_empty(),
-            thermal: B::TEMPERATURE,
-        };
+        let optional = history::OptionalColumns::of(prepared.contact(), B::TEMPERATURE);
         hist.write_all(history::header(&groups, optional).as_bytes())
             .map_err(io(&hist_path))?;
         // `t = 0` is written before the start-up step moves `u^0` on (no reactions yet).
         let (body, contact) = (prepared.body(), prepared.contact());
         let mut disp = KeptSteps::new(dir, body, contact, &self.sampling)?;
-        let rest = vec![0.0; contact.len()];
-        disp.write(0, 0.0, prepared.state(), (body, contact, &rest))?;
+        let (rest, rest_tangential) = (
+            vec![0.0; contact.len()],
+            vec![0.0; contact.friction().len()],
+        );
+        let at_rest = Kept {
+            body,
+            contact,
+            reactions: &rest,
+            tangential: &rest_tangential,
+            increments: None,
+        };
+        disp.write(0, 0.0, prepared.state(), at_rest)?;
         let mut sim = prepared.start()?;
         let mut tracker = Tracker::new(&sim, !sim.is_forced());
         let mut row = Vec::new();
@@ -328,18 +334,15 @@ impl Run<'_> {
         let (steps, every) = (self.steps, self.output.every as usize);
         let keep = |n: usize| n.is_multiple_of(every) || n == steps;
         let bar = Progress::new(self.options.progress, steps, sim.body().unknowns());
-        fn kept<B: Body>(sim: &Scheme<B>) -> Kept<'_, B> {
-            (sim.body(), sim.contact(), sim.reactions())
-        }
         if keep(1) {
-            disp.write(1, sim.time(), sim.state(), kept(&sim))?;
+            disp.write(1, sim.time(), sim.state(), Kept::of(&sim))?;
         }
         for _ in 1..steps {
             let r = sim.step()?;
             observe(&mut tracker, &r, self.options.certify)?;
             write_row(&mut hist, &r).map_err(io(&hist_path))?;
             if keep(r.step) {
-                disp.write(r.step, sim.time(), sim.state(), kept(&sim))?;
+                disp.write(r.step, sim.time(), sim.state(), Kept::of(&sim))?;
             }
             bar.step(r.step);
         }

@@ -5,20 +5,46 @@
 //! (`[output] every`, `nodes`, `max_rows`): every `node_stride`-th node along each axis and the
 //! last, joined into quads. Point data: `displacement`, `velocity` (`(u^n − u^{n−1})/Δt`),
 //! `sigma_xx`, `sigma_yy`, `sigma_xy`, `von_mises` (nodal area-weighted means of the cell-centre
-//! Kelvin–Voigt stress, [`crate::plane::stress`]), `contact_reaction` (the obstacles' force
-//! `Σ_k r_k s_k e_{c_k}` at the node), `gap` (the least gap of the node's constraints, 0 at a
-//! node without one) and `contact_constraints` (their number: 0, 1, or 2 at a corner).
+//! Kelvin–Voigt stress, [`crate::plane::stress`]), `contact_reaction` (the obstacles' normal
+//! force `Σ_k r_k s_k e_{c_k}` at the node), `contact_force` (that plus a frictional node's
+//! tangential reaction `r_T t`), `friction_state` ([`crate::scheme::NodeState`]: 0 open or
+//! frictionless, 1 stick, 2 slip), `gap` (the least gap of the node's constraints, 0 at a node
+//! without one) and `contact_constraints` (their number: 0, 1, or 2 at a corner). At `t = 0` no
+//! step has acted: every reaction and state is 0.
 
 use crate::output::profiles::Profiles;
 #[cfg(feature = "vtk")]
 use crate::scene::OutputFormat;
 use crate::scene::OutputSampling;
 use crate::scheme::contact::ContactSet;
-use crate::scheme::{Body, RunError, State};
+use crate::scheme::{Body, RunError, Scheme, State};
 use std::path::{Path, PathBuf};
 
-/// What a kept step shows besides the state: the body, its constraints and their reactions.
-pub type Kept<'a, B> = (&'a B, &'a ContactSet, &'a [f64]);
+/// What a kept step shows besides the state: the body, its constraints, their reactions and
+/// the increments that classify its frictional nodes.
+pub struct Kept<'a, B> {
+    pub body: &'a B,
+    pub contact: &'a ContactSet,
+    /// One per constraint.
+    pub reactions: &'a [f64],
+    /// One per frictional node.
+    pub tangential: &'a [f64],
+    /// [`Scheme::increments`]; `None` before the first step.
+    pub increments: Option<[&'a [f64]; 2]>,
+}
+
+impl<'a, B: Body> Kept<'a, B> {
+    /// The last step of `sim`.
+    pub fn of(sim: &'a Scheme<B>) -> Self {
+        Self {
+            body: sim.body(),
+            contact: sim.contact(),
+            reactions: sim.reactions(),
+            tangential: sim.tangential_reactions(),
+            increments: Some(sim.increments()),
+        }
+    }
+}
 
 /// The writer of a run's kept steps.
 pub enum KeptSteps {
@@ -72,7 +98,7 @@ impl KeptSteps {
     ) -> Result<(), RunError> {
         match self {
             KeptSteps::Table { profiles, path } => {
-                profiles.write(t, state, kept.0).map_err(io(path))
+                profiles.write(t, state, kept.body).map_err(io(path))
             }
             #[cfg(feature = "vtk")]
             KeptSteps::Vtu(s) => s.write(step, t, state, kept),
@@ -120,6 +146,8 @@ pub mod series {
         points: Vec<f64>,
         /// The written node and component of each constraint (`None`: its node is not written).
         constraint_at: Vec<Option<(usize, usize)>>,
+        /// The same of each frictional node's tangential unknown.
+        tangent_at: Vec<Option<(usize, usize)>>,
         /// Digits of the step numbers in the file names (of a bound on the last step).
         width: usize,
         /// `solution.pvd`.
@@ -157,18 +185,19 @@ pub mod series {
                     dof_of[i] = dof;
                 }
             }
-            let constraint_at = (0..contact.len())
-                .map(|c| {
-                    let dof = dof_of[contact.unknown(c)];
-                    written[dof / k].map(|w| (w, dof % k))
-                })
-                .collect();
+            let at = |unknown: usize| {
+                let dof = dof_of[unknown];
+                written[dof / k].map(|w| (w, dof % k))
+            };
+            let constraint_at = (0..contact.len()).map(|c| at(contact.unknown(c))).collect();
+            let tangent_at = contact.friction().tangents.iter().map(|&t| at(t)).collect();
             Ok(Self {
                 dir: dir.to_path_buf(),
                 nodes,
                 lattice: written_lattice,
                 points,
                 constraint_at,
+                tangent_at,
                 width: (sampling.kept_steps.saturating_sub(1) * sampling.every)
                     .to_string()
                     .len(),
@@ -184,8 +213,9 @@ pub mod series {
             step: usize,
             t: f64,
             state: State<'_>,
-            (body, contact, reactions): Kept<'_, B>,
+            kept: Kept<'_, B>,
         ) -> Result<(), RunError> {
+            let (body, contact, reactions) = (kept.body, kept.contact, kept.reactions);
             let k = body.components();
             let v: Vec<f64> = state.w.iter().map(|w| w * state.scale).collect();
             let vector = |f: &[f64]| {
@@ -226,6 +256,17 @@ pub mod series {
                 };
                 count[w] += 1.0;
             }
+            // The normal part, then the tangential reactions and states of the frictional nodes.
+            let mut force = reaction.clone();
+            let mut friction_state = vec![0.0; self.nodes.len()];
+            for (j, at) in self.tangent_at.iter().enumerate() {
+                let Some((w, component)) = *at else { continue };
+                force[3 * w + component] += kept.tangential[j];
+                if let Some([z, w_before]) = kept.increments {
+                    let node = contact.node_state(j, (state.u, z, w_before));
+                    friction_state[w] = f64::from(node as u8);
+                }
+            }
             let scalar = |name: &str, data: Vec<f64>| {
                 Attribute::DataArray(DataArrayBase {
                     name: name.into(),
@@ -251,6 +292,8 @@ pub mod series {
                 scalar("sigma_xy", component(2)),
                 scalar("von_mises", mises),
                 vectors("contact_reaction", reaction),
+                vectors("contact_force", force),
+                scalar("friction_state", friction_state),
                 scalar("gap", gap),
                 scalar("contact_constraints", count),
             ];

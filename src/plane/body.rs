@@ -350,7 +350,10 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
     }
     let normals = normals(&disc.grid, &disc.index, &gaps, &u0_full)?;
     let mu = scene.edges.frictions()?;
-    let friction = crate::plane::friction::frictional_nodes(&normals, &disc.index, &mu);
+    let friction = crate::plane::friction::frictional_nodes(&normals, &disc.index, &mu)?;
+    if let Some(&first) = friction.normals.first() {
+        scene.check_frictional_step(normals.len(), friction.len(), normals[first].edge)?;
+    }
     let contact = contact_set(&normals)
         .with_motion(edge_motion(&gaps, &normals))
         .with_friction(friction.clone());

@@ -1,20 +1,30 @@
 //! Coulomb friction on the plane body's Signorini edges: the frictional node of each normal of
-//! an edge with `friction = μ > 0`, its tangent `t` the edge's direction of increasing `s`
+//! an edge with `friction = μ(s)` where `μ(s) > 0` (each node its own `μ`), its tangent `t` the edge's direction of increasing `s`
 //! (`+e_y` along left and right, `+e_x` along bottom and top); the step solver that has the law
 //! is [`crate::step::algorithm`]'s choice for [`crate::step::Shape::PlaneFriction`]. A corner
 //! shared with another Signorini edge carries that edge's normal on its tangential component
 //! and no friction.
 
 use crate::plane::normals::Normal;
+use crate::scene::SceneError;
+use crate::scene::expr::Expression;
+use crate::scene::friction::friction_at;
 use crate::step::Friction;
 
 /// The frictional nodes of the normals `normals` (in the contact set's order) with the edges'
-/// coefficients `mu` (`[left, right, bottom, top]`); `index` maps a degree of freedom of the mesh
-/// to its unknown.
-pub fn frictional_nodes(normals: &[Normal], index: &[Option<usize>], mu: &[f64; 4]) -> Friction {
+/// coefficients `mu` (`[left, right, bottom, top]`, expressions in `s`, `None`: frictionless),
+/// each evaluated at its node's `s` and checked there ([`friction_at`]); `index` maps a degree
+/// of freedom of the mesh to its unknown.
+pub fn frictional_nodes(
+    normals: &[Normal],
+    index: &[Option<usize>],
+    mu: &[Option<Expression>; 4],
+) -> Result<Friction, SceneError> {
     let mut friction = Friction::default();
     for (k, nk) in normals.iter().enumerate() {
-        if mu[nk.edge] <= 0.0 {
+        let Some(field) = &mu[nk.edge] else { continue };
+        let coefficient = friction_at(field, nk.edge, nk.s)?;
+        if coefficient == 0.0 {
             continue;
         }
         // Left and right edges: normal x, tangent y; bottom and top: normal y, tangent x.
@@ -27,7 +37,7 @@ pub fn frictional_nodes(normals: &[Normal], index: &[Option<usize>], mu: &[f64; 
         }
         friction.normals.push(k);
         friction.tangents.push(tangent);
-        friction.coefficients.push(mu[nk.edge]);
+        friction.coefficients.push(coefficient);
     }
-    friction
+    Ok(friction)
 }

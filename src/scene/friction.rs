@@ -1,10 +1,15 @@
 //! The `friction` key of a plane edge, `{ condition = "signorini", gap = …, friction = μ }`:
-//! Coulomb's coefficient `μ >= 0` (a finite number; absent, 0: frictionless), on Signorini
-//! edges only, with a step solver that has a friction law (`exact` or `osqp`). Errors name
-//! `edges.<edge>.friction` (or `solver.method`).
+//! Coulomb's coefficient `μ(s) >= 0`, a number or an expression in the edge's coordinate `s`
+//! (absent: frictionless), on Signorini edges only. It is checked finite and `>= 0` at every
+//! node of the edge ([`friction_at`]); a node where `μ(s) = 0` is frictionless, so a key that is
+//! zero at every node is no key. The frictional step (some `μ(s) > 0`) needs a step solver
+//! with a friction law (`exact` or `osqp`) and at most [`MAX_FRICTION_LCP`] unknowns
+//! ([`PlaneScene::check_frictional_step`]). Errors name `edges.<edge>.friction` (or
+//! `solver.method`).
 
 use crate::scene::SceneError;
-use crate::scene::plane::{EDGE_NAMES, EdgeCondition, Edges, PlaneScene};
+use crate::scene::expr::Expression;
+use crate::scene::plane::{EDGE_NAMES, EdgeCondition, EdgeSpec, Edges, PlaneScene};
 use crate::scene::solver::SolverMethod;
 
 /// Largest size `m + 3p` of the frictional step's complementarity problem (`m` normals, `p`
@@ -12,66 +17,103 @@ use crate::scene::solver::SolverMethod;
 /// 400 MB at this limit.
 pub const MAX_FRICTION_LCP: u64 = 4096;
 
+/// The key of edge `edge`'s friction (`edges.<edge>.friction`).
+pub fn friction_field(edge: usize) -> String {
+    format!("edges.{}.friction", EDGE_NAMES[edge])
+}
+
+/// `μ(s)` of edge `edge`'s friction `mu` at the node with coordinate `s`; an error names the key
+/// and `s` when the value is not finite or negative.
+pub fn friction_at(mu: &Expression, edge: usize, s: f64) -> Result<f64, SceneError> {
+    let value = mu.eval(s, 0.0)?;
+    if value >= 0.0 {
+        return Ok(value);
+    }
+    Err(SceneError::Invalid {
+        field: friction_field(edge),
+        value: format!("\"{}\" = {value} at s = {s}", mu.text()),
+        allowed: "must be finite and >= 0 at every node of the edge (Coulomb's coefficient)".into(),
+    })
+}
+
+impl EdgeSpec {
+    /// The friction coefficient when the key is a constant (a number or an expression without
+    /// `s`) that is finite and `>= 0`; `None` when absent, varying along the edge or invalid.
+    pub fn constant_friction(&self) -> Option<f64> {
+        let text = self.friction.as_deref()?;
+        let mu = Expression::parse_edge("friction", text).ok()?;
+        let constant = !(mu.depends_on_x() || mu.depends_on_t());
+        constant.then(|| mu.eval(0.0, 0.0).ok()).flatten()
+    }
+}
+
 impl Edges {
-    /// The friction coefficient of each edge, `[left, right, bottom, top]` (0 where absent);
-    /// an error names `edges.<edge>.friction`.
-    pub fn frictions(&self) -> Result<[f64; 4], SceneError> {
-        let mut out = [0.0; 4];
+    /// The parsed friction of each edge, `[left, right, bottom, top]`: `None` where absent or
+    /// the constant 0 (frictionless either way). A constant is checked here, an expression in
+    /// `s` at every node by [`friction_at`]. An error names `edges.<edge>.friction`.
+    pub fn frictions(&self) -> Result<[Option<Expression>; 4], SceneError> {
+        let mut out: [Option<Expression>; 4] = Default::default();
         for (k, e) in self.all().into_iter().enumerate() {
-            let Some(mu) = e.friction else { continue };
-            let field = format!("edges.{}.friction", EDGE_NAMES[k]);
-            if !(mu.is_finite() && mu >= 0.0) {
-                return Err(SceneError::Invalid {
-                    field,
-                    value: mu.to_string(),
-                    allowed: "must be a finite number >= 0 (Coulomb's coefficient)".into(),
-                });
-            }
+            let Some(text) = &e.friction else { continue };
+            let field = friction_field(k);
             if e.condition != EdgeCondition::Signorini {
                 return Err(SceneError::Invalid {
                     field,
-                    value: mu.to_string(),
+                    value: text.clone(),
                     allowed: format!(
                         "friction belongs to a Signorini edge only (this edge is {})",
                         format!("{:?}", e.condition).to_lowercase()
                     ),
                 });
             }
-            out[k] = mu;
+            let mu = Expression::parse_edge(&field, text)?;
+            if mu.depends_on_t() {
+                return Err(SceneError::Invalid {
+                    field,
+                    value: text.clone(),
+                    allowed: "a number or an expression in s (friction does not change in time)"
+                        .into(),
+                });
+            }
+            if !mu.depends_on_x() && friction_at(&mu, k, 0.0)? == 0.0 {
+                continue;
+            }
+            out[k] = Some(mu);
         }
         Ok(out)
     }
 }
 
 impl PlaneScene {
-    /// The friction keys: values, edges, the solver method, and the size of the frictional
-    /// step's problem (at most `MAX_FRICTION_LCP`, counting every node of a frictional edge).
+    /// The friction keys as far as they are known without the mesh: each parsed, on a
+    /// Signorini edge, a constant finite and `>= 0` ([`Edges::frictions`]).
     pub fn validate_friction(&self) -> Result<(), SceneError> {
-        let mu = self.edges.frictions()?;
-        let Some(edge) = (0..4).find(|&k| mu[k] > 0.0) else {
-            return Ok(());
-        };
+        self.edges.frictions().map(drop)
+    }
+
+    /// The frictional step of `normals` contact normals and `frictional` frictional nodes, the
+    /// first on edge `edge` (`frictional > 0`): a solver method with a friction law, and at most
+    /// `MAX_FRICTION_LCP` unknowns.
+    pub fn check_frictional_step(
+        &self,
+        normals: usize,
+        frictional: usize,
+        edge: usize,
+    ) -> Result<(), SceneError> {
         if self.solver.method == SolverMethod::Penalty {
             return Err(SceneError::Invalid {
                 field: "solver.method".into(),
                 value: "penalty".into(),
                 allowed: format!(
-                    "has no friction law: with `edges.{}.friction` > 0 use \"exact\" or \"osqp\"",
-                    EDGE_NAMES[edge]
+                    "has no friction law: with `{}` > 0 use \"exact\" or \"osqp\"",
+                    friction_field(edge)
                 ),
             });
         }
-        let [l, r, b, t] = self.edges.clamped();
-        let along_y = (self.mesh.ny + 1).saturating_sub(u64::from(b) + u64::from(t));
-        let along_x = (self.mesh.nx + 1).saturating_sub(u64::from(l) + u64::from(r));
-        let frictional: u64 = (0..4)
-            .filter(|&k| mu[k] > 0.0)
-            .map(|k| if k < 2 { along_y } else { along_x })
-            .sum();
-        let size = self.contact_normals().saturating_add(3 * frictional);
+        let size = (normals as u64).saturating_add(3 * frictional as u64);
         if size > MAX_FRICTION_LCP {
             return Err(SceneError::Invalid {
-                field: format!("edges.{}.friction", EDGE_NAMES[edge]),
+                field: friction_field(edge),
                 value: format!("{size} unknowns of the frictional step"),
                 allowed: format!(
                     "at most {MAX_FRICTION_LCP} (m normals + 3 per frictional node; its dense \

@@ -126,9 +126,14 @@ pub struct EdgeSpec {
         skip_serializing_if = "Option::is_none"
     )]
     pub gap: Option<String>,
-    /// `μ >= 0` of a Signorini edge (absent: 0, frictionless).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub friction: Option<f64>,
+    /// `μ(s) >= 0` of a Signorini edge, a number or an expression in `s` (absent: 0,
+    /// frictionless).
+    #[serde(
+        default,
+        deserialize_with = "optional_expression",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub friction: Option<String>,
 }
 
 impl EdgeSpec {

@@ -58,6 +58,9 @@ pub struct GroupState {
     /// `−½ Σ r_k s_k (u^{n+1} − u^{n−1})_{i_k}`, its share of the contact dissipation (0 when
     /// the step's energy balance is not measured).
     pub dissipation: f64,
+    /// `Σ_j r_T,j` over the group's frictional nodes, each along its tangent `t_j` (0 without
+    /// friction; [`ContactSet::tangential_totals`]).
+    pub tangential_reaction: f64,
 }
 
 /// The constraints of a run: gaps, unknowns, directions, positions and groups.
@@ -441,6 +444,7 @@ impl ContactSet {
             min_gap: p.min_gap,
             reaction: p.total,
             dissipation: p.dissipation,
+            tangential_reaction: 0.0,
         }
     }
 
@@ -478,11 +482,13 @@ impl ContactSet {
                     } else {
                         0.0
                     },
+                    tangential_reaction: 0.0,
                 }
             } else {
                 self.group_state(&self.pass(group.range.clone(), (u, z, w, r), dissipation))
             };
         }
+        self.tangential_totals(r, &mut state.groups);
         let empty = m == 0;
         state.total_reaction = all.total;
         state.min_gap = if empty { 0.0 } else { all.min_gap };

@@ -4,7 +4,7 @@
 //! in contact that stick or slip ([`is_slipping`], one definition for every output).
 //! Derivation: `docs/friction.md`.
 
-use crate::scheme::contact::{ContactSet, in_contact};
+use crate::scheme::contact::{ContactSet, GroupState, in_contact};
 
 /// A frictional node in contact slips when its central slip `|δ|` exceeds this: the exact
 /// solver puts a sticking node at `δ = 0` up to the rounding of `u^{n+1} − u^{n−1}` (a few ulps
@@ -38,21 +38,59 @@ impl ContactSet {
         let (f, m) = (self.friction(), self.len());
         let mut state = FrictionState::default();
         for j in 0..f.len() {
-            let k = f.normals[j];
-            let gap = self.direction(k) * u[self.unknown(k)] + self.gaps()[k];
-            let t = f.tangents[j];
-            let delta = z[t] + w[t];
-            if in_contact(gap) {
-                if is_slipping(delta) {
-                    state.slip_nodes += 1;
-                } else {
-                    state.stick_nodes += 1;
-                }
+            match self.node_state(j, (u, z, w)) {
+                NodeState::Open => {}
+                NodeState::Stick => state.stick_nodes += 1,
+                NodeState::Slip => state.slip_nodes += 1,
             }
             if dissipation {
-                state.dissipation += -0.5 * r[m + j] * delta;
+                let t = f.tangents[j];
+                state.dissipation += -0.5 * r[m + j] * (z[t] + w[t]);
             }
         }
         state
+    }
+
+    /// The state of frictional node `j` at `u = u^{n+1}` with central slip `(z + w)_{t_j}`
+    /// (`z`, `w` the step's two increments, in either order).
+    #[inline]
+    pub fn node_state(&self, j: usize, (u, z, w): (&[f64], &[f64], &[f64])) -> NodeState {
+        let f = self.friction();
+        let k = f.normals[j];
+        let gap = self.direction(k) * u[self.unknown(k)] + self.gaps()[k];
+        let t = f.tangents[j];
+        if !in_contact(gap) {
+            NodeState::Open
+        } else if is_slipping(z[t] + w[t]) {
+            NodeState::Slip
+        } else {
+            NodeState::Stick
+        }
+    }
+}
+
+/// A frictional node's state at one step; its number (`as u8`) is the VTU field
+/// `friction_state`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum NodeState {
+    /// Not in contact ([`in_contact`]).
+    Open = 0,
+    /// In contact, `|δ| <= SLIP_TOL`.
+    Stick = 1,
+    /// In contact, `|δ| > SLIP_TOL` ([`is_slipping`]).
+    Slip = 2,
+}
+
+impl ContactSet {
+    /// Each group's `Σ_j r_T,j` (the tangential reactions `r[m + j]` of its frictional nodes)
+    /// into `groups`' `tangential_reaction`; nothing without friction.
+    pub fn tangential_totals(&self, r: &[f64], groups: &mut [GroupState]) {
+        let (f, m) = (self.friction(), self.len());
+        for (j, &k) in f.normals.iter().enumerate() {
+            if let Some(g) = self.groups().iter().position(|g| g.range.contains(&k)) {
+                groups[g].tangential_reaction += r[m + j];
+            }
+        }
     }
 }

@@ -20,6 +20,6 @@ pub use body::{Body, EnergySums, HeatTerms};
 pub use certify::{Certificate, CertificateFailure};
 pub use contact::{CONTACT_GAP_TOL, ContactSet, ContactState, GroupState, in_contact};
 pub use error::RunError;
-pub use friction::{FrictionState, SLIP_TOL, is_slipping};
+pub use friction::{FrictionState, NodeState, SLIP_TOL, is_slipping};
 pub use load::Load;
 pub use stepper::{Scheme, Setup, State, StepRecord, Unstarted};

@@ -520,6 +520,13 @@ impl<B: Body> Scheme<B> {
         &self.reactions[self.contact.len()..]
     }
 
+    /// The last step's two increments `u^{n+1} − u^n` and the one before: their sum at a
+    /// tangent is the slip that the step's record classifies
+    /// ([`crate::scheme::ContactSet::node_state`]).
+    pub fn increments(&self) -> [&[f64]; 2] {
+        [&self.w, &self.z]
+    }
+
     /// The gaps `s_k u^n_{i_k} + g_k` of every constraint.
     pub fn gaps_into(&self, out: &mut [f64]) {
         self.contact.gaps_into(&self.u, out);

@@ -32,7 +32,7 @@ pub fn with_friction(scene: &PlaneScene, friction: Option<f64>) -> PlaneScene {
         &mut s.edges.top,
     ] {
         if e.condition == EdgeCondition::Signorini {
-            e.friction = friction;
+            e.friction = friction.map(|mu| mu.to_string());
         }
     }
     s

@@ -135,7 +135,7 @@ fn slope_block(scene: &PlaneScene) -> Result<RigidBlock, ConvergeError> {
     Ok(RigidBlock {
         tangential: ft / scene.plane.density,
         normal: -fy / scene.plane.density,
-        mu: scene.edges.bottom.friction.unwrap_or(0.0),
+        mu: scene.edges.bottom.constant_friction().unwrap_or(0.0),
     })
 }
 
@@ -212,7 +212,7 @@ pub fn rigid_row(kappa: f64) -> Result<RigidRow, ConvergeError> {
     row.identity = id;
     // Slope, sticking.
     let mut stick = slope.clone();
-    stick.edges.bottom.friction = Some(STICK_FRICTION);
+    stick.edges.bottom.friction = Some(STICK_FRICTION.to_string());
     let (h, id) = mean_history(&stick)?;
     let (mid, last) = (h[h.len() / 2], h[h.len() - 1]);
     let mean_velocity = (last.1 - mid.1).abs() / (last.0 - mid.0);

@@ -103,7 +103,7 @@ pub fn plane_worst() -> Result<PlaneWorst, RunError> {
         let sim_has_contact = !scene.edges.gaps()?.iter().all(Option::is_none);
         // The friction scenes' gaps are held by their audit (tests/plane_coulomb_friction.rs),
         // as in the test.
-        let frictional = scene.edges.frictions()?.iter().any(|mu| *mu > 0.0);
+        let frictional = scene.edges.frictions()?.iter().any(Option::is_some);
         for r in records.iter().skip(1) {
             w.identity = w.identity.max(r.identity_residual);
         }
