@@ -25,7 +25,8 @@ fn run_writes_the_friction_columns_and_the_total_dissipation() {
         Some(
             "step,t,energy,work,viscous_dissipation,contact_dissipation,identity_residual,\
              friction_dissipation,stick_nodes,slip_nodes,contact_nodes_bottom,\
-             contact_s_min_bottom,contact_s_max_bottom,min_gap_bottom,reaction_bottom,iterations"
+             contact_s_min_bottom,contact_s_max_bottom,min_gap_bottom,reaction_bottom,\
+             tangential_reaction_bottom,iterations"
         )
     );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();

@@ -230,3 +230,33 @@ fn t_and_x_are_the_display_of_the_rounded_values() {
         assert!(rows > 3 * disc.nodes, "{tag}: {rows} rows");
     }
 }
+
+/// `history.csv`'s `tangential_reaction_<edge>` follows `reaction_<edge>` on an edge with
+/// frictional nodes only: none for a frictionless plane (its columns as before) or a friction
+/// zero at every node, one for the frictional floor beside a frictionless Signorini wall.
+#[test]
+fn the_tangential_total_is_written_beside_the_reaction_of_frictional_edges_only() {
+    let columns = |overrides: &[&str]| {
+        let mut set = vec!["time.end=0.05".to_string()];
+        set.extend(overrides.iter().map(|s| s.to_string()));
+        let (_, scene) = viscobar::scene::load_any("plane-tilted-drop", &set).unwrap();
+        viscobar::output::memory::record_any("drop", &scene)
+            .unwrap()
+            .history_columns
+    };
+    let plain = columns(&[]);
+    assert!(
+        !plain.iter().any(|c| c.starts_with("tangential")),
+        "{plain:?}"
+    );
+    assert_eq!(columns(&["edges.bottom.friction=\"0*s\""]), plain);
+    let wall = "edges.left={condition=\"signorini\", gap=0.5}";
+    let frictional = columns(&[wall, "edges.bottom.friction=\"0.3*(s > 0.5)\""]);
+    let at = |c: &str| frictional.iter().position(|x| x == c);
+    assert_eq!(
+        at("tangential_reaction_bottom"),
+        at("reaction_bottom").map(|k| k + 1),
+        "{frictional:?}"
+    );
+    assert!(at("reaction_left").is_some() && at("tangential_reaction_left").is_none());
+}

@@ -354,7 +354,8 @@ mod tests {
     /// but for its clock fields), and its arrays are the numbers the files read back to, on a
     /// bar with sampled steps and nodes and unmeasured steps, a bar on an obstacle under every
     /// node (the extent's cells empty before contact), a bar whose obstacle moves
-    /// (`obstacle_work`), a thermal bar, a plane and a plane with friction.
+    /// (`obstacle_work`), a thermal bar, a plane and a plane with friction (its tangential
+    /// total).
     #[test]
     fn the_memory_run_holds_the_files_of_the_run_to_a_folder() {
         // Each case's scene, overrides and a column that only such a run writes.
@@ -391,7 +392,7 @@ mod tests {
             (
                 "plane-friction-tilted-drop",
                 &["time.end=0.3"],
-                "friction_dissipation",
+                "tangential_reaction_bottom",
             ),
         ];
         for (name, set, column) in cases {

@@ -348,7 +348,8 @@ pub enum Edge {
     Clamped,
     Signorini {
         gap: &'static str,
-        friction: Option<f64>,
+        /// A number or an expression in `s`.
+        friction: Option<&'static str>,
     },
 }
 
@@ -363,11 +364,17 @@ fn edge() -> impl Strategy<Value = Edge> {
                 Just("0.02 - 0.2*t"),
                 Just("0")
             ],
+            // Numbers and fields: a step (its threshold 0.03 or more from every node the
+            // widths and node counts drawn give, so that the mirror sees the same μ at each
+            // node), one zero at every node, one zero at `s = 0` only.
             prop_oneof![
-                2 => Just(None),
-                1 => Just(Some(0.0)),
-                2 => Just(Some(0.3)),
-                1 => Just(Some(1.0))
+                4 => Just(None),
+                2 => Just(Some("0")),
+                4 => Just(Some("0.3")),
+                2 => Just(Some("1.0")),
+                2 => Just(Some("0.3 + 0.4*(s > 0.37)")),
+                1 => Just(Some("0*s")),
+                1 => Just(Some("0.5*s"))
             ],
         )
             .prop_map(|(gap, friction)| Edge::Signorini { gap, friction }),
@@ -471,8 +478,14 @@ impl PlaneDraw {
                 Edge::Free => format!("{name} = {{ condition = \"free\" }}\n"),
                 Edge::Clamped => format!("{name} = {{ condition = \"clamped\" }}\n"),
                 Edge::Signorini { gap: g, friction } => {
-                    let friction =
-                        friction.map_or(String::new(), |f| format!(", friction = {f:?}"));
+                    // A number as a TOML number, an expression as a string.
+                    let friction = friction.map_or(String::new(), |f| {
+                        if f.parse::<f64>().is_ok() {
+                            format!(", friction = {f}")
+                        } else {
+                            format!(", friction = \"{}\"", gap(f))
+                        }
+                    });
                     format!(
                         "{name} = {{ condition = \"signorini\", gap = \"{}\"{friction} }}\n",
                         gap(g)
@@ -515,16 +528,17 @@ impl PlaneDraw {
         m
     }
 
-    /// With some `friction = 0`, the scene without those keys.
+    /// With some friction zero at every node (`0`, `"0*s"`), the scene without those keys.
     pub fn without_zero_friction(&self) -> Option<Self> {
-        let zero = |e: &Edge| matches!(e, Edge::Signorini { friction: Some(f), .. } if *f == 0.0);
+        let is_zero = |f: &str| f == "0" || f == "0*s";
+        let zero = |e: &Edge| matches!(e, Edge::Signorini { friction: Some(f), .. } if is_zero(f));
         if !self.edges.iter().any(zero) {
             return None;
         }
         let mut plain = self.clone();
         for e in &mut plain.edges {
             if let Edge::Signorini { friction, .. } = e
-                && *friction == Some(0.0)
+                && friction.is_some_and(is_zero)
             {
                 *friction = None;
             }
