@@ -38,6 +38,13 @@ def test_arrays_hold_the_bits_of_the_cli_files(scene, out):
     for column, values in history.items():
         assert same_bits(run.history[column], values), column
     assert run.history["step"].dtype == np.float64
+    columns = list(run.history)
+    if scene == "plane-friction-tilted-drop":
+        # The frictional floor's tangential total, beside its reaction.
+        at = columns.index("reaction_bottom")
+        assert columns[at + 1] == "tangential_reaction_bottom"
+    else:
+        assert not any(c.startswith("tangential_reaction") for c in columns)
 
     table = read_csv(files / "displacement.csv")
     kept, nodes = len(run.times), len(run.positions)
