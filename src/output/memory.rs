@@ -156,6 +156,7 @@ fn record_prepared<B: Body>(
     let optional = history::OptionalColumns {
         moving: prepared.contact().is_moving(),
         friction: !prepared.contact().friction().is_empty(),
+        sliding: prepared.contact().is_sliding(),
         thermal: B::TEMPERATURE,
     };
     let header = history::header(&groups, optional);

@@ -308,6 +308,7 @@ impl Run<'_> {
         let optional = history::OptionalColumns {
             moving: prepared.contact().is_moving(),
             friction: !prepared.contact().friction().is_empty(),
+            sliding: prepared.contact().is_sliding(),
             thermal: B::TEMPERATURE,
         };
         hist.write_all(history::header(&groups, optional).as_bytes())

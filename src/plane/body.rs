@@ -351,9 +351,17 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
     let normals = normals(&disc.grid, &disc.index, &gaps, &u0_full)?;
     let mu = scene.edges.frictions()?;
     let friction = crate::plane::friction::frictional_nodes(&normals, &disc.index, &mu);
+    let velocities = scene.edges.velocities()?;
+    let slide = crate::plane::friction::sliding_obstacles(
+        &velocities,
+        &normals,
+        &friction,
+        scene.time.step,
+    )?;
     let contact = contact_set(&normals)
         .with_motion(edge_motion(&gaps, &normals))
-        .with_friction(friction.clone());
+        .with_friction(friction.clone())
+        .with_slide(slide);
     let restrict = |v: &[f64]| disc.free.iter().map(|&d| v[d]).collect::<Vec<f64>>();
     let (displacement, velocity) = (restrict(&u0_full), restrict(&v0_full));
     let c = disc.step_matrix();

@@ -1,11 +1,13 @@
 //! The `friction` key of a plane edge, `{ condition = "signorini", gap = …, friction = μ }`:
 //! Coulomb's coefficient `μ >= 0` (a finite number; absent, 0: frictionless), on Signorini
-//! edges only, with a step solver that has a friction law (`exact` or `osqp`). Errors name
-//! `edges.<edge>.friction` (or `solver.method`).
+//! edges only, with a step solver that has a friction law (`exact` or `osqp`); and its
+//! obstacle's `velocity` along the edge's tangent (an expression in `t`, absent: 0), on an
+//! edge with friction only. Errors name `edges.<edge>.friction`, `edges.<edge>.velocity` (or
+//! `solver.method`).
 
-use crate::scene::SceneError;
 use crate::scene::plane::{EDGE_NAMES, EdgeCondition, Edges, PlaneScene};
 use crate::scene::solver::SolverMethod;
+use crate::scene::{Expression, SceneError};
 
 /// Largest size `m + 3p` of the frictional step's complementarity problem (`m` normals, `p`
 /// frictional nodes): its dense matrix, basis inverse and work space take `24 N²` bytes,
@@ -41,13 +43,40 @@ impl Edges {
         }
         Ok(out)
     }
+
+    /// The sliding speed of each edge's obstacle, `[left, right, bottom, top]` (`None` where
+    /// absent): an expression in `t` on a Signorini edge with friction > 0, finite at `t = 0`
+    /// (later times are checked as the run reaches them); an error names
+    /// `edges.<edge>.velocity`.
+    pub fn velocities(&self) -> Result<[Option<Expression>; 4], SceneError> {
+        let mu = self.frictions()?;
+        let mut out: [Option<Expression>; 4] = Default::default();
+        for (k, e) in self.all().into_iter().enumerate() {
+            let Some(text) = &e.velocity else { continue };
+            let field = format!("edges.{}.velocity", EDGE_NAMES[k]);
+            if e.condition != EdgeCondition::Signorini || mu[k] <= 0.0 {
+                return Err(SceneError::Invalid {
+                    field,
+                    value: text.clone(),
+                    allowed: "an obstacle slides along a Signorini edge with friction > 0 only \
+                              (its speed along the edge's tangent)"
+                        .into(),
+                });
+            }
+            let speed = Expression::parse_time(&field, text)?;
+            speed.eval(0.0, 0.0)?;
+            out[k] = Some(speed);
+        }
+        Ok(out)
+    }
 }
 
 impl PlaneScene {
-    /// The friction keys: values, edges, the solver method, and the size of the frictional
+    /// The friction keys: values, edges, sliding speeds, the solver method, and the size of the frictional
     /// step's problem (at most `MAX_FRICTION_LCP`, counting every node of a frictional edge).
     pub fn validate_friction(&self) -> Result<(), SceneError> {
         let mu = self.edges.frictions()?;
+        self.edges.velocities()?;
         let Some(edge) = (0..4).find(|&k| mu[k] > 0.0) else {
             return Ok(());
         };

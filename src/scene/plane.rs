@@ -114,8 +114,8 @@ pub enum EdgeCondition {
 }
 
 /// One edge: its condition and, for `signorini`, the gap (a number or an expression in the
-/// edge's coordinate `s`: `x` along bottom and top, `y` along left and right) and the Coulomb
-/// friction coefficient (`crate::scene::friction`).
+/// edge's coordinate `s`: `x` along bottom and top, `y` along left and right), the Coulomb
+/// friction coefficient and the obstacle's sliding speed (`crate::scene::friction`).
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EdgeSpec {
@@ -129,6 +129,14 @@ pub struct EdgeSpec {
     /// `μ >= 0` of a Signorini edge (absent: 0, frictionless).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction: Option<f64>,
+    /// The obstacle's speed along the edge's tangent, a number or an expression in `t`, of a
+    /// Signorini edge with friction (absent: 0, a fixed obstacle).
+    #[serde(
+        default,
+        deserialize_with = "optional_expression",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub velocity: Option<String>,
 }
 
 impl EdgeSpec {
@@ -138,6 +146,7 @@ impl EdgeSpec {
             condition,
             gap: None,
             friction: None,
+            velocity: None,
         }
     }
 
@@ -147,6 +156,7 @@ impl EdgeSpec {
             condition: EdgeCondition::Signorini,
             gap: Some(gap.to_string()),
             friction: None,
+            velocity: None,
         }
     }
 }
