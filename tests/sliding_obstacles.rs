@@ -7,8 +7,11 @@ mod common;
 
 use viscobar::output::run_plane_in_memory;
 use viscobar::scene::plane::{PlaneScene, plane_builtin_text};
+use viscobar_certificate::friction::osqp_agreement;
 use viscobar_certificate::plane::moving::{BELT_SPEED, galilean_belt};
-use viscobar_certificate::tolerances::{FRICTION_DISSIPATION_TOL, PLANE_IDENTITY_TOL};
+use viscobar_certificate::tolerances::{
+    FRICTION_DISSIPATION_TOL, PLANE_IDENTITY_TOL, friction_osqp_agreement_ratio,
+};
 
 fn launch(sets: &[&str]) -> PlaneScene {
     let text = plane_builtin_text("plane-friction-launch").unwrap();
@@ -148,4 +151,44 @@ const CASES: &[(&str, &[&str], &str)] = &[
 fn bad_velocity_input_exits_2_naming_the_key_and_writes_nothing() {
     let out = common::fresh_dir("sliding", "bad");
     common::assert_each_refused("plane-tilted-drop", CASES, &out);
+}
+
+/// The built-in stick–slip scene sticks and slips in turn: in every half period of the belt
+/// after the first, most of the bottom sticks at some step (where the belt turns) and all of
+/// it slips at another; its identity closes with `D_f >= 0` at every step.
+#[test]
+fn the_stick_slip_scene_sticks_and_slips_in_turn() {
+    let text = plane_builtin_text("plane-friction-stick-slip").unwrap();
+    let scene = PlaneScene::from_toml(text, &[]).unwrap();
+    let (records, _, sim) = run_plane_in_memory("stick-slip", &scene).unwrap();
+    let nodes = sim.contact().friction().len();
+    let half = (0.5 / scene.time.step).round() as usize;
+    for (k, period) in records.chunks(half).enumerate().skip(1) {
+        let most_stick = period.iter().any(|r| 2 * r.stick_nodes > nodes);
+        let all_slip = period.iter().any(|r| r.slip_nodes == nodes);
+        assert!(most_stick && all_slip, "half period {k}");
+    }
+    for r in records.iter().skip(1) {
+        assert!(r.identity_residual <= PLANE_IDENTITY_TOL, "{r:?}");
+        assert!(
+            r.friction_dissipation >= -FRICTION_DISSIPATION_TOL * r.energy,
+            "{r:?}"
+        );
+    }
+}
+
+/// OSQP's Tresca fixed point agrees with the exact Lemke step on the relative slip, within the
+/// friction agreement bound, its answers audited against the Tresca law with the sliding
+/// obstacle: the first period of the stick–slip belt.
+#[test]
+fn osqp_agrees_with_the_exact_step_on_a_sliding_obstacle() {
+    let text = plane_builtin_text("plane-friction-stick-slip").unwrap();
+    let scene = PlaneScene::from_toml(text, &["time.end=1.0".into()]).unwrap();
+    let a = osqp_agreement("stick-slip", &scene).unwrap();
+    let ratio = friction_osqp_agreement_ratio(&a);
+    println!("{a:?} ratio {ratio:.3e}");
+    assert!(ratio <= 1.0, "{ratio:e} of the bound: {a:?}");
+    assert!(a.audit_worst_ratio <= 1.0, "{a:?}");
+    // The fixed point iterates: Coulomb is more than one Tresca problem.
+    assert!(a.max_iterations > 2 && a.mean_iterations > 1.0, "{a:?}");
 }
