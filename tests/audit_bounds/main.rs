@@ -353,6 +353,13 @@ fn evaluate<S>(body: &Body<S>, case: &Case, a: &Answer) -> Eval {
     let (cz_norm, b_norm, z_norm, r_norm) = (cz.amax(), amax(&b), amax(&a.z), amax(&a.r));
     let p_scale = (body.rows[..m].iter().zip(&a.lo))
         .fold(0.0f64, |s, (&(i, _), lo)| s.max(a.z[i].abs()).max(lo.abs()));
+    // A sliding obstacle's displacements join the gaps' scale where the law has a slip.
+    let slip_law = case.frictional() && case.previous() && !matches!(case.1, Kind::Frictionless);
+    let p_scale = if slip_law {
+        a.v.iter().fold(p_scale, |s, v| s.max(v.abs()))
+    } else {
+        p_scale
+    };
     // The slack in force, displacement and gaps.
     let (e_a, e_r) = (MARGIN * EPS_ABS, MARGIN * EPS_REL);
     let (s_f, s_dz, s_z, slack) = match case.3 {

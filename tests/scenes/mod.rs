@@ -349,6 +349,8 @@ pub enum Edge {
     Signorini {
         gap: &'static str,
         friction: Option<f64>,
+        /// The obstacle's speed along the edge (refused without friction).
+        velocity: Option<&'static str>,
     },
 }
 
@@ -369,8 +371,24 @@ fn edge() -> impl Strategy<Value = Edge> {
                 2 => Just(Some(0.3)),
                 1 => Just(Some(1.0))
             ],
+            prop_oneof![
+                3 => Just(None),
+                1 => Just(Some("0.5")),
+                1 => Just(Some("-0.3*t")),
+                1 => Just(Some("0.2*sin(2*pi*t)"))
+            ],
+            // A speed on an edge without friction (refused) in a quarter of its draws.
+            prop::bool::weighted(0.25),
         )
-            .prop_map(|(gap, friction)| Edge::Signorini { gap, friction }),
+            .prop_map(|(gap, friction, velocity, keep)| {
+                let frictional = friction.is_some_and(|f| f > 0.0);
+                let velocity = velocity.filter(|_| frictional || keep);
+                Edge::Signorini {
+                    gap,
+                    friction,
+                    velocity,
+                }
+            }),
     ]
 }
 
@@ -470,11 +488,24 @@ impl PlaneDraw {
             t += &match e {
                 Edge::Free => format!("{name} = {{ condition = \"free\" }}\n"),
                 Edge::Clamped => format!("{name} = {{ condition = \"clamped\" }}\n"),
-                Edge::Signorini { gap: g, friction } => {
+                Edge::Signorini {
+                    gap: g,
+                    friction,
+                    velocity,
+                } => {
                     let friction =
                         friction.map_or(String::new(), |f| format!(", friction = {f:?}"));
+                    // Along bottom and top the tangent `+e_x` turns under the mirror.
+                    let velocity = velocity.map_or(String::new(), |v| {
+                        let v = if self.mirrored && k >= 2 {
+                            format!("-({v})")
+                        } else {
+                            v.to_string()
+                        };
+                        format!(", velocity = \"{v}\"")
+                    });
                     format!(
-                        "{name} = {{ condition = \"signorini\", gap = \"{}\"{friction} }}\n",
+                        "{name} = {{ condition = \"signorini\", gap = \"{}\"{friction}{velocity} }}\n",
                         gap(g)
                     )
                 }
@@ -513,6 +544,40 @@ impl PlaneDraw {
         m.mirrored = !self.mirrored;
         m.edges.swap(0, 1);
         m
+    }
+
+    /// Where the body may travel along `x` with its obstacles (no clamped edge, left and right
+    /// free, a frictional bottom or top edge, the exact solver): the scene whose frictional
+    /// bottom and top obstacles slide at `c` (a belt) and its twin with them fixed and the
+    /// initial velocity's `x` lowered by `c`, whose final `x` displacement is the first's less
+    /// `c t_N` (the shift along `x` leaves every normal constraint, along `y`, as it is).
+    pub fn belt_twins(&self) -> Option<(Self, Self, f64)> {
+        let frictional =
+            |e: &Edge| matches!(e, Edge::Signorini { friction: Some(f), .. } if *f > 0.0);
+        let free = |e: &Edge| matches!(e, Edge::Free);
+        if !(free(&self.edges[0]) && free(&self.edges[1]))
+            || !self.edges[2..].iter().any(frictional)
+            || self.edges.iter().any(|e| matches!(e, Edge::Clamped))
+            || self.solver != "exact"
+        {
+            return None;
+        }
+        let c = 0.3;
+        let (mut belt, mut fixed) = (self.clone(), self.clone());
+        for k in 2..4 {
+            let on = frictional(&self.edges[k]);
+            for (draw, speed) in [(&mut belt, Some("0.3")), (&mut fixed, None)] {
+                if let Edge::Signorini { velocity, .. } = &mut draw.edges[k] {
+                    *velocity = if on { speed } else { None };
+                }
+            }
+        }
+        // In the scene's own frame: a mirrored draw's `x` is `W − x`, its speeds negated.
+        let vx = format!("({}) - {c:?}", self.velocity[0]);
+        fixed.velocity[0] = Box::leak(vx.into_boxed_str());
+        let t_end = self.steps as f64 * self.dt;
+        let sign = if self.mirrored { -1.0 } else { 1.0 };
+        Some((belt, fixed, sign * c * t_end))
     }
 
     /// With some `friction = 0`, the scene without those keys.
