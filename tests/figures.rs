@@ -175,6 +175,11 @@ fn expected_files() -> Vec<(String, (u32, u32))> {
             files.push((format!("{stem}.{ext}"), figures::PAIR_SIZE));
         }
     }
+    for scene in figures::FRICTION_FIGURES {
+        for ext in ["png", "svg"] {
+            files.push((format!("{scene}.{ext}"), figures::FRICTION_FIGURE_SIZE));
+        }
+    }
     files
 }
 
@@ -219,6 +224,20 @@ fn figures_command_writes_every_talk_figure_reproducibly() {
             svg.contains(&format!("width=\"{}\" height=\"{}\"", size.0, size.1)),
             "{name}: size"
         );
+        if figures::FRICTION_FIGURES
+            .iter()
+            .any(|f| name.starts_with(f))
+        {
+            // The stick/slip state, the pressure and the traction over (s, t), as cells.
+            for needle in [
+                "state (white open, blue stick",
+                "normal pressure",
+                "traction",
+            ] {
+                assert!(svg.contains(needle), "{name}: lacks `{needle}`");
+            }
+            continue;
+        }
         let maps = svg.matches("\"data:image/png;base64,").count();
         let panels = if name.starts_with("figure-") { 2 } else { 1 };
         // Distributed scenes draw their contact set over (x, t) as a second colour map.
@@ -304,7 +323,7 @@ fn docs_figures_are_the_pngs_the_command_writes() {
     let readme =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
     assert!(readme.contains("`cargo run --release -- figures --out docs/figures`"));
-    for scene in figures::talk_scenes() {
+    for scene in figures::talk_scenes().chain(figures::FRICTION_FIGURES.iter().copied()) {
         let link = format!("(docs/figures/{scene}.png)");
         assert!(readme.contains(&link), "README does not show {scene}");
     }

@@ -1,8 +1,8 @@
-//! Snapshot regression of `plane-friction-tilted-drop`: statistics of the run at 11 steps
-//! (`n = 1`, the start-up step, and `N/10, …, N`), rounded, in the reviewed YAML file
-//! `snapshots/plane/plane-friction-tilted-drop.snap` (never raw matrices or fields). A change
-//! that moves the frictional drop's numbers fails this test; the README ("Snapshots") says how
-//! to review and accept it.
+//! Snapshot regression of `plane-friction-tilted-drop` and `plane-friction-stick-slip` (a block
+//! on a reciprocating belt): statistics of each run at 11 steps (`n = 1`, the start-up step,
+//! and `N/10, …, N`), rounded, in the reviewed YAML files `snapshots/plane/<scene>.snap` (never
+//! raw matrices or fields). A change that moves a frictional scene's numbers fails this test;
+//! the README ("Snapshots") says how to review and accept it.
 //!
 //! Rounding: each quantity to [`SIGNIFICANT_DIGITS`] digits of its largest magnitude over the
 //! run, as `tests/plane_contact_snapshot.rs`: far above the run's round-off, far below its
@@ -40,20 +40,35 @@ struct Row {
     tangential_force: f64,
     /// The mean displacement of the nodes (x, y).
     mean_u: [f64; 2],
+    /// `Σ W_T` up to this step: the sliding obstacle's work (absent without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    sliding_work: Option<f64>,
 }
 
 #[test]
 fn the_frictional_tilted_drop_matches_its_reviewed_snapshot() {
-    let scene = plane_scene("plane-friction-tilted-drop", &[]).unwrap();
+    snapshot("plane-friction-tilted-drop");
+}
+
+#[test]
+fn the_stick_slip_belt_matches_its_reviewed_snapshot() {
+    snapshot("plane-friction-stick-slip");
+}
+
+fn snapshot(name: &str) {
+    let scene = plane_scene(name, &[]).unwrap();
     let steps = scene.steps();
     let mut sim = PlaneSimulation::new(&scene).unwrap();
     let mut rows = Vec::new();
     let mut record = sim.first_record();
     let mut dissipated = 0.0;
+    let mut sliding_work = 0.0;
+    let sliding = sim.contact().is_sliding();
     for n in 1..=steps {
         if n > 1 {
             record = sim.step().unwrap();
             dissipated += record.friction_dissipation;
+            sliding_work += record.sliding_work;
         }
         if n > 1 && !(n * (T_POINTS - 1)).is_multiple_of(steps) {
             continue;
@@ -71,6 +86,7 @@ fn the_frictional_tilted_drop_matches_its_reviewed_snapshot() {
             normal_force: sim.reactions().iter().sum::<f64>() + 0.0,
             tangential_force: sim.tangential_reactions().iter().sum::<f64>() + 0.0,
             mean_u,
+            sliding_work: sliding.then_some(sliding_work),
         });
     }
     let scale = |f: &dyn Fn(&Row) -> f64| rows.iter().map(|r| f(r).abs()).fold(0.0, f64::max);
@@ -81,6 +97,7 @@ fn the_frictional_tilted_drop_matches_its_reviewed_snapshot() {
         scale(&|r| r.tangential_force),
     );
     let su = scale(&|r| r.mean_u[0].abs().max(r.mean_u[1].abs()));
+    let sw = scale(&|r| r.sliding_work.unwrap_or(0.0));
     for r in &mut rows {
         r.t = round_sig(r.t, 1.0);
         r.energy = round_sig(r.energy, se);
@@ -88,9 +105,10 @@ fn the_frictional_tilted_drop_matches_its_reviewed_snapshot() {
         r.normal_force = round_sig(r.normal_force, sn);
         r.tangential_force = round_sig(r.tangential_force, st);
         r.mean_u = r.mean_u.map(|v| round_sig(v, su));
+        r.sliding_work = r.sliding_work.map(|v| round_sig(v, sw));
     }
     assert_eq!(rows.len(), T_POINTS);
     with_settings!({snapshot_path => "../snapshots/plane", prepend_module_to_snapshot => false}, {
-        insta::assert_yaml_snapshot!("plane-friction-tilted-drop", &rows);
+        insta::assert_yaml_snapshot!(name, &rows);
     });
 }

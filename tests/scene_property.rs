@@ -2,12 +2,13 @@
 //! (bar: ends free, clamped or Signorini with fixed, moving or oscillating gaps, an obstacle, the
 //! mass and matrix variants, loads, `[heat]` with every end condition, each solver; plane: edges
 //! free, clamped or Signorini with fixed, varying and moving gaps, friction as a number or a
-//! field of `s`, both integration rules, tilted loads, each solver), small and short. Each draw
-//! is refused naming a key with nothing written, or runs certified at every step (the run checks
-//! its identity against its bound itself, the solvers their audits) with finite records, contact
-//! consistent with the reactions and files free of NaN and infinity. Over the same draws the
-//! metamorphic relations: the mirrored bar and plane, a friction zero at every node against no
-//! key, `coupling = 0` against no `[heat]`, a moving obstacle against its Galilean twin.
+//! field of `s`, sliding obstacles, both integration rules, tilted loads, each solver), small
+//! and short. Each draw is refused naming a key with nothing written, or runs certified at
+//! every step (the run checks its identity against its bound itself, the solvers their audits)
+//! with finite records, contact consistent with the reactions and files free of NaN and
+//! infinity. Over the same draws the metamorphic relations: the mirrored bar and plane, a
+//! friction zero at every node against no key, `coupling = 0` against no `[heat]`, a moving
+//! obstacle and a belt (a sliding obstacle) against their Galilean twins.
 //!
 //! `cargo test` draws `SCENE_CASES` scenes of each body (default 150) from the fixed seed; the
 //! soak: `SCENE_CASES=1000 cargo test --release --test scene_property` (2000 scenes), or other
@@ -342,7 +343,8 @@ fn bar_relations(d: &BarDraw, records: &[StepRecord], u: &[f64]) -> Result<(), T
 }
 
 /// The plane's relations over one draw: the mirrored scene (`x → W − x`) has the same energies
-/// and friction dissipation; a friction zero at every node matches no friction key.
+/// and friction dissipation; a belt matches its Galilean twin; a friction zero at every node
+/// matches no friction key.
 fn plane_relations(d: &PlaneDraw, records: &[StepRecord], u: &[f64]) -> Result<(), TestCaseError> {
     let text = d.toml();
     // The mirror for the solvers exact to round-off (OSQP's answers differ by its tolerance).
@@ -362,6 +364,19 @@ fn plane_relations(d: &PlaneDraw, records: &[StepRecord], u: &[f64]) -> Result<(
                 "mirror: D_f, step {}\n{text}",
                 a.step
             );
+        }
+    }
+    // A belt against its Galilean twin: frictional bottom and top obstacles sliding at `c`
+    // against fixed ones with the velocity lowered by `c`, so that u_fixed = u_belt − c t along
+    // x (every unknown is free: x components at even indices).
+    if let Some((belt, fixed, shift)) = d.belt_twins() {
+        if let (Some((_, ub)), Some((_, uf))) =
+            (twin(&belt.toml(), &text)?, twin(&fixed.toml(), &text)?)
+        {
+            let shifted: Vec<f64> = (ub.iter().enumerate())
+                .map(|(i, x)| if i % 2 == 0 { x - shift } else { *x })
+                .collect();
+            prop_assert!(close(&shifted, &uf, TWIN_TOL), "belt twins\n{}", text);
         }
     }
     let Some(plain) = d.without_zero_friction() else {

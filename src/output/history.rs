@@ -5,8 +5,8 @@
 //! frictional nodes `tangential_reaction_G`, their tangential total), then the iterations.
 //! Optional columns follow `identity_residual` ([`OptionalColumns`]): `obstacle_work` when an
 //! obstacle moves; with friction, the friction dissipation `D_f` (empty when not measured) and
-//! the frictional nodes that stick and slip; for a bar with a temperature, the identity's
-//! thermal terms.
+//! the frictional nodes that stick and slip; `sliding_work` when an obstacle slides; for a bar
+//! with a temperature, the identity's thermal terms.
 
 use crate::output::text::{push_time, push_value};
 use crate::scheme::StepRecord;
@@ -21,6 +21,8 @@ const ENERGY_COLUMNS: &str =
 const OBSTACLE_COLUMN: &str = ",obstacle_work";
 /// The columns of a run with friction.
 const FRICTION_COLUMNS: &str = ",friction_dissipation,stick_nodes,slip_nodes";
+/// The column of a run whose obstacles slide along their edges.
+const SLIDING_COLUMN: &str = ",sliding_work";
 /// The thermal terms of a bar with a temperature.
 const THERMAL_COLUMNS: &str = ",thermal_energy,thermal_dissipation,exchange,heat_supply";
 
@@ -31,6 +33,8 @@ pub struct OptionalColumns {
     pub moving: bool,
     /// Some edge has friction: `friction_dissipation`, `stick_nodes`, `slip_nodes`.
     pub friction: bool,
+    /// An obstacle slides along its edge: `sliding_work`.
+    pub sliding: bool,
     /// The body has a temperature: `thermal_energy`, `thermal_dissipation`, `exchange`,
     /// `heat_supply`.
     pub thermal: bool,
@@ -52,6 +56,7 @@ impl OptionalColumns {
         Self {
             moving: contact.is_moving(),
             friction: !contact.friction().is_empty(),
+            sliding: contact.is_sliding(),
             thermal,
             tangential,
         }
@@ -66,6 +71,9 @@ pub fn header(groups: &[Group], optional: OptionalColumns) -> String {
     }
     if optional.friction {
         h.push_str(FRICTION_COLUMNS);
+    }
+    if optional.sliding {
+        h.push_str(SLIDING_COLUMN);
     }
     if optional.thermal {
         h.push_str(THERMAL_COLUMNS);
@@ -117,6 +125,12 @@ pub fn row(r: &StepRecord, groups: &[Group], optional: OptionalColumns, row: &mu
             push_value(r.friction_dissipation, row);
         }
         write!(row, ",{},{}", r.stick_nodes, r.slip_nodes).expect("writing to a vector");
+    }
+    if optional.sliding {
+        row.push(b',');
+        if r.measured {
+            push_value(r.sliding_work, row);
+        }
     }
     if optional.thermal {
         let h = r.heat.unwrap_or_default();

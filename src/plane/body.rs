@@ -354,9 +354,17 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
     if let Some(&first) = friction.normals.first() {
         scene.check_frictional_step(normals.len(), friction.len(), normals[first].edge)?;
     }
+    let velocities = scene.edges.velocities()?;
+    let slide = crate::plane::friction::sliding_obstacles(
+        &velocities,
+        &normals,
+        &friction,
+        scene.time.step,
+    )?;
     let contact = contact_set(&normals)
         .with_motion(edge_motion(&gaps, &normals))
-        .with_friction(friction.clone());
+        .with_friction(friction.clone())
+        .with_slide(slide);
     let restrict = |v: &[f64]| disc.free.iter().map(|&d| v[d]).collect::<Vec<f64>>();
     let (displacement, velocity) = (restrict(&u0_full), restrict(&v0_full));
     let c = disc.step_matrix();

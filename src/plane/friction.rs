@@ -3,12 +3,12 @@
 //! (`+e_y` along left and right, `+e_x` along bottom and top); the step solver that has the law
 //! is [`crate::step::algorithm`]'s choice for [`crate::step::Shape::PlaneFriction`]. A corner
 //! shared with another Signorini edge carries that edge's normal on its tangential component
-//! and no friction.
+//! and no friction. An edge's obstacle may slide along `t` ([`sliding_obstacles`]).
 
 use crate::plane::normals::Normal;
-use crate::scene::SceneError;
-use crate::scene::expr::Expression;
 use crate::scene::friction::friction_at;
+use crate::scene::{Expression, SceneError};
+use crate::scheme::Slide;
 use crate::step::Friction;
 
 /// The frictional nodes of the normals `normals` (in the contact set's order) with the edges'
@@ -40,4 +40,27 @@ pub fn frictional_nodes(
         friction.coefficients.push(coefficient);
     }
     Ok(friction)
+}
+
+/// The obstacles of the edges with a `velocity` (`[left, right, bottom, top]`, speeds along the
+/// edge's tangent) under the frictional nodes of `friction`, with time step `dt`; `None` when
+/// no edge's obstacle slides.
+pub fn sliding_obstacles(
+    velocities: &[Option<Expression>; 4],
+    normals: &[Normal],
+    friction: &Friction,
+    dt: f64,
+) -> Result<Option<Slide>, SceneError> {
+    let mut laws = Vec::new();
+    let mut law_of_edge = [None; 4];
+    for (edge, v) in velocities.iter().enumerate() {
+        if let Some(v) = v {
+            law_of_edge[edge] = Some(laws.len());
+            laws.push(v.clone());
+        }
+    }
+    let law_of_node = (friction.normals.iter())
+        .map(|&k| law_of_edge[normals[k].edge])
+        .collect();
+    Slide::new(laws, law_of_node, dt)
 }

@@ -4,13 +4,13 @@
 //! node of the edge ([`friction_at`]); a node where `μ(s) = 0` is frictionless, so a key that is
 //! zero at every node is no key. The frictional step (some `μ(s) > 0`) needs a step solver
 //! with a friction law (`exact` or `osqp`) and at most [`MAX_FRICTION_LCP`] unknowns
-//! ([`PlaneScene::check_frictional_step`]). Errors name `edges.<edge>.friction` (or
-//! `solver.method`).
+//! ([`PlaneScene::check_frictional_step`]). An edge with friction may have an obstacle sliding
+//! along its tangent, `velocity` (an expression in `t`; absent: 0). Errors name
+//! `edges.<edge>.friction`, `edges.<edge>.velocity` (or `solver.method`).
 
-use crate::scene::SceneError;
-use crate::scene::expr::Expression;
 use crate::scene::plane::{EDGE_NAMES, EdgeCondition, EdgeSpec, Edges, PlaneScene};
 use crate::scene::solver::SolverMethod;
+use crate::scene::{Expression, SceneError};
 
 /// Largest size `m + 3p` of the frictional step's complementarity problem (`m` normals, `p`
 /// frictional nodes): its dense matrix, basis inverse and work space take `24 N²` bytes,
@@ -82,13 +82,40 @@ impl Edges {
         }
         Ok(out)
     }
+
+    /// The sliding speed of each edge's obstacle, `[left, right, bottom, top]` (`None` where
+    /// absent): an expression in `t` on a Signorini edge with a `friction` key (not the constant 0), finite at `t = 0`
+    /// (later times are checked as the run reaches them); an error names
+    /// `edges.<edge>.velocity`.
+    pub fn velocities(&self) -> Result<[Option<Expression>; 4], SceneError> {
+        let mu = self.frictions()?;
+        let mut out: [Option<Expression>; 4] = Default::default();
+        for (k, e) in self.all().into_iter().enumerate() {
+            let Some(text) = &e.velocity else { continue };
+            let field = format!("edges.{}.velocity", EDGE_NAMES[k]);
+            if e.condition != EdgeCondition::Signorini || mu[k].is_none() {
+                return Err(SceneError::Invalid {
+                    field,
+                    value: text.clone(),
+                    allowed: "an obstacle slides along a Signorini edge with friction only \
+                              (its speed along the edge's tangent)"
+                        .into(),
+                });
+            }
+            let speed = Expression::parse_time(&field, text)?;
+            speed.eval(0.0, 0.0)?;
+            out[k] = Some(speed);
+        }
+        Ok(out)
+    }
 }
 
 impl PlaneScene {
     /// The friction keys as far as they are known without the mesh: each parsed, on a
-    /// Signorini edge, a constant finite and `>= 0` ([`Edges::frictions`]).
+    /// Signorini edge, a constant finite and `>= 0` ([`Edges::frictions`]), and each
+    /// obstacle's sliding speed ([`Edges::velocities`]).
     pub fn validate_friction(&self) -> Result<(), SceneError> {
-        self.edges.frictions().map(drop)
+        self.edges.velocities().map(drop)
     }
 
     /// The frictional step of `normals` contact normals and `frictional` frictional nodes, the

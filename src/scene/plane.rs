@@ -114,8 +114,8 @@ pub enum EdgeCondition {
 }
 
 /// One edge: its condition and, for `signorini`, the gap (a number or an expression in the
-/// edge's coordinate `s`: `x` along bottom and top, `y` along left and right) and the Coulomb
-/// friction coefficient (`crate::scene::friction`).
+/// edge's coordinate `s`: `x` along bottom and top, `y` along left and right), the Coulomb
+/// friction coefficient and the obstacle's sliding speed (`crate::scene::friction`).
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EdgeSpec {
@@ -134,6 +134,14 @@ pub struct EdgeSpec {
         skip_serializing_if = "Option::is_none"
     )]
     pub friction: Option<String>,
+    /// The obstacle's speed along the edge's tangent, a number or an expression in `t`, of a
+    /// Signorini edge with friction (absent: 0, a fixed obstacle).
+    #[serde(
+        default,
+        deserialize_with = "optional_expression",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub velocity: Option<String>,
 }
 
 impl EdgeSpec {
@@ -143,6 +151,7 @@ impl EdgeSpec {
             condition,
             gap: None,
             friction: None,
+            velocity: None,
         }
     }
 
@@ -152,6 +161,7 @@ impl EdgeSpec {
             condition: EdgeCondition::Signorini,
             gap: Some(gap.to_string()),
             friction: None,
+            velocity: None,
         }
     }
 }

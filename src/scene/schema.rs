@@ -354,6 +354,10 @@ pub const PLANE_BUILTIN: &[(&str, &str)] = &[
         "plane-friction-launch",
         include_str!("../../scenes/plane-friction-launch.toml"),
     ),
+    (
+        "plane-friction-stick-slip",
+        include_str!("../../scenes/plane-friction-stick-slip.toml"),
+    ),
 ];
 
 /// The TOML text of a built-in plane scene.

@@ -6,9 +6,11 @@
 //! pushes along `s_k e_{i_k}`. One definition of "in contact" serves every body and output:
 //! [`in_contact`]. The constraints form named groups (an end of the bar, an edge of the plane,
 //! the bar's whole obstacle), whose contact episodes the outputs report. An obstacle may move
-//! ([`GapMotion`]): its gaps `g_k(t)` are then set before each step's bounds.
+//! ([`GapMotion`]): its gaps `g_k(t)` are then set before each step's bounds; a frictional
+//! edge's obstacle may slide along the edge ([`Slide`]), moved on at the same time.
 
 use crate::scene::{Expression, SceneError};
+use crate::scheme::slide::Slide;
 use crate::step::{Constraints, Friction};
 use std::ops::Range;
 
@@ -77,6 +79,8 @@ pub struct ContactSet {
     motion: Option<Box<GapMotion>>,
     /// The frictional nodes (none without friction), [`crate::scheme::friction`].
     friction: Friction,
+    /// The obstacles that slide along their edges, if any ([`ContactSet::with_slide`]).
+    slide: Option<Box<Slide>>,
 }
 
 /// One constraint whose obstacle moves: `g_k(t) = min(law(s, t), cap)`.
@@ -209,6 +213,7 @@ impl ContactSet {
             groups,
             motion: None,
             friction: Friction::default(),
+            slide: None,
         }
     }
 
@@ -237,6 +242,9 @@ impl ContactSet {
     /// g^n ← g^{n+1} ← g(t)`. Does nothing (and allocates nothing) when no obstacle moves; an
     /// error names the gap's field and the point where it is not finite.
     pub fn advance_gaps(&mut self, t: f64) -> Result<(), SceneError> {
+        if let Some(slide) = self.slide.as_deref_mut() {
+            slide.advance(t)?;
+        }
         let Some(motion) = self.motion.as_deref_mut() else {
             return Ok(());
         };
@@ -279,6 +287,23 @@ impl ContactSet {
     /// The frictional nodes (empty without friction).
     pub fn friction(&self) -> &Friction {
         &self.friction
+    }
+
+    /// The same constraints with the frictional nodes' obstacles sliding by `slide` (moved on
+    /// by [`ContactSet::advance_gaps`]); `None` keeps them fixed.
+    pub fn with_slide(mut self, slide: Option<Slide>) -> Self {
+        self.slide = slide.map(Box::new);
+        self
+    }
+
+    /// The sliding obstacles, if any.
+    pub fn slide(&self) -> Option<&Slide> {
+        self.slide.as_deref()
+    }
+
+    /// Whether an obstacle slides along its edge.
+    pub fn is_sliding(&self) -> bool {
+        self.slide.is_some()
     }
 
     /// Reactions of a step: one per constraint, then one tangential per frictional node.

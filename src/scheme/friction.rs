@@ -1,8 +1,9 @@
 //! The friction state of a step, for a contact set with frictional nodes: the friction
 //! dissipation `D_f = −½ Σ_j r_T,j δ_j` of the energy identity (`δ_j = (u^{n+1} − u^{n−1})_{t_j}`,
 //! the central slip; `= ½ Σ_j μ_j r_N,j |δ_j| >= 0` by Coulomb's law), and the frictional nodes
-//! in contact that stick or slip ([`is_slipping`], one definition for every output).
-//! Derivation: `docs/friction.md`.
+//! in contact that stick or slip ([`is_slipping`], one definition for every output). An
+//! obstacle sliding along its edge ([`crate::scheme::Slide`]) makes the slip relative, `δ_j − v_j`, and does
+//! the work `½ Σ_j r_T,j v_j`. Derivation: `docs/friction.md`.
 
 use crate::scheme::contact::{ContactSet, GroupState, in_contact};
 
@@ -44,24 +45,46 @@ impl ContactSet {
                 NodeState::Slip => state.slip_nodes += 1,
             }
             if dissipation {
-                let t = f.tangents[j];
-                state.dissipation += -0.5 * r[m + j] * (z[t] + w[t]);
+                state.dissipation += -0.5 * r[m + j] * self.relative_slip(j, (z, w));
             }
         }
         state
     }
 
-    /// The state of frictional node `j` at `u = u^{n+1}` with central slip `(z + w)_{t_j}`
-    /// (`z`, `w` the step's two increments, in either order).
+    /// The sliding obstacles' work over the step just taken, `½ Σ_j r_T,j v_j` (`r` the normal
+    /// then the tangential reactions): positive when an obstacle drags the body along its
+    /// motion (0 when none slides).
+    pub fn sliding_work(&self, r: &[f64]) -> f64 {
+        let Some(slide) = self.slide() else {
+            return 0.0;
+        };
+        let m = self.len();
+        let mut work = 0.0;
+        for (j, v) in slide.displacement().iter().enumerate() {
+            work += 0.5 * r[m + j] * v;
+        }
+        work
+    }
+
+    /// The slip of frictional node `j` relative to its obstacle, `(z + w)_{t_j} − v_j` (`z`, `w`
+    /// the step's two increments, in either order; `v_j` a sliding obstacle's displacement over
+    /// them, [`crate::scheme::Slide`]; `− 0.0` keeps a fixed obstacle's bits).
+    #[inline]
+    pub fn relative_slip(&self, j: usize, (z, w): (&[f64], &[f64])) -> f64 {
+        let t = self.friction().tangents[j];
+        z[t] + w[t] - self.slide().map_or(0.0, |s| s.displacement()[j])
+    }
+
+    /// The state of frictional node `j` at `u = u^{n+1}` with its relative central slip
+    /// ([`ContactSet::relative_slip`]).
     #[inline]
     pub fn node_state(&self, j: usize, (u, z, w): (&[f64], &[f64], &[f64])) -> NodeState {
         let f = self.friction();
         let k = f.normals[j];
         let gap = self.direction(k) * u[self.unknown(k)] + self.gaps()[k];
-        let t = f.tangents[j];
         if !in_contact(gap) {
             NodeState::Open
-        } else if is_slipping(z[t] + w[t]) {
+        } else if is_slipping(self.relative_slip(j, (z, w))) {
             NodeState::Slip
         } else {
             NodeState::Stick

@@ -14,6 +14,7 @@ pub(crate) mod contact;
 pub(crate) mod error;
 pub(crate) mod friction;
 pub(crate) mod load;
+pub(crate) mod slide;
 pub(crate) mod stepper;
 
 pub use body::{Body, EnergySums, HeatTerms};
@@ -22,4 +23,5 @@ pub use contact::{CONTACT_GAP_TOL, ContactSet, ContactState, GroupState, in_cont
 pub use error::RunError;
 pub use friction::{FrictionState, NodeState, SLIP_TOL, is_slipping};
 pub use load::Load;
+pub use slide::Slide;
 pub use stepper::{Scheme, Setup, State, StepRecord, Unstarted};

@@ -27,7 +27,8 @@ pub struct StepRecord {
     pub viscous_dissipation: f64,
     /// `D = −½ Σ_k r_k (s_k (u^{n+1} − u^{n−1})_{i_k} + g_k^{n+1} − g_k^{n−1}) >= 0`.
     pub contact_dissipation: f64,
-    /// `|E^{n+1/2} − E^{n−1/2} − work − obstacle_work + viscous + D + D_f|` over the largest
+    /// `|E^{n+1/2} − E^{n−1/2} − work − obstacle_work − sliding_work + viscous + D + D_f|` over
+    /// the largest
     /// of those terms (with a temperature: `+ thermal dissipation + exchange − supply`,
     /// [`HeatTerms`]), or over the run's energy resolution `ENERGY_RESOLUTION` times the
     /// largest term measured so far where that is larger.
@@ -38,8 +39,12 @@ pub struct StepRecord {
     /// `W = −½ Σ_k r_k (g_k^{n+1} − g_k^{n−1})`, the work of moving obstacles (0 when none
     /// moves; of either sign).
     pub obstacle_work: f64,
-    /// `D_f = −½ Σ_j r_T,j δ_j >= 0`, the friction dissipation (0 without friction).
+    /// `D_f = −½ Σ_j r_T,j δ_j >= 0`, the friction dissipation (0 without friction), `δ_j`
+    /// relative to a sliding obstacle.
     pub friction_dissipation: f64,
+    /// `W_T = ½ Σ_j r_T,j v_j`, the work of obstacles sliding along their edges (0 when none
+    /// slides; of either sign).
+    pub sliding_work: f64,
     /// Frictional nodes in contact that stick and that slip (`crate::scheme::friction`).
     pub stick_nodes: usize,
     pub slip_nodes: usize,
@@ -160,6 +165,9 @@ impl<B: Body> Scheme<B> {
     fn start_up(&mut self, v0: &[f64]) -> Result<(), RunError> {
         let (dt, alpha) = (self.body.dt(), self.body.viscosity());
         self.contact.advance_gaps(dt)?;
+        if let Some(slide) = self.contact.slide() {
+            self.solver.set_obstacle_slide(slide.displacement());
+        }
         self.contact.lower_bounds_into(&self.u, &mut self.lower);
         self.body.prepare_step(0, &self.lower)?;
         // a = M⁻¹ (F^0 − K u^0 − α K u_1), in z.
@@ -258,7 +266,9 @@ impl<B: Body> Scheme<B> {
     ///    side and `g^{n+1} − g^{n−1}` to `D`'s bracket ([`ContactSet::advance_gaps`],
     ///    [docs/moving-obstacles.md](../../docs/moving-obstacles.md)). With friction the
     ///    right-hand side also loses `D_f = −½ Σ_j r_T,j δ_{t_j} >= 0`
-    ///    (`crate::scheme::friction`); the solver reads `w` for the central slip.
+    ///    (`crate::scheme::friction`); the solver reads `w` for the central slip. An obstacle
+    ///    sliding along its edge by `v_j` makes the slip relative and adds its work
+    ///    `W_T = ½ Σ_j r_T,j v_j` ([`crate::scheme::Slide`]).
     ///
     /// The identity is measured every `[output] diagnostics_every`-th step and at the last; a
     /// measured step after an unmeasured one first recomputes `E^{n−1/2}` from `u^n` and `w`,
@@ -282,6 +292,9 @@ impl<B: Body> Scheme<B> {
         let clock = clock.lap(&mut self.timing.rhs_ns);
         // 3. The constrained minimisation, and u^{n+1} = u^n + z.
         self.solver.set_previous_increment(&self.w);
+        if let Some(slide) = self.contact.slide() {
+            self.solver.set_obstacle_slide(slide.displacement());
+        }
         let info = (self.solver)
             .solve_and_advance(
                 &self.b,
@@ -307,6 +320,7 @@ impl<B: Body> Scheme<B> {
         if measure {
             let sums = (self.body).energy_sums(&self.u, &self.z, &self.w, self.load.force());
             record.obstacle_work = self.contact.obstacle_work(&self.reactions);
+            record.sliding_work = self.contact.sliding_work(&self.reactions);
             let heat = self.body.heat_terms(&self.u, &self.z, &self.w);
             self.close_balance(&mut record, sums, [contact, friction.dissipation], heat)?;
         }
@@ -354,9 +368,10 @@ impl<B: Body> Scheme<B> {
             0.0
         };
         let work = 0.5 * sums.work;
-        let obstacle = record.obstacle_work;
+        let (obstacle, sliding) = (record.obstacle_work, record.sliding_work);
         // Subtracting a zero obstacle work is exact: fixed obstacles keep their bits.
-        let mut residual = energy - before - work - obstacle + viscous + contact + friction;
+        let mut residual =
+            energy - before - work - obstacle - sliding + viscous + contact + friction;
         let mut scale = [
             energy,
             before,
@@ -365,6 +380,7 @@ impl<B: Body> Scheme<B> {
             contact.abs(),
             obstacle.abs(),
             friction.abs(),
+            sliding.abs(),
         ]
         .into_iter()
         .fold(0.0, f64::max);
@@ -421,11 +437,14 @@ impl<B: Body> Scheme<B> {
         &self.contact
     }
 
-    /// Whether something can feed energy in: a load, a moving obstacle, or a temperature (heat
-    /// may come in through the ends, a source or an exchange); without any a run cannot gain
-    /// energy.
+    /// Whether something can feed energy in: a load, a moving or sliding obstacle, or a
+    /// temperature (heat may come in through the ends, a source or an exchange); without any a
+    /// run cannot gain energy.
     pub fn is_forced(&self) -> bool {
-        self.load.force().is_some() || self.contact.is_moving() || B::TEMPERATURE
+        self.load.force().is_some()
+            || self.contact.is_moving()
+            || self.contact.is_sliding()
+            || B::TEMPERATURE
     }
 
     /// The load vector `F^n` on the unknowns (zeros without a load), as the step from `t_n`

@@ -212,6 +212,11 @@ impl KktAudit {
         for (j, &node) in self.rows.unknowns[..m].iter().enumerate() {
             p_scale = p_scale.max(z[node].abs()).max(lower[j].abs());
         }
+        // A sliding obstacle's displacements are data of the condensed problem (its slips), to
+        // whose size the answer's gaps are rounded: they join the gaps' scale (0 when fixed).
+        if let Some(slip) = law.slip() {
+            p_scale = slip.obstacle.iter().fold(p_scale, |a, v| a.max(v.abs()));
+        }
         // The slack in force, in displacement, and in the gaps.
         let (slack_f, slack_dz, slack_z) = match slack {
             Slack::Osqp { eps_abs, eps_rel } => {

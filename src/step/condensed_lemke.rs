@@ -1,5 +1,5 @@
 //! The exact frictional step: Coulomb friction at the frictional nodes, with the central slip
-//! `δ_j = (z + w)_{t_j}` (`w` the previous increment) and the law `|r_T| <= μ r_N`,
+//! `δ_j = (z + w)_{t_j} − v_j` (`w` the previous increment, `v_j` a sliding obstacle's) and the law `|r_T| <= μ r_N`,
 //! `r_T = −μ r_N sign δ` where `δ ≠ 0`. Condensed onto the normals and the tangents,
 //! `S = E C⁻¹ Eᵀ` (`E` the normal rows `s_k e_{i_k}ᵀ` and the tangential rows `e_{t_j}ᵀ`), the
 //! step is the Stewart–Trinkle LCP in `(r_N, β⁺, β⁻, λ)` (`r_T = β⁺ − β⁻`, `λ` the slip
@@ -74,6 +74,8 @@ pub struct CondensedLemke<S: SpdSystem> {
     /// The previous increment at the tangents, and whether it was given.
     previous: Vec<f64>,
     slip_known: bool,
+    /// The obstacles' tangential displacements `v_j` (zeros unless an obstacle slides).
+    obstacle: Vec<f64>,
     q: Vec<f64>,
     x: Vec<f64>,
     q_normal: Vec<f64>,
@@ -112,6 +114,7 @@ impl<S: SpdSystem> CondensedLemke<S> {
             sigma,
             previous: vec![0.0; p],
             slip_known: false,
+            obstacle: vec![0.0; p],
             q: vec![0.0; n],
             x: vec![0.0; n],
             q_normal: vec![0.0; m],
@@ -150,8 +153,12 @@ impl<S: SpdSystem> CondensedLemke<S> {
         for k in 0..m {
             self.q[k] = self.q_normal[k] * inv;
         }
+        let slip = Slip {
+            previous: &self.previous,
+            obstacle: &self.obstacle,
+        };
         for j in 0..p {
-            let delta = z[self.friction.tangents[j]] + self.previous[j];
+            let delta = slip.at(j, z[self.friction.tangents[j]]);
             self.q[m + j] = delta * inv;
             self.q[m + p + j] = -delta * inv;
             self.q[m + 2 * p + j] = 0.0;
@@ -181,6 +188,10 @@ impl<S: SpdSystem> StepSolver for CondensedLemke<S> {
     fn set_previous_increment(&mut self, w: &[f64]) {
         self.friction.tangential_into(w, &mut self.previous);
         self.slip_known = true;
+    }
+
+    fn set_obstacle_slide(&mut self, v: &[f64]) {
+        self.obstacle.copy_from_slice(v);
     }
 
     fn solve(
@@ -222,6 +233,7 @@ impl<S: SpdSystem> StepSolver for CondensedLemke<S> {
                 mu: &self.friction.coefficients,
                 slip: Slip {
                     previous: &self.previous,
+                    obstacle: &self.obstacle,
                 },
             }
         } else {

@@ -8,27 +8,32 @@
 //! residual), its checks and names in the audit, its bound tests in `tests/audit_bounds/`.
 //! `docs/step-solvers.md#kkt-audit` and `docs/friction.md#audit` derive the audit's tolerances.
 
-/// The slip of the frictional nodes over the step, `δ_j = (z + w)_{t_j}` (the central slip,
-/// `w` the previous increment at the tangents). A sliding obstacle, moving tangentially by
-/// `v_j` over the step, makes the slip relative, `δ_j = (z + w)_{t_j} − v_j`: one more field
-/// here, read by [`Slip::at`] and by the audit's slip-law floor ([`Slip::scale`]).
+/// The slip of the frictional nodes over the step, relative to the obstacle,
+/// `δ_j = (z + w)_{t_j} − v_j`: the central slip, `w` the previous increment at the tangents,
+/// less `v_j`, the obstacle's tangential displacement over the same two steps (0 for a fixed
+/// obstacle; `docs/friction.md#sliding-obstacles`). Read by [`Slip::at`] and by the audit's
+/// slip-law floor ([`Slip::scale`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Slip<'a> {
     /// `w_j`, the previous increment at the tangents.
     pub previous: &'a [f64],
+    /// `v_j`, the obstacle's tangential displacement over the two steps (zeros when fixed).
+    pub obstacle: &'a [f64],
 }
 
 impl Slip<'_> {
-    /// `δ_j` of node `j` whose tangential unknown is `z_t`.
+    /// `δ_j` of node `j` whose tangential unknown is `z_t` (`− 0.0` is exact: a fixed
+    /// obstacle's slip has the bits of `z_t + w_j`).
     #[inline]
     pub fn at(&self, j: usize, z_t: f64) -> f64 {
-        z_t + self.previous[j]
+        z_t + self.previous[j] - self.obstacle[j]
     }
 
-    /// The magnitude added to `z_t` in [`Slip::at`], `|w_j|`: `δ_j` rounds to ulps of it.
+    /// The magnitudes added to `z_t` in [`Slip::at`], `|w_j| + |v_j|`: `δ_j` rounds to ulps
+    /// of them.
     #[inline]
     pub fn scale(&self, j: usize) -> f64 {
-        self.previous[j].abs()
+        self.previous[j].abs() + self.obstacle[j].abs()
     }
 }
 

@@ -7,7 +7,7 @@
 //! ```
 //!
 //! (`S`, `q` of [`crate::step::condensed_lemke`]; its KKT conditions are Signorini on the normals and
-//! Tresca's law on the central slip), solved by OSQP, set up once and warm-started; `z` then
+//! Tresca's law on the central slip, relative to a sliding obstacle), solved by OSQP, set up once and warm-started; `z` then
 //! from `C z = b + Eᵀ r`, and each answer audited against the Tresca law it solved
 //! ([`crate::step::audit`]). The iteration starts from the previous step's normal
 //! reactions and stops when they change by at most [`FIXED_POINT_TOL`] (relative); beyond
@@ -42,6 +42,8 @@ pub struct OsqpTresca<S: SpdSystem> {
     sigma: f64,
     previous: Vec<f64>,
     slip_known: bool,
+    /// The obstacles' tangential displacements `v_j` (zeros unless an obstacle slides).
+    obstacle: Vec<f64>,
     /// `q / σ`, the bounds, the thresholds, the iterate and the warm start.
     q: Vec<f64>,
     lower: Vec<f64>,
@@ -116,6 +118,7 @@ impl<S: SpdSystem> OsqpTresca<S> {
             sigma,
             previous: vec![0.0; p],
             slip_known: false,
+            obstacle: vec![0.0; p],
             q,
             lower,
             upper,
@@ -171,6 +174,7 @@ impl<S: SpdSystem> OsqpTresca<S> {
             thresholds: &self.thresholds,
             slip: (self.slip_known).then_some(Slip {
                 previous: &self.previous,
+                obstacle: &self.obstacle,
             }),
         };
         let slack = Slack::Bounds {
@@ -192,6 +196,10 @@ impl<S: SpdSystem> StepSolver for OsqpTresca<S> {
         self.slip_known = true;
     }
 
+    fn set_obstacle_slide(&mut self, v: &[f64]) {
+        self.obstacle.copy_from_slice(v);
+    }
+
     fn solve(
         &mut self,
         rhs: &[f64],
@@ -210,13 +218,18 @@ impl<S: SpdSystem> StepSolver for OsqpTresca<S> {
         for k in 0..m {
             self.q[k] = (signs[k] * z[unknowns[k]] - lower[k]) * inv;
         }
+        let slip = Slip {
+            previous: &self.previous,
+            obstacle: &self.obstacle,
+        };
         for j in 0..p {
-            let w = if self.slip_known {
-                self.previous[j]
+            let z_t = z[self.friction.tangents[j]];
+            let delta = if self.slip_known {
+                slip.at(j, z_t)
             } else {
-                0.0
+                z_t + 0.0
             };
-            self.q[m + j] = (z[self.friction.tangents[j]] + w) * inv;
+            self.q[m + j] = delta * inv;
         }
         self.problem.update_lin_cost(&self.q);
         let mut inaccurate = false;

@@ -120,6 +120,12 @@ pub trait StepSolver {
     /// unknowns. Default: ignored.
     fn set_previous_increment(&mut self, _w: &[f64]) {}
 
+    /// `v_j`, the tangential displacement of each frictional node's obstacle over the slip's
+    /// interval (one per frictional node), given before a solve when an obstacle slides along
+    /// its edge: the slip becomes `(z + w)_{t_j} − v_j` ([`crate::step::law::Slip`]). Default:
+    /// ignored (no friction law).
+    fn set_obstacle_slide(&mut self, _v: &[f64]) {}
+
     /// Statistics over all solves so far; `None` for solvers that keep none.
     fn report(&self) -> Option<SolverReport> {
         None

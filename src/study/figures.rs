@@ -5,15 +5,18 @@
 //! Per scene (`<scene>.png`, `<scene>.svg`): the displacement `u(x, t)` as a colour map with a
 //! colour bar (for a bar with a temperature, `θ(x, t)` beside it on its own scale), beside the
 //! contact history. Per talk figure (`figure-<k>.png/.svg`): the `l = 0`
-//! scene beside the forced one, as the talk lays them out.
+//! scene beside the forced one, as the talk lays them out. Per friction figure
+//! (`<scene>.png/.svg`): the stick/slip state and forces over `(s, t)`.
 //!
 //! Only with the `plots` feature (on by default), which brings plotters and the font.
 
 #![cfg(feature = "plots")]
 
 use crate::scene;
+use crate::scene::plane::{PlaneScene, plane_builtin_text};
 use crate::scheme::RunError;
 use crate::study::figure_writer::{DrawResult, Drawing, FigureError, register_font, write_figure};
+use crate::study::friction_figure::{self, FrictionFigure};
 use crate::study::sampled_run::{ContactHistory, SampledRun, Sampling, sample_run};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
@@ -41,6 +44,14 @@ pub const TALK_FIGURES: &[(&str, &str, [&str; 2])] = &[
         ["distributed", "distributed-forced"],
     ),
 ];
+
+/// The frictional scenes whose contact over `(s, t)` `viscobar figures` also draws
+/// (`<scene>.png`/`.svg`, the figure of `run SCENE --figure`'s `friction-state`), each of one
+/// frictional edge ([`FRICTION_FIGURE_SIZE`]).
+pub const FRICTION_FIGURES: &[&str] = &["plane-friction-stick-slip"];
+
+/// Size of a friction figure of one frictional edge.
+pub const FRICTION_FIGURE_SIZE: (u32, u32) = friction_figure::figure_size(1);
 
 /// The talk scenes, figure by figure.
 pub fn talk_scenes() -> impl Iterator<Item = &'static str> {
@@ -102,6 +113,16 @@ pub fn write_talk_figures(out: &Path, overrides: &[String]) -> Result<Vec<PathBu
         let sampling = Sampling::for_figure(scene);
         runs.push(sample_run(name, scene, sampling).map_err(run_err(name))?);
     }
+    let mut friction = Vec::new();
+    for &name in FRICTION_FIGURES {
+        let text = plane_builtin_text(name).expect("a built-in plane scene");
+        // The scene's own solver: `--solver penalty` has no friction law.
+        let scene = PlaneScene::from_toml(text, &[])
+            .map_err(RunError::from)
+            .map_err(run_err(name))?;
+        let figure = FrictionFigure::run(name, &scene).map_err(run_err(name))?;
+        friction.push((name, figure.expect("a frictional scene")));
+    }
     register_font()?;
     create_folder(out)?;
     let mut written = Vec::new();
@@ -112,6 +133,9 @@ pub fn write_talk_figures(out: &Path, overrides: &[String]) -> Result<Vec<PathBu
         let pair = [&runs[2 * k], &runs[2 * k + 1]];
         let title = format!("Figure {}: {caption}", k + 1);
         written.extend(write_both(out, stem, &TalkFigure::Pair(&title, pair))?);
+    }
+    for (name, figure) in &friction {
+        written.extend(figure.write_as(out, name)?);
     }
     Ok(written)
 }

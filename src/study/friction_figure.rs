@@ -2,7 +2,8 @@
 //! of each node (open, sticking, slipping towards `+s` or `−s`, [`crate::scheme::is_slipping`]),
 //! its normal pressure `r_N/ω` and its tangential traction `r_T/ω` (`ω` its trapezoid share of
 //! the edge) as colour maps, `s` along the edge, `t` upwards (`friction-state.png`/`.svg`,
-//! written beside the deformed mesh by `viscobar run SCENE --figure`). Only with `plots`.
+//! written beside the deformed mesh by `viscobar run SCENE --figure`; `viscobar figures` draws
+//! it of the stick–slip scene). The slip is relative to a sliding obstacle. Only with `plots`.
 
 #![cfg(feature = "plots")]
 
@@ -91,11 +92,15 @@ impl FrictionFigure {
         let (mut max_pressure, mut max_traction) = (0.0f64, 0.0f64);
         let mut gaps = vec![0.0; sim.contact().len()];
         let mut previous: Vec<f64> = friction.tangents.iter().map(|_| 0.0).collect();
+        let mut obstacle = previous.clone();
         for n in 1..steps {
             for (p, &t) in previous.iter_mut().zip(&friction.tangents) {
                 *p = sim.state().w[t];
             }
             sim.step()?;
+            if let Some(slide) = sim.contact().slide() {
+                obstacle.copy_from_slice(slide.displacement());
+            }
             if !(n + 1).is_multiple_of(every) {
                 continue;
             }
@@ -105,7 +110,8 @@ impl FrictionFigure {
                 let row: NodeRow = (e.nodes.iter())
                     .map(|&j| {
                         let k = friction.normals[j];
-                        let delta = w[friction.tangents[j]] + previous[j];
+                        // Relative to a sliding obstacle (`crate::scheme::friction`).
+                        let delta = w[friction.tangents[j]] + previous[j] - obstacle[j];
                         let state = match (in_contact(gaps[k]), is_slipping(delta)) {
                             (false, _) => State::Open,
                             (true, false) => State::Stick,
@@ -140,14 +146,25 @@ impl FrictionFigure {
 
     /// Writes `friction-state.png`/`.svg` into `out`; returns their paths.
     pub fn write(&self, out: &Path) -> Result<Vec<PathBuf>, FigureError> {
+        self.write_as(out, "friction-state")
+    }
+
+    /// Writes `<stem>.png`/`.svg` into `out`; returns their paths.
+    pub fn write_as(&self, out: &Path, stem: &str) -> Result<Vec<PathBuf>, FigureError> {
         let mut files = Vec::new();
         for ext in ["png", "svg"] {
-            let path = out.join(format!("friction-state.{ext}"));
+            let path = out.join(format!("{stem}.{ext}"));
             write_figure(&path, self)?;
             files.push(path);
         }
         Ok(files)
     }
+}
+
+/// The figure's size in pixels with `edges` frictional edges (three maps each).
+pub const fn figure_size(edges: usize) -> (u32, u32) {
+    let panels = 3 * edges as u32;
+    (WIDTH, TITLE_HEIGHT + panels * PANEL_HEIGHT + 2 * BAR_HEIGHT)
 }
 
 fn state_colour(s: State) -> RGBColor {
@@ -172,8 +189,7 @@ fn diverging(v: f64, top: f64) -> RGBColor {
 
 impl Drawing for FrictionFigure {
     fn size(&self) -> (u32, u32) {
-        let panels = 3 * self.edges.len() as u32;
-        (WIDTH, TITLE_HEIGHT + panels * PANEL_HEIGHT + 2 * BAR_HEIGHT)
+        figure_size(self.edges.len())
     }
 
     fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult

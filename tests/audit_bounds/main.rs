@@ -145,7 +145,10 @@ impl Case {
 
     /// The law handed to the audit for answer `a`, and the family the audit is set up for.
     fn law<'a, S>(&self, body: &'a Body<S>, a: &'a Answer) -> (Law<'a>, LawFamily<'a>) {
-        let slip = Slip { previous: &a.w };
+        let slip = Slip {
+            previous: &a.w,
+            obstacle: &a.v,
+        };
         let law = match self.1 {
             Kind::Signorini => Law::Signorini,
             Kind::Penalty(epsilon) => Law::Penalty { epsilon },
@@ -173,13 +176,15 @@ struct Answer {
     r: Vec<f64>,
     lo: Vec<f64>,
     w: Vec<f64>,
+    /// The obstacle's tangential displacement `v_j` (a sliding obstacle's; zeros here).
+    v: Vec<f64>,
     extra: Vec<f64>,
 }
 
 impl Answer {
-    /// `δ_j = (z + w)_{t_j}`, as the audit rounds it.
+    /// `δ_j = (z + w)_{t_j} − v_j`, as the audit rounds it.
     fn slip<S>(&self, body: &Body<S>, j: usize) -> f64 {
-        self.z[body.rows[body.m + j].0] + self.w[j]
+        self.z[body.rows[body.m + j].0] + self.w[j] - self.v[j]
     }
 
     /// Constraint `k` active (`lo_k = s_k z_{i_k}`).
@@ -263,7 +268,15 @@ fn base<S>(body: &Body<S>, case: &Case) -> Answer {
         PREVIOUS[..body.p].to_vec(),
         vec![0.0; z.len()],
     );
-    let mut a = Answer { z, r, lo, w, extra };
+    let v = vec![0.0; w.len()];
+    let mut a = Answer {
+        z,
+        r,
+        lo,
+        w,
+        v,
+        extra,
+    };
     for j in 0..body.p {
         a.settle(body, case, j);
     }
@@ -340,6 +353,13 @@ fn evaluate<S>(body: &Body<S>, case: &Case, a: &Answer) -> Eval {
     let (cz_norm, b_norm, z_norm, r_norm) = (cz.amax(), amax(&b), amax(&a.z), amax(&a.r));
     let p_scale = (body.rows[..m].iter().zip(&a.lo))
         .fold(0.0f64, |s, (&(i, _), lo)| s.max(a.z[i].abs()).max(lo.abs()));
+    // A sliding obstacle's displacements join the gaps' scale where the law has a slip.
+    let slip_law = case.frictional() && case.previous() && !matches!(case.1, Kind::Frictionless);
+    let p_scale = if slip_law {
+        a.v.iter().fold(p_scale, |s, v| s.max(v.abs()))
+    } else {
+        p_scale
+    };
     // The slack in force, displacement and gaps.
     let (e_a, e_r) = (MARGIN * EPS_ABS, MARGIN * EPS_REL);
     let (s_f, s_dz, s_z, slack) = match case.3 {
@@ -393,7 +413,8 @@ fn evaluate<S>(body: &Body<S>, case: &Case, a: &Answer) -> Eval {
         keep(&mut cone, ((rt.abs() - g).max(0.0), tol_f + ulp * g.abs()));
         if case.previous() {
             let delta = a.slip(body, j);
-            let t = tol_f * delta.abs() + (tol_z + ulp * a.w[j].abs()) * (g.abs() + rt.abs());
+            let t = tol_f * delta.abs()
+                + (tol_z + ulp * (a.w[j].abs() + a.v[j].abs())) * (g.abs() + rt.abs());
             keep(&mut slip, ((g * delta.abs() + rt * delta).abs(), t));
         }
     }
@@ -644,12 +665,13 @@ fn friction_cone() {
 
 /// Node `j` sliding (`δ = SLIPS[j]`, its normal pressed) with `r_T` short of the cone by `y`,
 /// `r_T = −sign δ (g − y)`: the slip law's value is `y |δ|`, placed at `f` times
-/// `τ_f |δ| + (τ_z + ε'|w|)(|g| + |r_T|)`. The start-up steps have no slip law.
+/// `τ_f |δ| + (τ_z + ε'(|w| + |v|))(|g| + |r_T|)`, on a fixed obstacle (`v = 0`) and on one
+/// sliding by `v = 1/4` over the step. The start-up steps have no slip law.
 #[test]
 fn slip_law() {
     let body = friction_plane();
     for case in FRICTION_CASES.iter().filter(|c| c.previous()) {
-        for j in 0..P {
+        for (j, obstacle) in (0..P).flat_map(|j| [(j, 0.0), (j, 0.25)]) {
             let k = FRICTIONAL[j];
             let mut a = base(&body, case);
             if a.r[k] == 0.0 {
@@ -657,16 +679,18 @@ fn slip_law() {
                 a.activate(&body, k);
             }
             let delta = SLIPS[j];
-            a.w[j] = delta - a.z[body.rows[M + j].0];
+            a.v[j] = obstacle;
+            a.w[j] = delta + obstacle - a.z[body.rows[M + j].0];
             assert_eq!(a.slip(&body, j), delta, "the slip is exact");
             a.settle(&body, case, j);
-            let label = format!("node {j}, delta = {delta}");
+            let label = format!("node {j}, delta = {delta}, v = {obstacle}");
             let at = (&body, case, label.as_str());
             bracket(at, (SLIP, SLIP), &a, |a, f, e| {
                 let g = threshold(&body, case, a, j);
                 let ulp = SPARSE_ULPS * f64::EPSILON;
                 let t = e.tol.f * delta.abs()
-                    + (e.tol.z + ulp * a.w[j].abs()) * (g.abs() + a.r[M + j].abs());
+                    + (e.tol.z + ulp * (a.w[j].abs() + a.v[j].abs()))
+                        * (g.abs() + a.r[M + j].abs());
                 a.r[M + j] = -delta.signum() * (g - f * t / delta.abs());
             });
         }

@@ -350,6 +350,8 @@ pub enum Edge {
         gap: &'static str,
         /// A number or an expression in `s`.
         friction: Option<&'static str>,
+        /// The obstacle's speed along the edge (refused without friction).
+        velocity: Option<&'static str>,
     },
 }
 
@@ -376,8 +378,25 @@ fn edge() -> impl Strategy<Value = Edge> {
                 1 => Just(Some("0*s")),
                 1 => Just(Some("0.5*s"))
             ],
+            prop_oneof![
+                3 => Just(None),
+                1 => Just(Some("0.5")),
+                1 => Just(Some("-0.3*t")),
+                1 => Just(Some("0.2*sin(2*pi*t)"))
+            ],
+            // A speed on an edge without friction (refused) in a quarter of its draws.
+            prop::bool::weighted(0.25),
         )
-            .prop_map(|(gap, friction)| Edge::Signorini { gap, friction }),
+            .prop_map(|(gap, friction, velocity, keep)| {
+                // The schema takes a speed on an edge with a friction key other than `0`.
+                let frictional = friction.is_some_and(|f| f != "0");
+                let velocity = velocity.filter(|_| frictional || keep);
+                Edge::Signorini {
+                    gap,
+                    friction,
+                    velocity,
+                }
+            }),
     ]
 }
 
@@ -477,7 +496,11 @@ impl PlaneDraw {
             t += &match e {
                 Edge::Free => format!("{name} = {{ condition = \"free\" }}\n"),
                 Edge::Clamped => format!("{name} = {{ condition = \"clamped\" }}\n"),
-                Edge::Signorini { gap: g, friction } => {
+                Edge::Signorini {
+                    gap: g,
+                    friction,
+                    velocity,
+                } => {
                     // A number as a TOML number, an expression as a string.
                     let friction = friction.map_or(String::new(), |f| {
                         if f.parse::<f64>().is_ok() {
@@ -486,8 +509,17 @@ impl PlaneDraw {
                             format!(", friction = \"{}\"", gap(f))
                         }
                     });
+                    // Along bottom and top the tangent `+e_x` turns under the mirror.
+                    let velocity = velocity.map_or(String::new(), |v| {
+                        let v = if self.mirrored && k >= 2 {
+                            format!("-({v})")
+                        } else {
+                            v.to_string()
+                        };
+                        format!(", velocity = \"{v}\"")
+                    });
                     format!(
-                        "{name} = {{ condition = \"signorini\", gap = \"{}\"{friction} }}\n",
+                        "{name} = {{ condition = \"signorini\", gap = \"{}\"{friction}{velocity} }}\n",
                         gap(g)
                     )
                 }
@@ -528,21 +560,61 @@ impl PlaneDraw {
         m
     }
 
+    /// Where the body may travel along `x` with its obstacles (no clamped edge, left and right
+    /// free, a frictional bottom or top edge, the exact solver): the scene whose frictional
+    /// bottom and top obstacles slide at `c` (a belt) and its twin with them fixed and the
+    /// initial velocity's `x` lowered by `c`, whose final `x` displacement is the first's less
+    /// `c t_N` (the shift along `x` leaves every normal constraint, along `y`, as it is).
+    pub fn belt_twins(&self) -> Option<(Self, Self, f64)> {
+        let frictional = |e: &Edge| matches!(e, Edge::Signorini { friction: Some(f), .. } if !is_zero_friction(f));
+        let free = |e: &Edge| matches!(e, Edge::Free);
+        if !(free(&self.edges[0]) && free(&self.edges[1]))
+            || !self.edges[2..].iter().any(frictional)
+            || self.edges.iter().any(|e| matches!(e, Edge::Clamped))
+            || self.solver != "exact"
+        {
+            return None;
+        }
+        let c = 0.3;
+        let (mut belt, mut fixed) = (self.clone(), self.clone());
+        for k in 2..4 {
+            let on = frictional(&self.edges[k]);
+            for (draw, speed) in [(&mut belt, Some("0.3")), (&mut fixed, None)] {
+                if let Edge::Signorini { velocity, .. } = &mut draw.edges[k] {
+                    *velocity = if on { speed } else { None };
+                }
+            }
+        }
+        // In the scene's own frame: a mirrored draw's `x` is `W − x`, its speeds negated.
+        let vx = format!("({}) - {c:?}", self.velocity[0]);
+        fixed.velocity[0] = Box::leak(vx.into_boxed_str());
+        let t_end = self.steps as f64 * self.dt;
+        let sign = if self.mirrored { -1.0 } else { 1.0 };
+        Some((belt, fixed, sign * c * t_end))
+    }
+
     /// With some friction zero at every node (`0`, `"0*s"`), the scene without those keys.
     pub fn without_zero_friction(&self) -> Option<Self> {
-        let is_zero = |f: &str| f == "0" || f == "0*s";
-        let zero = |e: &Edge| matches!(e, Edge::Signorini { friction: Some(f), .. } if is_zero(f));
+        let zero = |e: &Edge| matches!(e, Edge::Signorini { friction: Some(f), .. } if is_zero_friction(f));
         if !self.edges.iter().any(zero) {
             return None;
         }
         let mut plain = self.clone();
         for e in &mut plain.edges {
-            if let Edge::Signorini { friction, .. } = e
-                && friction.is_some_and(is_zero)
+            if let Edge::Signorini {
+                friction, velocity, ..
+            } = e
+                && friction.is_some_and(is_zero_friction)
             {
-                *friction = None;
+                // A sliding obstacle under no frictional node does nothing.
+                (*friction, *velocity) = (None, None);
             }
         }
         Some(plain)
     }
+}
+
+/// The drawn frictions that are zero at every node (no frictional node).
+fn is_zero_friction(f: &str) -> bool {
+    f == "0" || f == "0*s"
 }

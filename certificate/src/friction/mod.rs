@@ -22,7 +22,8 @@ pub const FRICTION_SCENES: [&str; 3] = [
     "plane-friction-launch",
 ];
 
-/// `scene` with the friction key of every Signorini edge set to `friction` (`None`: absent).
+/// `scene` with the friction key of every Signorini edge set to `friction` (`None`: absent;
+/// without friction an edge's obstacle does not slide).
 pub fn with_friction(scene: &PlaneScene, friction: Option<f64>) -> PlaneScene {
     let mut s = scene.clone();
     for e in [
@@ -33,6 +34,10 @@ pub fn with_friction(scene: &PlaneScene, friction: Option<f64>) -> PlaneScene {
     ] {
         if e.condition == EdgeCondition::Signorini {
             e.friction = friction.map(|mu| mu.to_string());
+            // A sliding obstacle belongs to a frictional edge: without friction it is fixed.
+            if !friction.is_some_and(|mu| mu > 0.0) {
+                e.velocity = None;
+            }
         }
     }
     s
