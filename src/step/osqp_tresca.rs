@@ -11,7 +11,8 @@
 //! from `C z = b + Eᵀ r`, and each answer audited against the Tresca law it solved
 //! ([`crate::step::audit`]). The iteration starts from the previous step's normal
 //! reactions and stops when they change by at most [`FIXED_POINT_TOL`] (relative); beyond
-//! [`FIXED_POINT_MAX_ITERATIONS`] it is an error. The start-up step is one QP with `g = 0`.
+//! [`FIXED_POINT_MAX_ITERATIONS`] it is an error. The start-up step is the same fixed point with
+//! `w = 0` (the slip `u^1 − u^0`), from `g = 0`.
 
 use crate::linalg::norms::max_abs;
 use crate::linalg::system::{Csc, SpdSystem};
@@ -40,8 +41,8 @@ pub struct OsqpTresca<S: SpdSystem> {
     settings: OsqpSettings,
     problem: Problem,
     sigma: f64,
+    /// The previous increment at the tangents (0 until given: the start-up step's law).
     previous: Vec<f64>,
-    slip_known: bool,
     /// `q / σ`, the bounds, the thresholds, the iterate and the warm start.
     q: Vec<f64>,
     lower: Vec<f64>,
@@ -115,7 +116,6 @@ impl<S: SpdSystem> OsqpTresca<S> {
             problem,
             sigma,
             previous: vec![0.0; p],
-            slip_known: false,
             q,
             lower,
             upper,
@@ -169,9 +169,9 @@ impl<S: SpdSystem> OsqpTresca<S> {
         let eps_q = self.settings.eps_abs + self.settings.eps_rel * max_abs(&self.q);
         let law = Law::Tresca {
             thresholds: &self.thresholds,
-            slip: (self.slip_known).then_some(Slip {
+            slip: Slip {
                 previous: &self.previous,
-            }),
+            },
         };
         let slack = Slack::Bounds {
             force: factor * eps,
@@ -189,7 +189,6 @@ impl<S: SpdSystem> StepSolver for OsqpTresca<S> {
 
     fn set_previous_increment(&mut self, w: &[f64]) {
         self.friction.tangential_into(w, &mut self.previous);
-        self.slip_known = true;
     }
 
     fn solve(
@@ -211,12 +210,7 @@ impl<S: SpdSystem> StepSolver for OsqpTresca<S> {
             self.q[k] = (signs[k] * z[unknowns[k]] - lower[k]) * inv;
         }
         for j in 0..p {
-            let w = if self.slip_known {
-                self.previous[j]
-            } else {
-                0.0
-            };
-            self.q[m + j] = (z[self.friction.tangents[j]] + w) * inv;
+            self.q[m + j] = (z[self.friction.tangents[j]] + self.previous[j]) * inv;
         }
         self.problem.update_lin_cost(&self.q);
         let mut inaccurate = false;
@@ -224,11 +218,7 @@ impl<S: SpdSystem> StepSolver for OsqpTresca<S> {
         loop {
             // Thresholds from the current normal reactions (the previous step's at first).
             for (j, g) in self.thresholds.iter_mut().enumerate() {
-                *g = if self.slip_known {
-                    self.friction.coefficients[j] * self.r[self.friction.normals[j]].max(0.0)
-                } else {
-                    0.0
-                };
+                *g = self.friction.coefficients[j] * self.r[self.friction.normals[j]].max(0.0);
             }
             self.r_before.copy_from_slice(&self.r[..m]);
             iterations += 1;
@@ -236,7 +226,7 @@ impl<S: SpdSystem> StepSolver for OsqpTresca<S> {
             let change = (reactions[..m].iter().zip(&self.r_before))
                 .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
             let scale = max_abs(&reactions[..m]).max(f64::MIN_POSITIVE);
-            if !self.slip_known || p == 0 || change <= FIXED_POINT_TOL * scale {
+            if p == 0 || change <= FIXED_POINT_TOL * scale {
                 break;
             }
             if iterations >= FIXED_POINT_MAX_ITERATIONS {
