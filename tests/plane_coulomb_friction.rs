@@ -34,6 +34,11 @@ fn zero_friction_reproduces_every_frictionless_contact_run_bit_for_bit() {
 /// stiffness: measured 0.95 to 0.97 (VERIFICATION.md, "Plane friction"; elastic transients of
 /// order 1/κ); the band is those ± 0.2.
 const RIGID_RATE_BAND: (f64, f64) = (0.75, 1.17);
+/// The launch's stop time from `κ = 100` up: friction acts from `t = 0`, so the mean velocity
+/// follows the rigid law exactly (the momentum balance) but for `μ` times the vertical mean
+/// velocity, decayed by the stop; measured at most 5.5e-10, the round-off of `C` at `κ = 1e5`
+/// (whose identity residual is of the same size), the bound 20 times that.
+const STOP_TIME_BOUND: f64 = 1e-8;
 
 #[test]
 fn the_rigid_limit_closed_forms_are_approached_as_the_block_stiffens() {
@@ -49,8 +54,10 @@ fn the_rigid_limit_closed_forms_are_approached_as_the_block_stiffens() {
     let (limit, stick) = rigid_limit_worst(&rows);
     assert!(limit <= RIGID_LIMIT_BOUND, "{limit:e}");
     assert!(stick <= STICK_VELOCITY_BOUND, "{stick:e}");
-    let errors: [fn(&RigidRow) -> f64; 3] =
-        [|r| r.slope_error, |r| r.stop_error, |r| r.distance_error];
+    for r in rows.iter().filter(|r| r.stiffness >= 100.0) {
+        assert!(r.stop_error <= STOP_TIME_BOUND, "{r:?}");
+    }
+    let errors: [fn(&RigidRow) -> f64; 2] = [|r| r.slope_error, |r| r.distance_error];
     for e in errors {
         // Every stiffening brings the block closer to the rigid motion.
         assert!(rows.windows(2).all(|w| e(&w[1]) < e(&w[0])), "{rows:?}");

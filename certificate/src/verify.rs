@@ -73,6 +73,10 @@ pub fn sections() -> Result<Vec<Section>, ConvergeError> {
     let jobs: Vec<Job> = vec![
         // The longest first.
         job("plane-friction", crate::friction::markdown),
+        job("plane-friction-period-two", || {
+            let rows = crate::friction::period_two::table()?;
+            Ok(crate::friction::period_two::markdown(&rows))
+        }),
         job("plane", crate::plane::markdown),
         keep(&stiff, || Ok(stiff_runs::run_all(stiff::Size::Full))),
         keep(&registry[0], || Ok(crate::tolerances::measured()?)),

@@ -161,7 +161,10 @@ impl<B: Body> Scheme<B> {
     /// The start-up step to `u^1`: the Taylor step
     /// `u^1_T = u^0 + Δt u_1 + Δt²/2 M⁻¹(F^0 − K u^0 − α K u_1)`, second order for smooth data,
     /// projected onto `K_h` in the `C`-norm by the step problem with `b = C (u^1_T − u^0)`, so
-    /// `u^1` is admissible. `z`, `w` and `b` serve as its work space.
+    /// `u^1` is admissible. With friction the projection obeys Coulomb's law on the slip
+    /// `u^1 − u^0` (the previous increment taken as 0), and the record's `D_f` is the friction
+    /// work over the step, `−Σ_j r_T,j (u^1 − u^0)_{t_j} >= 0` (docs/friction.md, "The start-up
+    /// step"). `z`, `w` and `b` serve as its work space.
     fn start_up(&mut self, v0: &[f64]) -> Result<(), RunError> {
         let (dt, alpha) = (self.body.dt(), self.body.viscosity());
         self.contact.advance_gaps(dt)?;
@@ -187,6 +190,9 @@ impl<B: Body> Scheme<B> {
         }
         self.body.complete_start_up(&self.u, v0, &mut self.w)?;
         self.body.step_matrix_mul(&self.w, &mut self.b);
+        // The start-up's slip is u^1 − u^0: a frictional solver's previous increment is 0.
+        self.z.fill(0.0);
+        self.solver.set_previous_increment(&self.z);
         let info = (self.solver)
             .solve(&self.b, &self.lower, &mut self.z, &mut self.reactions)
             .map_err(|failure| self.failure(1, failure))?;
@@ -224,8 +230,13 @@ impl<B: Body> Scheme<B> {
         };
         let state = (&self.u[..], &self.z[..], &self.w[..], &self.reactions[..]);
         self.contact.measure(state, false, &mut record.contact);
-        let friction = self.contact.measure_friction(state, false);
+        // The slip u^1 − u^0 is z: w (the Taylor increment, no longer needed) becomes 0.
+        self.w.fill(0.0);
+        let state = (&self.u[..], &self.z[..], &self.w[..], &self.reactions[..]);
+        let friction = self.contact.measure_friction(state, true);
         (record.stick_nodes, record.slip_nodes) = (friction.stick_nodes, friction.slip_nodes);
+        // measure_friction's −½ Σ r_T δ of a central slip, doubled: the work over one step.
+        record.friction_dissipation = 2.0 * friction.dissipation;
         std::mem::swap(&mut self.w, &mut self.z);
         self.n = 1;
         self.first_record = record;

@@ -162,6 +162,12 @@ impl KktAudit {
         &self.report
     }
 
+    /// The report back to `report`, taken before answers a solver replaced (only the answer it
+    /// returns is the step's).
+    pub fn restore(&mut self, report: AuditReport) {
+        self.report = report;
+    }
+
     /// Checks one answer `(z, r)` (`r`: the `m` normal reactions, then with friction the `p`
     /// tangential ones) of the step problem with data `(b, lo)` against `law` with the solver's
     /// `slack`, records its residuals, and returns the first failed check. `system` is the `C`

@@ -4,8 +4,9 @@
 //! `S = E C⁻¹ Eᵀ` (`E` the normal rows `s_k e_{i_k}ᵀ` and the tangential rows `e_{t_j}ᵀ`), the
 //! step is the Stewart–Trinkle LCP in `(r_N, β⁺, β⁻, λ)` (`r_T = β⁺ − β⁻`, `λ` the slip
 //! multiplier; size `m + 3p`), solved by [`Lemke`]; a step whose free motion is admissible is
-//! `r = 0` without it. The start-up step (no `u^{−1}`) is the frictionless projection (the
-//! normals' SPD LCP, [`DenseLcp`]). On the cone's boundary `r_T` is set to `∓μ r_N` exactly;
+//! `r = 0` without it. The start-up step is the same law with `w = 0` (the slip `u^1 − u^0`,
+//! until [`StepSolver::set_previous_increment`] is first called). On the cone's boundary `r_T`
+//! is set to `∓μ r_N` exactly;
 //! `z` then comes from `C z = b + Eᵀ r` by a second solve. Every answer is audited
 //! ([`crate::step::audit`]). Derivation, termination, audit:
 //! `docs/friction.md`.
@@ -66,20 +67,16 @@ pub struct CondensedLemke<S: SpdSystem> {
     system: S,
     constraints: Constraints,
     friction: Friction,
-    /// The normals' LCP, for the frictionless start-up step.
-    normal_lcp: DenseLcp,
     lemke: Lemke,
     /// `σ = max_k S_kk`, the scale of the LCP.
     sigma: f64,
-    /// The previous increment at the tangents, and whether it was given.
+    /// The previous increment at the tangents (0 until given: the start-up step's law).
     previous: Vec<f64>,
-    slip_known: bool,
     /// The obstacles' tangential displacements `v_j` (zeros unless an obstacle slides).
     obstacle: Vec<f64>,
     q: Vec<f64>,
     x: Vec<f64>,
     q_normal: Vec<f64>,
-    w_normal: Vec<f64>,
     audit: KktAudit,
 }
 
@@ -98,10 +95,6 @@ impl<S: SpdSystem> CondensedLemke<S> {
         let contact = |e: LcpError| SetupError::Contact(e.to_string());
         // S on normals and tangents must be positive definite (Lemke's termination needs it).
         DenseLcp::new(s.clone(), k).map_err(contact)?;
-        let s_nn: Vec<f64> = (0..m)
-            .flat_map(|i| s[i * k..i * k + m].iter().copied())
-            .collect();
-        let normal_lcp = DenseLcp::new(s_nn, m).map_err(contact)?;
         let sigma = (0..k).map(|i| s[i * k + i]).fold(0.0, f64::max);
         let matrix = stewart_trinkle_matrix(&s, m, &friction, sigma);
         let n = m + 3 * p;
@@ -109,16 +102,13 @@ impl<S: SpdSystem> CondensedLemke<S> {
         Ok(Self {
             system,
             constraints,
-            normal_lcp,
             lemke: Lemke::new(&matrix, n),
             sigma,
             previous: vec![0.0; p],
-            slip_known: false,
             obstacle: vec![0.0; p],
             q: vec![0.0; n],
             x: vec![0.0; n],
             q_normal: vec![0.0; m],
-            w_normal: vec![0.0; m],
             audit,
             friction,
         })
@@ -127,22 +117,6 @@ impl<S: SpdSystem> CondensedLemke<S> {
     /// `σ`, the scale of the LCP (`max_k S_kk`).
     pub fn scale(&self) -> f64 {
         self.sigma
-    }
-
-    /// The frictionless projection (start-up): the normals' LCP, `r_T = 0`.
-    fn frictionless(&mut self, reactions: &mut [f64]) -> Result<u32, StepFailure> {
-        let m = self.constraints.len();
-        reactions[m..].fill(0.0);
-        self.normal_lcp
-            .solve(&self.q_normal, &mut reactions[..m], &mut self.w_normal)
-            .map_err(|e| match e {
-                LcpError::IterationLimit { iterations } => {
-                    StepFailure::IterationLimit { iterations }
-                }
-                LcpError::NonFinite | LcpError::NotPositiveDefinite { .. } => {
-                    StepFailure::NonFinite
-                }
-            })
     }
 
     /// The Stewart–Trinkle LCP by Lemke's method; the reactions, the tangential ones on the
@@ -180,6 +154,58 @@ impl<S: SpdSystem> CondensedLemke<S> {
     }
 }
 
+impl<S: SpdSystem> CondensedLemke<S> {
+    /// One answer: the free step, or Lemke's; `z` from the step equation; the audit. Returns
+    /// the audit's verdict, the bases tried and whether Lemke's method ran.
+    fn attempt(
+        &mut self,
+        rhs: &[f64],
+        lower: &[f64],
+        z: &mut [f64],
+        reactions: &mut [f64],
+    ) -> (Result<(), StepFailure>, u32, bool) {
+        let m = self.constraints.len();
+        z.copy_from_slice(rhs);
+        self.system.solve_in_place(z);
+        let c = &self.constraints;
+        for (k, q) in self.q_normal.iter_mut().enumerate() {
+            *q = c.directions[k] * z[c.unknowns[k]] - lower[k];
+        }
+        let lemke = !self.q_normal.iter().all(|&q| q >= 0.0);
+        let iterations = if lemke {
+            match self.frictional(z, reactions) {
+                Ok(iterations) => iterations,
+                Err(failure) => return (Err(failure), 0, lemke),
+            }
+        } else {
+            // The free step is admissible: r = 0 (no normal force, so no friction).
+            reactions.fill(0.0);
+            1
+        };
+        if reactions.iter().any(|&r| r != 0.0) {
+            let (unknowns, signs) = (&self.constraints.unknowns, &self.constraints.directions);
+            z.copy_from_slice(rhs);
+            for (k, r) in reactions[..m].iter().enumerate() {
+                z[unknowns[k]] += signs[k] * r;
+            }
+            for (j, r) in reactions[m..].iter().enumerate() {
+                z[self.friction.tangents[j]] += r;
+            }
+            self.system.solve_in_place(z);
+        }
+        let law = Law::Coulomb {
+            mu: &self.friction.coefficients,
+            slip: Slip {
+                previous: &self.previous,
+                obstacle: &self.obstacle,
+            },
+        };
+        let slack = Slack::NONE;
+        let verdict = (self.audit).check(&mut self.system, law, slack, rhs, lower, z, reactions);
+        (verdict, iterations, lemke)
+    }
+}
+
 impl<S: SpdSystem> StepSolver for CondensedLemke<S> {
     fn name(&self) -> &'static str {
         "exact"
@@ -187,7 +213,6 @@ impl<S: SpdSystem> StepSolver for CondensedLemke<S> {
 
     fn set_previous_increment(&mut self, w: &[f64]) {
         self.friction.tangential_into(w, &mut self.previous);
-        self.slip_known = true;
     }
 
     fn set_obstacle_slide(&mut self, v: &[f64]) {
@@ -201,47 +226,22 @@ impl<S: SpdSystem> StepSolver for CondensedLemke<S> {
         z: &mut [f64],
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
-        let m = self.constraints.len();
-        z.copy_from_slice(rhs);
-        self.system.solve_in_place(z);
-        let c = &self.constraints;
-        for (k, q) in self.q_normal.iter_mut().enumerate() {
-            *q = c.directions[k] * z[c.unknowns[k]] - lower[k];
+        let before = self.audit.report().clone();
+        let (result, iterations, lemke) = self.attempt(rhs, lower, z, reactions);
+        match result {
+            // A warm basis a round-off away from a stick/slip switch can leave a slip of the
+            // wrong sign beyond the audit's floors: its answer is replaced by the cold run's
+            // (the one the termination claim covers), and only that answer is audited.
+            Err(StepFailure::AuditFailed { .. }) if lemke => {
+                self.audit.restore(before);
+                self.lemke.reset();
+                let (result, more, _) = self.attempt(rhs, lower, z, reactions);
+                result.map(|()| SolveInfo {
+                    iterations: iterations + more,
+                })
+            }
+            result => result.map(|()| SolveInfo { iterations }),
         }
-        let iterations = if self.q_normal.iter().all(|&q| q >= 0.0) {
-            // The free step is admissible: r = 0 (no normal force, so no friction).
-            reactions.fill(0.0);
-            1
-        } else if self.slip_known {
-            self.frictional(z, reactions)?
-        } else {
-            self.frictionless(reactions)?
-        };
-        if reactions.iter().any(|&r| r != 0.0) {
-            let (unknowns, signs) = (&self.constraints.unknowns, &self.constraints.directions);
-            z.copy_from_slice(rhs);
-            for (k, r) in reactions[..m].iter().enumerate() {
-                z[unknowns[k]] += signs[k] * r;
-            }
-            for (j, r) in reactions[m..].iter().enumerate() {
-                z[self.friction.tangents[j]] += r;
-            }
-            self.system.solve_in_place(z);
-        }
-        let law = if self.slip_known {
-            Law::Coulomb {
-                mu: &self.friction.coefficients,
-                slip: Slip {
-                    previous: &self.previous,
-                    obstacle: &self.obstacle,
-                },
-            }
-        } else {
-            Law::Frictionless
-        };
-        let slack = Slack::NONE;
-        (self.audit).check(&mut self.system, law, slack, rhs, lower, z, reactions)?;
-        Ok(SolveInfo { iterations })
     }
 
     fn report(&self) -> Option<SolverReport> {

@@ -9,10 +9,11 @@
 //! `docs/step-solvers.md#kkt-audit` and `docs/friction.md#audit` derive the audit's tolerances.
 
 /// The slip of the frictional nodes over the step, relative to the obstacle,
-/// `δ_j = (z + w)_{t_j} − v_j`: the central slip, `w` the previous increment at the tangents,
-/// less `v_j`, the obstacle's tangential displacement over the same two steps (0 for a fixed
-/// obstacle; `docs/friction.md#sliding-obstacles`). Read by [`Slip::at`] and by the audit's
-/// slip-law floor ([`Slip::scale`]).
+/// `δ_j = (z + w)_{t_j} − v_j`: the central slip, `w` the previous increment at the tangents
+/// (0 at the start-up step, whose slip is `u^1 − u^0`), less `v_j`, the obstacle's tangential
+/// displacement over the same steps (0 for a fixed obstacle;
+/// `docs/friction.md#sliding-obstacles`). Read by [`Slip::at`] and by the audit's slip-law
+/// floor ([`Slip::scale`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Slip<'a> {
     /// `w_j`, the previous increment at the tangents.
@@ -46,17 +47,14 @@ pub enum Law<'a> {
     /// Normal compliance (the penalty law): `ε r_k = (lo_k − s_k z_{i_k})⁺`
     /// ([`Law::penalty_reaction`]).
     Penalty { epsilon: f64 },
-    /// The frictionless start-up of a frictional body: Signorini on the normals, `r_T = 0`
-    /// (thresholds 0, no slip law: the previous increment is not known yet).
-    Frictionless,
     /// Coulomb: Signorini on the normals, `|r_T,j| <= g_j = μ_j r_N,k_j` (the answer's own normal
-    /// reaction at node `j`'s constraint `k_j`), and `g_j |δ_j| + r_T,j δ_j = 0`.
+    /// reaction at node `j`'s constraint `k_j`), and `g_j |δ_j| + r_T,j δ_j = 0`. The start-up
+    /// step is this law with `w = 0` (the slip `u^1 − u^0`).
     Coulomb { mu: &'a [f64], slip: Slip<'a> },
-    /// Tresca: as Coulomb with given thresholds `g_j`; without a slip (a start-up step) the slip
-    /// law is not checked.
+    /// Tresca: as Coulomb with given thresholds `g_j`.
     Tresca {
         thresholds: &'a [f64],
-        slip: Option<Slip<'a>>,
+        slip: Slip<'a>,
     },
 }
 
@@ -68,17 +66,14 @@ pub enum LawFamily<'a> {
     Signorini,
     /// [`Law::Penalty`].
     Penalty,
-    /// [`Law::Frictionless`], [`Law::Coulomb`] and [`Law::Tresca`] on these frictional nodes.
+    /// [`Law::Coulomb`] and [`Law::Tresca`] on these frictional nodes.
     Frictional(&'a crate::step::solver::Friction),
 }
 
 impl Law<'_> {
     /// Whether the law has tangential reactions (with the frictional floors of the audit).
     pub fn is_frictional(&self) -> bool {
-        matches!(
-            self,
-            Law::Frictionless | Law::Coulomb { .. } | Law::Tresca { .. }
-        )
+        matches!(self, Law::Coulomb { .. } | Law::Tresca { .. })
     }
 
     /// The threshold `g_j` of frictional node `j`, whose normal reaction is `r_n`: `μ_j r_n`,
@@ -88,15 +83,14 @@ impl Law<'_> {
         match self {
             Law::Coulomb { mu, .. } => mu[j] * r_n,
             Law::Tresca { thresholds, .. } => thresholds[j],
-            Law::Signorini | Law::Penalty { .. } | Law::Frictionless => 0.0,
+            Law::Signorini | Law::Penalty { .. } => 0.0,
         }
     }
 
-    /// The slip the slip law is stated in (`None`: no slip law this step).
+    /// The slip the slip law is stated in (`None`: a normal law).
     pub fn slip(&self) -> Option<&Slip<'_>> {
         match self {
-            Law::Coulomb { slip, .. } => Some(slip),
-            Law::Tresca { slip, .. } => slip.as_ref(),
+            Law::Coulomb { slip, .. } | Law::Tresca { slip, .. } => Some(slip),
             _ => None,
         }
     }

@@ -11,7 +11,8 @@
 //! from `C z = b + Eᵀ r`, and each answer audited against the Tresca law it solved
 //! ([`crate::step::audit`]). The iteration starts from the previous step's normal
 //! reactions and stops when they change by at most [`FIXED_POINT_TOL`] (relative); beyond
-//! [`FIXED_POINT_MAX_ITERATIONS`] it is an error. The start-up step is one QP with `g = 0`.
+//! [`FIXED_POINT_MAX_ITERATIONS`] it is an error. The start-up step is the same fixed point with
+//! `w = 0` (the slip `u^1 − u^0`), from `g = 0`.
 
 use crate::linalg::norms::max_abs;
 use crate::linalg::system::{Csc, SpdSystem};
@@ -40,8 +41,8 @@ pub struct OsqpTresca<S: SpdSystem> {
     settings: OsqpSettings,
     problem: Problem,
     sigma: f64,
+    /// The previous increment at the tangents (0 until given: the start-up step's law).
     previous: Vec<f64>,
-    slip_known: bool,
     /// The obstacles' tangential displacements `v_j` (zeros unless an obstacle slides).
     obstacle: Vec<f64>,
     /// `q / σ`, the bounds, the thresholds, the iterate and the warm start.
@@ -117,7 +118,6 @@ impl<S: SpdSystem> OsqpTresca<S> {
             problem,
             sigma,
             previous: vec![0.0; p],
-            slip_known: false,
             obstacle: vec![0.0; p],
             q,
             lower,
@@ -172,10 +172,10 @@ impl<S: SpdSystem> OsqpTresca<S> {
         let eps_q = self.settings.eps_abs + self.settings.eps_rel * max_abs(&self.q);
         let law = Law::Tresca {
             thresholds: &self.thresholds,
-            slip: (self.slip_known).then_some(Slip {
+            slip: Slip {
                 previous: &self.previous,
                 obstacle: &self.obstacle,
-            }),
+            },
         };
         let slack = Slack::Bounds {
             force: factor * eps,
@@ -193,7 +193,6 @@ impl<S: SpdSystem> StepSolver for OsqpTresca<S> {
 
     fn set_previous_increment(&mut self, w: &[f64]) {
         self.friction.tangential_into(w, &mut self.previous);
-        self.slip_known = true;
     }
 
     fn set_obstacle_slide(&mut self, v: &[f64]) {
@@ -223,13 +222,7 @@ impl<S: SpdSystem> StepSolver for OsqpTresca<S> {
             obstacle: &self.obstacle,
         };
         for j in 0..p {
-            let z_t = z[self.friction.tangents[j]];
-            let delta = if self.slip_known {
-                slip.at(j, z_t)
-            } else {
-                z_t + 0.0
-            };
-            self.q[m + j] = delta * inv;
+            self.q[m + j] = slip.at(j, z[self.friction.tangents[j]]) * inv;
         }
         self.problem.update_lin_cost(&self.q);
         let mut inaccurate = false;
@@ -237,11 +230,7 @@ impl<S: SpdSystem> StepSolver for OsqpTresca<S> {
         loop {
             // Thresholds from the current normal reactions (the previous step's at first).
             for (j, g) in self.thresholds.iter_mut().enumerate() {
-                *g = if self.slip_known {
-                    self.friction.coefficients[j] * self.r[self.friction.normals[j]].max(0.0)
-                } else {
-                    0.0
-                };
+                *g = self.friction.coefficients[j] * self.r[self.friction.normals[j]].max(0.0);
             }
             self.r_before.copy_from_slice(&self.r[..m]);
             iterations += 1;
@@ -249,7 +238,7 @@ impl<S: SpdSystem> StepSolver for OsqpTresca<S> {
             let change = (reactions[..m].iter().zip(&self.r_before))
                 .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
             let scale = max_abs(&reactions[..m]).max(f64::MIN_POSITIVE);
-            if !self.slip_known || p == 0 || change <= FIXED_POINT_TOL * scale {
+            if p == 0 || change <= FIXED_POINT_TOL * scale {
                 break;
             }
             if iterations >= FIXED_POINT_MAX_ITERATIONS {

@@ -225,8 +225,6 @@ pub(super) const PRESSED: f64 = 0.5;
 /// The Tresca thresholds of the OSQP case: distinct from the answer's `μ r_N`, so that an audit
 /// reading the wrong ones refuses the base answer.
 pub(super) const GIVEN: [f64; P] = [0.125, 0.25, 0.0625];
-/// The start-up Tresca problem's thresholds (`g = 0`).
-pub(super) const ZERO: [f64; P] = [0.0; P];
 /// A residual along the left edge's `u_x` with alternating signs (rows where `C z = 0`, so that
 /// `b = −residual` is exact): a stiff load, whose displacement stays small.
 pub(super) const STIFF_ROWS: [(usize, usize, f64); 3] = [(0, 2, 1.0), (0, 3, -1.0), (0, 4, 1.0)];

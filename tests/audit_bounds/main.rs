@@ -3,7 +3,8 @@
 //! one at `(1 + DELTA)` is refused by that check, so that a loosened or mis-scaled bound fails.
 //! Cases: OSQP's Signorini answers on the bar's tridiagonal and the plane's sparse `C`; the
 //! penalty law and Signorini at round-off on the bar's matrix (tridiagonal and sparse); on a
-//! frictional plane, the exact solver's Coulomb and start-up answers and OSQP's Tresca answers.
+//! frictional plane, the exact solver's Coulomb answers (the start-up step's among them, `w = 0`)
+//! and OSQP's Tresca answers, accurate and inaccurate.
 //! Each tolerance is computed here from the documented formulas (docs/step-solvers.md, "KKT
 //! audit"; docs/friction.md, "Audit") on dense copies of `C` and `C⁻¹` (nalgebra), never read
 //! from the audit. `b = C z − Eᵀ r − extra` makes the residual `extra`; every other check stays
@@ -102,7 +103,6 @@ fn reported(r: &AuditReport) -> [Option<f64>; 8] {
 enum Kind {
     Signorini,
     Penalty(f64),
-    Frictionless,
     Coulomb,
     Tresca(&'static [f64; P]),
 }
@@ -116,19 +116,19 @@ enum Stop {
     Tresca(f64),
 }
 
-/// One way a solver calls the audit (the exact or OSQP's, inaccurate at start-up); `previous`:
-/// whether the previous increment is known (no slip law at the start-up step).
+/// One way a solver calls the audit (the exact or OSQP's, accurate or inaccurate); `previous`:
+/// whether the law has a slip law (the frictional ones; the start-up step's is Coulomb's with
+/// `w = 0`, a case of `COULOMB`'s).
 #[derive(Clone, Copy, Debug)]
 struct Case(&'static str, Kind, bool, Stop);
 
 const SIGNORINI: Case = Case("OSQP", Kind::Signorini, false, Stop::Osqp);
 const SIGNORINI_EXACT: Case = Case("round-off", Kind::Signorini, false, Stop::Exact);
 const COULOMB: Case = Case("Coulomb", Kind::Coulomb, true, Stop::Exact);
-const START: Case = Case("start-up", Kind::Frictionless, false, Stop::Exact);
 const TRESCA: Case = Case("Tresca", Kind::Tresca(&GIVEN), true, Stop::Tresca(MARGIN));
 const LATE: Stop = Stop::Tresca(MARGIN * INACCURATE);
-const TRESCA_START: Case = Case("Tresca start-up", Kind::Tresca(&ZERO), false, LATE);
-const FRICTION_CASES: [Case; 4] = [COULOMB, START, TRESCA, TRESCA_START];
+const TRESCA_LATE: Case = Case("Tresca, inaccurate", Kind::Tresca(&GIVEN), true, LATE);
+const FRICTION_CASES: [Case; 3] = [COULOMB, TRESCA, TRESCA_LATE];
 
 fn penalty(epsilon: f64) -> Case {
     Case("penalty", Kind::Penalty(epsilon), false, Stop::Exact)
@@ -136,7 +136,7 @@ fn penalty(epsilon: f64) -> Case {
 
 impl Case {
     fn frictional(&self) -> bool {
-        matches!(self.1, Kind::Frictionless | Kind::Coulomb | Kind::Tresca(_))
+        matches!(self.1, Kind::Coulomb | Kind::Tresca(_))
     }
 
     fn previous(&self) -> bool {
@@ -152,11 +152,10 @@ impl Case {
         let law = match self.1 {
             Kind::Signorini => Law::Signorini,
             Kind::Penalty(epsilon) => Law::Penalty { epsilon },
-            Kind::Frictionless => Law::Frictionless,
             Kind::Coulomb => Law::Coulomb { mu: &body.mu, slip },
             Kind::Tresca(g) => Law::Tresca {
                 thresholds: g,
-                slip: self.2.then_some(slip),
+                slip,
             },
         };
         let family = match (self.1, &body.friction) {
@@ -666,7 +665,7 @@ fn friction_cone() {
 /// Node `j` sliding (`δ = SLIPS[j]`, its normal pressed) with `r_T` short of the cone by `y`,
 /// `r_T = −sign δ (g − y)`: the slip law's value is `y |δ|`, placed at `f` times
 /// `τ_f |δ| + (τ_z + ε'(|w| + |v|))(|g| + |r_T|)`, on a fixed obstacle (`v = 0`) and on one
-/// sliding by `v = 1/4` over the step. The start-up steps have no slip law.
+/// sliding by `v = 1/4` over the step.
 #[test]
 fn slip_law() {
     let body = friction_plane();

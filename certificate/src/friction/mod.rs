@@ -5,6 +5,7 @@
 //! ([`crate::friction::rigid`]) and the frictional drop's convergence against a finer exact run.
 //! The tests (`tests/plane_coulomb_friction.rs`) assert on the same computations.
 
+pub mod period_two;
 pub mod rigid;
 
 use crate::friction::rigid::{RigidRow, closed_form_self_test, rigid_table};
@@ -340,7 +341,7 @@ fn sci(v: f64) -> String {
 /// The rigid-limit table's Markdown.
 pub fn rigid_markdown(rows: &[RigidRow]) -> String {
     let mut md = String::from(
-        "| κ = λ = μ_L | slope: mean acceleration | rel. error vs g(sin θ − μ cos θ) | stick (μ = 1): mean velocity, 2nd half / f_t T | launch: stop time from t_1/2 | rel. error vs v0/(μg) | distance from t_1/2 | rel. error vs v0²/(2μg) | max identity residual |\n|---|---|---|---|---|---|---|---|---|\n",
+        "| κ = λ = μ_L | slope: mean acceleration | rel. error vs g(sin θ − μ cos θ) | stick (μ = 1): mean velocity, 2nd half / f_t T | launch: stop time from t = 0 | rel. error vs v0/(μg) | distance from t = 0 | rel. error vs v0²/(2μg) | max identity residual |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         let _ = writeln!(

@@ -6,8 +6,9 @@
 //! independent integration of the rigid block's law of motion with its stops located exactly
 //! ([`rigid_motion`]); the plane runs (`plane-friction-slope`, `plane-friction-launch`, the
 //! stiffness `λ = μ_L = κ` set) are then measured by the block's mass-weighted mean motion.
-//! The scheme's start-up step is frictionless, so friction acts from `t_{1/2}` on: times and
-//! distances of the runs are measured from there.
+//! Friction acts from the start-up step on (its projection applies the rigid block's
+//! deceleration over `[0, Δt/2]` exactly), so the launch's stop time and distance are measured
+//! from `t = 0`.
 
 use crate::plane::contact::{plane_error, plane_scene};
 use viscobar::plane::PlaneSimulation;
@@ -151,8 +152,8 @@ pub struct RigidRow {
     /// Slope, sticking (`μ = STICK_FRICTION`): the mean velocity over the run's second half,
     /// `|X_N − X_{N/2}| / (t_N − t_{N/2})`, over the frictionless block's final velocity `f_t T`.
     pub stick_velocity: f64,
-    /// Launch: the time from `t_{1/2}` to the first zero of `V` (linear between half-steps),
-    /// the distance from the mean position at `t_{1/2}` to the end, and their relative errors.
+    /// Launch: the time from `t = 0` to the first zero of `V` (linear between half-steps),
+    /// the distance from the mean position at `t = 0` to the end, and their relative errors.
     pub stop_time: f64,
     pub stop_error: f64,
     pub distance: f64,
@@ -224,11 +225,11 @@ pub fn rigid_row(kappa: f64) -> Result<RigidRow, ConvergeError> {
     let (stop, distance) = block.launched(v0);
     let (h, id) = mean_history(&launch)?;
     row.identity = row.identity.max(id);
-    let start = 0.5 * (h[0].1 + h[1].1);
+    let start = h[0].1;
     let crossing = h.windows(2).skip(1).find(|w| w[0].2 > 0.0 && w[1].2 <= 0.0);
     row.stop_time = crossing.map_or(f64::INFINITY, |w| {
         let (ta, tb) = (w[0].0 - 0.5 * dt, w[1].0 - 0.5 * dt);
-        ta + (tb - ta) * w[0].2 / (w[0].2 - w[1].2) - 0.5 * dt
+        ta + (tb - ta) * w[0].2 / (w[0].2 - w[1].2)
     });
     row.stop_error = (row.stop_time - stop).abs() / stop;
     row.distance = h[h.len() - 1].1 - start;
