@@ -332,7 +332,7 @@ fn the_friction_force_and_state_read_back_to_the_run() {
     let friction = sim.contact().friction().clone();
     let tangent_at: Vec<(usize, usize)> = friction.tangents.iter().map(|&t| written(t)).collect();
     assert!(!friction.is_empty());
-    let (mut stick_steps, mut slip_steps) = (0, 0);
+    let (mut stick_steps, mut slip_steps, mut worst) = (0, 0, 0.0f64);
     for n in 1..=scene.steps() {
         if n > 1 {
             sim.step().unwrap();
@@ -362,6 +362,7 @@ fn the_friction_force_and_state_read_back_to_the_run() {
         for (j, &(w, c)) in tangent_at.iter().enumerate() {
             let r_t = force[3 * w + c] - reaction[3 * w + c];
             let cone = friction.coefficients[j] * sim.reactions()[friction.normals[j]];
+            worst = worst.max((r_t.abs() - cone) / largest);
             assert!(
                 r_t.abs() <= cone + CONE_ROUNDING * largest,
                 "{name}: node {j}: |r_T| = {} > mu r_N = {cone}",
@@ -378,6 +379,7 @@ fn the_friction_force_and_state_read_back_to_the_run() {
         stick_steps += usize::from(stick > 0);
         slip_steps += usize::from(slip > 0);
     }
+    eprintln!("worst excess over Coulomb's cone: {worst:e} of the largest mu r_N");
     assert!(
         stick_steps > 0 && slip_steps > 0,
         "{stick_steps} {slip_steps}"

@@ -50,7 +50,7 @@ impl EdgeSpec {
 impl Edges {
     /// The parsed friction of each edge, `[left, right, bottom, top]`: `None` where absent or
     /// the constant 0 (frictionless either way). A constant is checked here, an expression in
-    /// `s` at every node by [`friction_at`]. An error names `edges.<edge>.friction`.
+    /// `s` at every node when the run is set up. An error names `edges.<edge>.friction`.
     pub fn frictions(&self) -> Result<[Option<Expression>; 4], SceneError> {
         let mut out: [Option<Expression>; 4] = Default::default();
         for (k, e) in self.all().into_iter().enumerate() {
