@@ -353,7 +353,7 @@ fn evaluate<S>(body: &Body<S>, case: &Case, a: &Answer) -> Eval {
     let p_scale = (body.rows[..m].iter().zip(&a.lo))
         .fold(0.0f64, |s, (&(i, _), lo)| s.max(a.z[i].abs()).max(lo.abs()));
     // A sliding obstacle's displacements join the gaps' scale where the law has a slip.
-    let slip_law = case.frictional() && case.previous() && !matches!(case.1, Kind::Frictionless);
+    let slip_law = case.frictional() && case.previous();
     let p_scale = if slip_law {
         a.v.iter().fold(p_scale, |s, v| s.max(v.abs()))
     } else {
