@@ -21,7 +21,8 @@ const OBSTACLE_COLUMN: &str = ",obstacle_work";
 /// The columns of a run with friction.
 const FRICTION_COLUMNS: &str = ",friction_dissipation,stick_nodes,slip_nodes";
 /// The thermal terms of a bar with a temperature.
-const THERMAL_COLUMNS: &str = ",thermal_energy,thermal_dissipation,exchange,heat_supply";
+const THERMAL_COLUMNS: &str =
+    ",thermal_energy,thermal_dissipation,exchange,heat_supply,smoothing_dissipation";
 
 /// Which optional columns a run writes after `identity_residual`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -31,7 +32,7 @@ pub struct OptionalColumns {
     /// Some edge has friction: `friction_dissipation`, `stick_nodes`, `slip_nodes`.
     pub friction: bool,
     /// The body has a temperature: `thermal_energy`, `thermal_dissipation`, `exchange`,
-    /// `heat_supply`.
+    /// `heat_supply`, `smoothing_dissipation`.
     pub thermal: bool,
 }
 
@@ -94,7 +95,7 @@ pub fn row(r: &StepRecord, groups: &[Group], optional: OptionalColumns, row: &mu
     }
     if optional.thermal {
         let h = r.heat.unwrap_or_default();
-        for v in [h.energy, h.dissipation, h.exchange, h.supply] {
+        for v in [h.energy, h.dissipation, h.exchange, h.supply, h.smoothing] {
             row.push(b',');
             if r.measured {
                 push_value(v, row);
