@@ -16,7 +16,7 @@ use crate::scheme::body::{Body, EnergySums, FullMassRows, HeatTerms};
 use crate::scheme::certify::{MAX_IDENTITY_BOUND, THERMAL_IDENTITY_TOL, conditioned_bound};
 use crate::thermal::heat_rows;
 use crate::thermal::matrices::{ThermalMatrices, heat_weight};
-use crate::thermal::smoothing::{START_MISMATCH, Smoothing, jumps_within};
+use crate::thermal::smoothing::{Smoothing, jumps_within, starts_with_a_jump};
 use crate::thermal::solver::{ImplicitFlag, exchange_state};
 
 /// An exchange end: its node, constraint, coefficient `h` and `θ_obs(t)`. Its gap is the
@@ -62,13 +62,6 @@ pub struct ThermalBody {
     smoothing: Smoothing,
     implicit: bool,
     start_jump: bool,
-}
-
-/// Whether the initial temperature at a fixed end disagrees with the end's value at `t = 0`
-/// by more than [`START_MISMATCH`] (relative to the larger of them and 1): a sudden end
-/// temperature.
-fn starts_with_a_jump(initial: f64, end: f64) -> bool {
-    (initial - end).abs() > START_MISMATCH * initial.abs().max(end.abs()).max(1.0)
 }
 
 /// `name(t)` finite, or the scene error naming `key`.

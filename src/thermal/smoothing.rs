@@ -21,6 +21,13 @@ pub const SMOOTHING_STEPS: usize = 2;
 /// two expressions of one value, far below any intended step (whose ringing is proportional).
 pub const START_MISMATCH: f64 = 1e-12;
 
+/// Whether the initial temperature at a fixed end disagrees with the end's value at `t = 0`
+/// by more than [`START_MISMATCH`] (relative to the larger of them and 1): a sudden end
+/// temperature.
+pub fn starts_with_a_jump(initial: f64, end: f64) -> bool {
+    (initial - end).abs() > START_MISMATCH * initial.abs().max(end.abs()).max(1.0)
+}
+
 /// Halvings of a step that [`jumps_within`] follows: a smooth `θ_end` gives each level's
 /// larger half about half of the level's change, so it fails [`JUMP_SHARE`] within one or two
 /// levels (a parabola's extremum fails it at the next); a jump keeps all of it at every level.
