@@ -21,7 +21,8 @@ fn a_thermal_run_writes_the_thermal_columns() {
     let header = history.lines().next().unwrap();
     assert!(header.starts_with(
         "step,t,energy,work,viscous_dissipation,contact_dissipation,identity_residual,\
-         thermal_energy,thermal_dissipation,exchange,heat_supply,gap_left,reaction_left"
+         thermal_energy,thermal_dissipation,exchange,heat_supply,smoothing_dissipation,gap_left,\
+         reaction_left"
     ));
     let columns = header.split(',').count();
     assert!(

@@ -24,7 +24,8 @@ const FRICTION_COLUMNS: &str = ",friction_dissipation,stick_nodes,slip_nodes";
 /// The column of a run whose obstacles slide along their edges.
 const SLIDING_COLUMN: &str = ",sliding_work";
 /// The thermal terms of a bar with a temperature.
-const THERMAL_COLUMNS: &str = ",thermal_energy,thermal_dissipation,exchange,heat_supply";
+const THERMAL_COLUMNS: &str =
+    ",thermal_energy,thermal_dissipation,exchange,heat_supply,smoothing_dissipation";
 
 /// Which optional columns a run writes after `identity_residual`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -36,7 +37,7 @@ pub struct OptionalColumns {
     /// An obstacle slides along its edge: `sliding_work`.
     pub sliding: bool,
     /// The body has a temperature: `thermal_energy`, `thermal_dissipation`, `exchange`,
-    /// `heat_supply`.
+    /// `heat_supply`, `smoothing_dissipation`.
     pub thermal: bool,
     /// The groups, in order, with frictional nodes: `tangential_reaction_G` after
     /// `reaction_G`.
@@ -134,7 +135,7 @@ pub fn row(r: &StepRecord, groups: &[Group], optional: OptionalColumns, row: &mu
     }
     if optional.thermal {
         let h = r.heat.unwrap_or_default();
-        for v in [h.energy, h.dissipation, h.exchange, h.supply] {
+        for v in [h.energy, h.dissipation, h.exchange, h.supply, h.smoothing] {
             row.push(b',');
             if r.measured {
                 push_value(v, row);

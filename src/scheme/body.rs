@@ -30,6 +30,9 @@ pub struct HeatTerms {
     pub exchange: f64,
     /// `Δt Q·θ̄` and the heat let in at the fixed-temperature ends.
     pub supply: f64,
+    /// `(w − ½)|θ^{n+1/2} − θ^{n−1/2}|²_M >= 0`: the numerical dissipation of an implicit
+    /// Euler heat step (`w = 1`; 0 on a Crank–Nicolson step, `w = ½`).
+    pub smoothing: f64,
 }
 
 /// `x ↦ (M x)` restricted to the unknowns, for `x` given at every degree of freedom of the

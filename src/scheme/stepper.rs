@@ -28,9 +28,9 @@ pub struct StepRecord {
     /// `D = −½ Σ_k r_k (s_k (u^{n+1} − u^{n−1})_{i_k} + g_k^{n+1} − g_k^{n−1}) >= 0`.
     pub contact_dissipation: f64,
     /// `|E^{n+1/2} − E^{n−1/2} − work − obstacle_work − sliding_work + viscous + D + D_f|` over
-    /// the largest
-    /// of those terms (with a temperature: `+ thermal dissipation + exchange − supply`,
-    /// [`HeatTerms`]), or over the run's energy resolution `ENERGY_RESOLUTION` times the
+    /// the largest of those terms (with a temperature: `+ thermal dissipation + exchange +
+    /// smoothing − supply`, [`HeatTerms`]), or over the run's energy resolution
+    /// `ENERGY_RESOLUTION` times the
     /// largest term measured so far where that is larger.
     pub identity_residual: f64,
     /// The bound the run's certificate holds `identity_residual` to on a measured step: the
@@ -396,8 +396,9 @@ impl<B: Body> Scheme<B> {
         .into_iter()
         .fold(0.0, f64::max);
         if let Some(h) = heat {
-            residual += h.dissipation + h.exchange - h.supply;
-            scale = [h.dissipation, h.exchange.abs(), h.supply.abs()]
+            // A zero smoothing term (Crank–Nicolson steps) adds nothing: their bits stay.
+            residual += h.dissipation + h.exchange + h.smoothing - h.supply;
+            scale = [h.dissipation, h.exchange.abs(), h.supply.abs(), h.smoothing]
                 .into_iter()
                 .fold(scale, f64::max);
         }

@@ -3,8 +3,9 @@
 //! is not fixed. Its kernels are the bar's on the displacement block (so the scheme's energy
 //! sums are the bar's) and the coupled ones where the step needs them: the right-hand side and
 //! the step matrix `[[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]]` ([`crate::thermal::matrices`]). The hooks
-//! evaluate the boundary data of each step, the start-up half step of `θ` and the thermal
-//! terms of the energy identity. Derivation: `docs/thermal.md`.
+//! evaluate the boundary data of each step and whether its heat step is implicit Euler
+//! ([`crate::thermal::smoothing`]), the start-up half step of `θ` and the thermal terms of
+//! the energy identity. Derivation: `docs/thermal.md`.
 
 use crate::bar::BarBody;
 use crate::linalg::kernels::ldlt::Ldlt;
@@ -14,8 +15,9 @@ use crate::scheme::RunError;
 use crate::scheme::body::{Body, EnergySums, FullMassRows, HeatTerms};
 use crate::scheme::certify::{MAX_IDENTITY_BOUND, THERMAL_IDENTITY_TOL, conditioned_bound};
 use crate::thermal::heat_rows;
-use crate::thermal::matrices::ThermalMatrices;
-use crate::thermal::solver::exchange_state;
+use crate::thermal::matrices::{ThermalMatrices, heat_weight};
+use crate::thermal::smoothing::{Smoothing, jumps_within, starts_with_a_jump};
+use crate::thermal::solver::{ImplicitFlag, exchange_state};
 
 /// An exchange end: its node, constraint, coefficient `h` and `θ_obs(t)`. Its gap is the
 /// contact set's (moved with its obstacle), read off the step's bounds.
@@ -33,9 +35,11 @@ pub struct ExchangeEnd {
 pub struct FixedEnd {
     pub node: usize,
     pub value: crate::scene::expr::Expression,
-    /// `θ_end(t_{n−1/2})` and `θ_end(t_{n+1/2})` of the step being taken.
+    /// `θ_end(t_{n−1/2})` and `θ_end(t_{n+1/2})` of the step being taken, and `θ_w` there,
+    /// `old + w (new − old)` (`w` the step's weight, [`heat_weight`]).
     pub old: f64,
     pub new: f64,
+    pub weighted: f64,
 }
 
 /// The bar with a temperature.
@@ -53,6 +57,11 @@ pub struct ThermalBody {
     /// `θ_obs(t_n)` of each exchange end.
     mask: usize,
     theta_obs: [f64; 2],
+    /// Which heat steps are implicit Euler, whether the step being taken is, and whether the
+    /// initial temperature disagrees with a fixed end's value at `t = 0`.
+    smoothing: Smoothing,
+    implicit: bool,
+    start_jump: bool,
 }
 
 /// `name(t)` finite, or the scene error naming `key`.
@@ -77,9 +86,14 @@ impl ThermalBody {
         let disc = bar.discretisation();
         let (nodes, dx, dt, first, n_u) =
             (disc.nodes, disc.dx, disc.dt, disc.first, disc.unknowns());
-        let HeatExpressions { source, ends, .. } = heat;
+        let HeatExpressions {
+            source,
+            ends,
+            temperature,
+        } = heat;
         let mut exchange = Vec::new();
         let mut fixed = Vec::new();
+        let mut start_jump = false;
         for (side, end) in ends.into_iter().enumerate() {
             let node = if side == 0 { 0 } else { nodes - 1 };
             let key = if side == 0 { "heat.left" } else { "heat.right" };
@@ -94,11 +108,14 @@ impl ThermalBody {
                             "must be finite",
                         ));
                     }
+                    let initial = temperature.eval(node as f64 * dx, 0.0)?;
+                    start_jump |= starts_with_a_jump(initial, v0);
                     fixed.push(FixedEnd {
                         node,
                         value,
                         old: v0,
                         new: v0,
+                        weighted: v0,
                     })
                 }
                 EndHeat::Exchange {
@@ -168,7 +185,26 @@ impl ThermalBody {
             },
             mask: 0,
             theta_obs: [0.0; 2],
+            smoothing: Smoothing::default(),
+            implicit: false,
+            start_jump,
         })
+    }
+
+    /// The flag telling the step solver whether the step being taken is implicit Euler.
+    pub fn implicit_flag(&self) -> ImplicitFlag {
+        self.smoothing.flag()
+    }
+
+    /// Whether the step being taken is an implicit Euler step of the heat.
+    pub fn implicit_step(&self) -> bool {
+        self.implicit
+    }
+
+    /// `1 − w`: `θ_w = θ^{n+1/2} − (1 − w) dθ` (½ for Crank–Nicolson, 0 for implicit Euler).
+    #[inline(always)]
+    fn lag(&self) -> f64 {
+        1.0 - heat_weight(self.implicit)
     }
 
     /// `κΔt/Δx²`: the heat step's stiffness ratio, which its round-off follows.
@@ -211,12 +247,13 @@ impl ThermalBody {
         self.fixed.iter().find(|f| f.node == node)
     }
 
-    /// `φ_j`: `θ^{n−1/2}_j` at an unknown (from `u`), the mean `½(old + new)` at a fixed end.
+    /// `φ_j`: `θ^{n−1/2}_j` at an unknown (from `u`), `θ_w` at a fixed end (the mean
+    /// `½(old + new)` on a Crank–Nicolson step).
     #[inline(always)]
     fn phi(&self, u: &[f64], node: usize) -> f64 {
         match self.m.theta_unknown(node) {
             Some(j) => u[j],
-            None => self.fixed_at(node).map_or(0.0, |f| 0.5 * (f.old + f.new)),
+            None => self.fixed_at(node).map_or(0.0, |f| f.weighted),
         }
     }
 
@@ -341,13 +378,14 @@ impl ThermalBody {
         s
     }
 
-    /// `θ̄` at `node`: `θ^{n+1/2} − ½ dθ` from the state `u` and the increment `z` at an
-    /// unknown, the mean of the step's two values at a fixed end.
+    /// `θ_w` at `node` (`θ̄` on a Crank–Nicolson step): `θ^{n+1/2} − (1 − w) dθ` from the
+    /// state `u` and the increment `z` at an unknown, `θ_w` of the step's two values at a
+    /// fixed end.
     #[inline(always)]
     fn theta_bar(&self, u: &[f64], z: &[f64], node: usize) -> f64 {
         match self.m.theta_unknown(node) {
-            Some(j) => u[j] - 0.5 * z[j],
-            None => self.fixed_at(node).map_or(0.0, |f| 0.5 * (f.old + f.new)),
+            Some(j) => u[j] - self.lag() * z[j],
+            None => self.fixed_at(node).map_or(0.0, |f| f.weighted),
         }
     }
 
@@ -357,11 +395,12 @@ impl ThermalBody {
         let (m, n_u) = (&self.m, self.m.n_u);
         let interior = 1 - m.t_first..m.nodes - 1 - m.t_first;
         let (theta, dtheta) = (&u[n_u..][interior.clone()], &z[n_u..][interior]);
+        let lag = self.lag();
         self.quads(
             (self.ends(|k| self.theta(u, k)), theta.iter().copied()),
             (
                 self.ends(|k| self.theta_bar(u, z, k)),
-                theta.iter().zip(dtheta).map(|(t, dt)| t - 0.5 * dt),
+                theta.iter().zip(dtheta).map(|(t, dt)| t - lag * dt),
             ),
         )
     }
@@ -510,7 +549,7 @@ impl Body for ThermalBody {
     }
 
     /// The bar's right-hand side plus `γ G φ` on the displacement, the heat rows times `−Δt`
-    /// on the temperature (`docs/thermal.md`).
+    /// on the temperature, `−2Δt` on an implicit Euler step (`docs/thermal.md`).
     fn rhs_into(&self, u: &[f64], w: &[f64], force: Option<&[f64]>, b: &mut [f64]) {
         let n_u = self.m.n_u;
         let (bu, bt) = b.split_at_mut(n_u);
@@ -518,6 +557,9 @@ impl Body for ThermalBody {
         self.bar.rhs_into(&u[..n_u], &w[..n_u], force, bu);
         let coupling = (self.m.gamma != 0.0).then_some(bu);
         self.heat_rhs(u, &w[..n_u], (self.dt(), -1.0), bt, coupling);
+        if self.implicit {
+            bt.iter_mut().for_each(|b| *b *= 2.0);
+        }
     }
 
     fn energy_sums(&self, u: &[f64], z: &[f64], w: &[f64], force: Option<&[f64]>) -> EnergySums {
@@ -551,16 +593,18 @@ impl Body for ThermalBody {
         y[n..].fill(0.0);
     }
 
-    /// `[[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]] x` with the step's exchange state.
+    /// `[[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]] x` with the step's exchange state, or on an implicit
+    /// Euler step `[[C, −γ G], [−γ Gᵀ, −2(M_θ + Δt κ K_θ + Δt h χ)]] x`.
     fn step_matrix_mul(&self, x: &[f64], y: &mut [f64]) {
         let m = &self.m;
-        let (n_u, gamma, s) = (m.n_u, m.gamma, 0.5 * self.dt());
+        let weight = heat_weight(self.implicit);
+        let (n_u, gamma, s, scale) = (m.n_u, m.gamma, weight * self.dt(), 2.0 * weight);
         let (xu, xt) = x.split_at(n_u);
         let theta = |k: usize| m.theta_unknown(k).map_or(0.0, |j| x[j]);
         let (yu, yt) = y.split_at_mut(n_u);
         self.bar.step_matrix_mul(xu, yu);
         for (i, yi) in yu.iter_mut().enumerate() {
-            *yi -= 0.5 * gamma * self.g_row(m.u_first + i, theta);
+            *yi -= weight * gamma * self.g_row(m.u_first + i, theta);
         }
         for (jt, yj) in yt.iter_mut().enumerate() {
             let j = m.t_first + jt;
@@ -569,7 +613,7 @@ impl Body for ThermalBody {
             if let Some((coefficient, _)) = self.exchanging(j) {
                 h += s * coefficient * xt[jt];
             }
-            *yj = -h - 0.5 * gamma * self.gt_row(j, |k| self.disp(xu, k));
+            *yj = -(scale * h) - weight * gamma * self.gt_row(j, |k| self.disp(xu, k));
         }
     }
 
@@ -629,7 +673,11 @@ impl Body for ThermalBody {
             };
             self.theta_obs[e] = eval_t(&x.obstacle, 0.0, t, key)?;
         }
-        self.mask = exchange_state(lower, self.exchange.iter().map(|x| x.constraint));
+        let mask = exchange_state(lower, self.exchange.iter().map(|x| x.constraint));
+        // An exchange switching on or off (on at t = 0: in contact from the start) is a jump
+        // of its end's flux; at t = 0 so is a sudden end temperature.
+        let mut jump = mask != self.mask || (n == 0 && self.start_jump);
+        self.mask = mask;
         let (t_old, t_new) = if n == 0 {
             (0.0, 0.5 * dt)
         } else {
@@ -643,6 +691,15 @@ impl Body for ThermalBody {
             };
             f.old = eval_t(&f.value, 0.0, t_old, key)?;
             f.new = eval_t(&f.value, 0.0, t_new, key)?;
+            let value = |t: f64| eval_t(&f.value, 0.0, t, key);
+            jump |= n > 0 && jumps_within(value, (t_old, t_new), (f.old, f.new))?;
+        }
+        self.implicit = self.smoothing.schedule(n, jump);
+        for f in &mut self.fixed {
+            f.weighted = match self.implicit {
+                true => f.new,
+                false => 0.5 * (f.old + f.new),
+            };
         }
         if let Some(source) = &self.source {
             let dx = self.bar.discretisation().dx;
@@ -655,7 +712,9 @@ impl Body for ThermalBody {
     }
 
     /// The Taylor increment's thermal stress `Δt²/2 M⁻¹ γ G θ^0`, then `θ^{1/2} − θ^0` by a
-    /// Crank–Nicolson half step with the displacement's Taylor increment in the coupling: `(M + Δt/4 (κK + hχ)) Δθ = Δt/2 (Q − κKφ − hχ(θ^0 − θ_obs)) − γ/2 Gᵀ z_u`.
+    /// half step with the displacement's Taylor increment in the coupling, Crank–Nicolson's
+    /// `(M + Δt/4 (κK + hχ)) Δθ = Δt/2 (Q − κKφ − hχ(θ^0 − θ_obs)) − γ/2 Gᵀ z_u` or, where
+    /// the data jump at `t = 0`, implicit Euler's, `Δt/2` in place of `Δt/4`.
     fn complete_start_up(
         &self,
         u0: &[f64],
@@ -679,7 +738,9 @@ impl Body for ThermalBody {
             }
         }
         self.heat_rhs(u0, zu, (0.5 * dt, 1.0), zt, None);
-        let h = self.m.heat_matrix(0.25 * dt, self.mask);
+        // Implicit Euler's `Δt/2 (κK + hχ)` over the half step, Crank–Nicolson's half of it.
+        let s = if self.implicit { 0.5 * dt } else { 0.25 * dt };
+        let h = self.m.heat_matrix((1.0, s), self.mask);
         if !zt.is_empty() {
             Ldlt::factor(&h)
                 .map_err(|e| {
@@ -704,8 +765,9 @@ impl Body for ThermalBody {
         Some(0.5 * self.quads((ends, x.clone()), (ends, x))[0])
     }
 
-    /// `½|θ^{n+1/2}|²_M`, `Δt κ |θ̄|²_K`, the exchange and the supply (source and the heat let
-    /// in at the fixed ends: the residual of their heat rows).
+    /// `½|θ^{n+1/2}|²_M`, `Δt κ |θ_w|²_K`, the exchange and the supply (source and the heat let
+    /// in at the fixed ends: the residual of their heat rows), all with the step's `θ_w`, and
+    /// an implicit Euler step's numerical dissipation `(w − ½)|θ^{n+1/2} − θ^{n−1/2}|²_M`.
     fn heat_terms(&self, u: &[f64], z: &[f64], w: &[f64]) -> Option<HeatTerms> {
         let m = &self.m;
         let dt = self.dt();
@@ -722,13 +784,13 @@ impl Body for ThermalBody {
             }
         }
         let mut supply = dt * source;
+        let dtheta = |k: usize| match m.theta_unknown(k) {
+            Some(i) => z[i],
+            None => self.fixed_increment(k),
+        };
         for f in &self.fixed {
             let j = f.node;
             let delta = |k: usize| self.disp(&z[..n_u], k) + self.disp(&w[..n_u], k);
-            let dtheta = |k: usize| match m.theta_unknown(k) {
-                Some(i) => z[i],
-                None => self.fixed_increment(k),
-            };
             let mut rho = Self::tri_row(&m.mass, j, dtheta)
                 + dt * m.kappa * Self::tri_row(&m.stiffness, j, bar_theta)
                 + 0.5 * m.gamma * self.gt_row(j, delta);
@@ -737,11 +799,22 @@ impl Body for ThermalBody {
             }
             supply += bar_theta(j) * rho;
         }
+        // (w − ½)|dθ|²_M on every node: ½|dθ|²_M on an implicit Euler step, 0 otherwise.
+        let smoothing = match self.implicit {
+            true => {
+                let sum: f64 = (0..m.nodes)
+                    .map(|j| dtheta(j) * Self::tri_row(&m.mass, j, dtheta))
+                    .sum();
+                (heat_weight(true) - 0.5) * sum
+            }
+            false => 0.0,
+        };
         Some(HeatTerms {
             energy,
             dissipation,
             exchange,
             supply,
+            smoothing,
         })
     }
 

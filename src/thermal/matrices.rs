@@ -2,7 +2,8 @@
 //! temperature (every node), the coupling `G_ij = ∫ ψ_j φ_i'` (displacement row `i`,
 //! temperature column `j`), the temperature's step matrix `H_χ = M_θ + Δt κ/2 K_θ + Δt h/2 χ`
 //! on its unknowns, and the coupled step matrix `[[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]]` node by node,
-//! block-tridiagonal with blocks of order 2. Derivation: `docs/thermal.md`.
+//! block-tridiagonal with blocks of order 2; an implicit Euler step's
+//! `[[C, −γ G], [−γ Gᵀ, −2(M_θ + Δt κ K_θ + Δt h χ)]]` beside it. Derivation: `docs/thermal.md`.
 
 use crate::bar::matrices::{MatrixVariant, mass, stiffness};
 use crate::linalg::kernels::block_tridiag::BlockTridiag;
@@ -23,6 +24,13 @@ pub fn coupling_entry(i: usize, j: usize, nodes: usize) -> f64 {
     } else {
         0.0
     }
+}
+
+/// The weight `w` of the temperature in a heat step, `θ_w = θ^{n−1/2} + w (θ^{n+1/2} −
+/// θ^{n−1/2})`: `½` (Crank–Nicolson), `1` (implicit Euler, `implicit`).
+#[inline(always)]
+pub fn heat_weight(implicit: bool) -> f64 {
+    if implicit { 1.0 } else { 0.5 }
 }
 
 /// The layout of the thermal bar's unknowns and its temperature matrices.
@@ -91,12 +99,13 @@ impl ThermalMatrices {
         (node >= self.u_first && node < self.u_first + self.n_u).then(|| node - self.u_first)
     }
 
-    /// `M_θ + s κ K_θ + s h χ` on the temperature's unknowns (`s = Δt/2` for the step,
-    /// `Δt/4` for the start-up's half step), exchange end `e` counted when bit `e` of `mask`
+    /// `a M_θ + s κ K_θ + s h χ` on the temperature's unknowns (`a = 1, s = Δt/2` for the
+    /// Crank–Nicolson step, `a = 2, s = 2Δt` for an implicit Euler step, `a = 1, s = Δt/2`
+    /// for the start-up's implicit half step), exchange end `e` counted when bit `e` of `mask`
     /// is set.
-    pub fn heat_matrix(&self, s: f64, mask: usize) -> SymTridiag {
+    pub fn heat_matrix(&self, (a, s): (f64, f64), mask: usize) -> SymTridiag {
         let last = self.t_first + self.n_t - 1;
-        let mut h = SymTridiag::combine(1.0, &self.mass, s * self.kappa, &self.stiffness)
+        let mut h = SymTridiag::combine(a, &self.mass, s * self.kappa, &self.stiffness)
             .sub(self.t_first, last);
         let mut diag = std::mem::take(&mut h.diag);
         for (e, &(node, coefficient)) in self.exchange.iter().enumerate() {
@@ -107,16 +116,33 @@ impl ThermalMatrices {
         SymTridiag::new(diag, std::mem::take(&mut h.off))
     }
 
+    /// The heat block of a step: `H_χ` for Crank–Nicolson, `2(M_θ + Δt κ K_θ + Δt h χ)` for
+    /// an implicit Euler step (`implicit`), the heat rows then scaled by `−2Δt` so that the
+    /// coupled matrix stays symmetric (`docs/thermal.md`).
+    pub fn step_heat_matrix(&self, mask: usize, implicit: bool) -> SymTridiag {
+        match implicit {
+            false => self.heat_matrix((1.0, 0.5 * self.dt), mask),
+            true => self.heat_matrix((2.0, 2.0 * self.dt), mask),
+        }
+    }
+
     /// The coupled step matrix `[[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]]` (`c`: the bar's `C`) node by
-    /// node, block `i` holding `(u_i, θ_i)`: a node without a displacement unknown (clamped),
+    /// node, or with `implicit` its implicit Euler form `[[C, −γ G], [−γ Gᵀ, −2(M_θ + Δt κ K_θ
+    /// + Δt h χ)]]`, block `i` holding `(u_i, θ_i)`: a node without a displacement unknown (clamped),
     /// or one of `identity` (an active constraint's node), has the row and column of `u_i`
     /// replaced by identity ones; a node without a temperature unknown (fixed) a row and
     /// column `−1` on the diagonal, 0 elsewhere, so a solve leaves 0 there.
-    pub fn coupled(&self, c: &SymTridiag, mask: usize, identity: &[usize]) -> BlockTridiag {
-        let h = self.heat_matrix(0.5 * self.dt, mask);
+    pub fn coupled(
+        &self,
+        c: &SymTridiag,
+        (mask, implicit): (usize, bool),
+        identity: &[usize],
+    ) -> BlockTridiag {
+        let h = self.step_heat_matrix(mask, implicit);
         let u = |node: usize| self.u_unknown(node).filter(|_| !identity.contains(&node));
         let t = |node: usize| self.theta_unknown(node).map(|j| j - self.n_u);
-        let g = |i: usize, j: usize| -0.5 * self.gamma * coupling_entry(i, j, self.nodes);
+        let weight = heat_weight(implicit);
+        let g = |i: usize, j: usize| -weight * self.gamma * coupling_entry(i, j, self.nodes);
         let mut a = BlockTridiag::zeros(self.nodes);
         for node in 0..self.nodes {
             let d = &mut a.diag[node];
@@ -187,7 +213,8 @@ mod tests {
 
     /// The coupled matrix node by node is quasi-definite: as many positive pivots as
     /// displacement unknowns (and padding rows of clamped nodes), by the block factor and by
-    /// the banded `LDLᵀ` of the same matrix, with and without identity rows at the ends.
+    /// the banded `LDLᵀ` of the same matrix, with and without identity rows at the ends, in
+    /// its Crank–Nicolson and its implicit Euler form.
     #[test]
     fn the_coupled_matrix_has_the_inertia_of_its_blocks() {
         use crate::linalg::kernels::banded::BandedLdlt;
@@ -213,9 +240,10 @@ mod tests {
             let uk =
                 stiffness(MatrixVariant::Consistent, nodes, dx).sub(u_first, u_first + n_u - 1);
             let c = SymTridiag::combine(1.0 / (dt * dt), &um, 0.5 + 0.1 / (2.0 * dt), &uk);
-            for mask in 0..=usize::from(!fixed[0]) {
+            let states = (0..=usize::from(!fixed[0])).flat_map(|m| [(m, false), (m, true)]);
+            for state in states {
                 for identity in [&[][..], &[nodes - 1][..]] {
-                    let a = m.coupled(&c, mask, identity);
+                    let a = m.coupled(&c, state, identity);
                     let banded = a.to_banded();
                     let expected = (nodes, nodes);
                     assert_eq!(BlockLdlt::factor(&a).unwrap().inertia(), expected);

@@ -83,19 +83,28 @@ impl Scheme<ThermalBody> {
         }
         let exchange = body.exchange_constraints();
         let masks = 1usize << exchange.len();
+        // Crank–Nicolson's matrices of every exchange state, then the implicit Euler steps'.
+        let states = || {
+            [false, true]
+                .into_iter()
+                .flat_map(|i| (0..masks).map(move |m| (m, i)))
+        };
+        let shared = (exchange, body.implicit_flag());
         let solver: Box<dyn StepSolver> = if m.gamma == 0.0 {
-            let heat = (0..masks)
-                .map(|mask| crate::linalg::Ldlt::factor(&m.heat_matrix(0.5 * disc.dt, mask)))
+            let heat = states()
+                .map(|(mask, implicit)| {
+                    crate::linalg::Ldlt::factor(&m.step_heat_matrix(mask, implicit))
+                })
                 .collect::<Result<Vec<_>, _>>()?;
-            Box::new(DecoupledSolver::new(bar.solver, heat, m.n_u, exchange))
+            Box::new(DecoupledSolver::new(bar.solver, heat, m.n_u, shared))
         } else {
-            let mut variants: Vec<Box<dyn StepSolver>> = Vec::with_capacity(masks);
+            let mut variants: Vec<Box<dyn StepSolver>> = Vec::with_capacity(2 * masks);
             let unknowns = disc.constrained_locals();
-            for mask in 0..masks {
+            for state in states() {
                 let system = CoupledEnds::new(
                     &m,
                     &disc.step_matrix,
-                    mask,
+                    state,
                     &unknowns,
                     kernels.twisted_solve,
                 )
@@ -106,7 +115,7 @@ impl Scheme<ThermalBody> {
                 })?;
                 variants.push(Box::new(EndEnumeration::on(system, &unknowns, true)));
             }
-            Box::new(CoupledSolver::new(variants, exchange))
+            Box::new(CoupledSolver::new(variants, shared))
         };
         debug_assert_eq!(displacement.len(), body.unknowns());
         // The load on the whole state (zero on the temperature's rows).

@@ -5,7 +5,12 @@
 //! it for its right-hand side. Without coupling (`γ = 0`) the displacement is the bar's own
 //! step, by the bar's own solver ([`DecoupledSolver`]: the bar's bits), and the temperature a
 //! tridiagonal solve; with coupling, the exact end solver per exchange state on the coupled
-//! matrix ([`CoupledSolver`], [`crate::thermal::system::CoupledEnds`]).
+//! matrix ([`CoupledSolver`], [`crate::thermal::system::CoupledEnds`]). Each has the matrices
+//! of the implicit Euler steps beside the Crank–Nicolson ones, taken as the body's
+//! [`ImplicitFlag`] says.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::linalg::kernels::ldlt::Ldlt;
 use crate::scheme::in_contact;
@@ -24,14 +29,27 @@ pub fn exchange_state(lower: &[f64], exchange: impl IntoIterator<Item = usize>) 
         .fold(0, |mask, (e, _)| mask | (1 << e))
 }
 
+/// Whether the step being taken is an implicit Euler step of the heat: set by the body's
+/// `prepare_step`, read by the step solver, which takes that step's matrix.
+pub type ImplicitFlag = Arc<AtomicBool>;
+
+/// The index of a step's matrix among `masks` exchange states: `mask`, after the
+/// Crank–Nicolson ones for an implicit step.
+#[inline]
+fn variant(flag: &AtomicBool, mask: usize, masks: usize) -> usize {
+    mask + usize::from(flag.load(Ordering::Relaxed)) * masks
+}
+
 /// `γ = 0`: the bar's step by the bar's solver on the displacement block, then
 /// `θ`'s increment from `−H_χ z_θ = b_θ`.
 pub struct DecoupledSolver {
     mechanical: Box<dyn StepSolver>,
-    /// `H_χ` factorised, per exchange state.
+    /// The step's heat block factorised, per exchange state: Crank–Nicolson's, then the
+    /// implicit Euler step's ([`crate::thermal::matrices::ThermalMatrices::step_heat_matrix`]).
     heat: Vec<Ldlt>,
     n_u: usize,
     exchange: Vec<usize>,
+    implicit: ImplicitFlag,
 }
 
 impl DecoupledSolver {
@@ -39,13 +57,15 @@ impl DecoupledSolver {
         mechanical: Box<dyn StepSolver>,
         heat: Vec<Ldlt>,
         n_u: usize,
-        exchange: Vec<usize>,
+        (exchange, implicit): (Vec<usize>, ImplicitFlag),
     ) -> Self {
+        assert_eq!(heat.len(), 2 << exchange.len());
         Self {
             mechanical,
             heat,
             n_u,
             exchange,
+            implicit,
         }
     }
 
@@ -55,7 +75,9 @@ impl DecoupledSolver {
         for (zi, b) in zt.iter_mut().zip(&rhs[n_u..]) {
             *zi = -b;
         }
-        self.heat[exchange_state(lower, self.exchange.iter().copied())].solve_in_place(zt);
+        let mask = exchange_state(lower, self.exchange.iter().copied());
+        let masks = 1 << self.exchange.len();
+        self.heat[variant(&self.implicit, mask, masks)].solve_in_place(zt);
     }
 }
 
@@ -86,17 +108,27 @@ impl StepSolver for DecoupledSolver {
     }
 }
 
-/// `γ > 0`: one solver per exchange state on the coupled matrix.
+/// `γ > 0`: one solver per exchange state and heat step (Crank–Nicolson or implicit Euler)
+/// on the coupled matrix.
 pub struct CoupledSolver {
     variants: Vec<Box<dyn StepSolver>>,
     exchange: Vec<usize>,
+    implicit: ImplicitFlag,
 }
 
 impl CoupledSolver {
-    /// `variants[mask]` solves the steps of exchange state `mask`.
-    pub fn new(variants: Vec<Box<dyn StepSolver>>, exchange: Vec<usize>) -> Self {
-        assert_eq!(variants.len(), 1 << exchange.len());
-        Self { variants, exchange }
+    /// `variants[mask]` solves the Crank–Nicolson steps of exchange state `mask`,
+    /// `variants[mask + 2^e]` (`e` exchange ends) its implicit Euler steps.
+    pub fn new(
+        variants: Vec<Box<dyn StepSolver>>,
+        (exchange, implicit): (Vec<usize>, ImplicitFlag),
+    ) -> Self {
+        assert_eq!(variants.len(), 2 << exchange.len());
+        Self {
+            variants,
+            exchange,
+            implicit,
+        }
     }
 }
 
@@ -113,7 +145,8 @@ impl StepSolver for CoupledSolver {
         reactions: &mut [f64],
     ) -> Result<SolveInfo, StepFailure> {
         let mask = exchange_state(lower, self.exchange.iter().copied());
-        self.variants[mask].solve(rhs, lower, z, reactions)
+        let masks = 1 << self.exchange.len();
+        self.variants[variant(&self.implicit, mask, masks)].solve(rhs, lower, z, reactions)
     }
 
     /// The report of the variant that solved the most steps.

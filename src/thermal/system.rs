@@ -13,7 +13,7 @@ use crate::linalg::kernels::block_tridiag_fast::TwistedBlockLdlt;
 use crate::linalg::tridiag::SymTridiag;
 use crate::step::end_enumeration::EndSystem;
 use crate::step::schur::{constraint_rows, row_product};
-use crate::thermal::matrices::{ThermalMatrices, coupling_entry};
+use crate::thermal::matrices::{ThermalMatrices, coupling_entry, heat_weight};
 
 /// A block factor: the plain sweep, or its twisted twin.
 #[derive(Clone, Debug)]
@@ -41,7 +41,8 @@ pub struct CoupledEnds {
     /// The first nodes of the displacement and the temperature unknowns.
     firsts: [usize; 2],
     /// The constrained displacement unknowns (at most two), the rows of `C` there
-    /// ([`constraint_rows`]) and `−γ/2 G_ij` with the temperature's position `j`.
+    /// ([`constraint_rows`]) and `−w γ G_ij` with the temperature's position `j` (`w` the
+    /// step's weight, [`heat_weight`]).
     unknowns: Vec<usize>,
     rows: [[f64; 3]; 2],
     theta: [Vec<(usize, f64)>; 2],
@@ -53,27 +54,29 @@ pub struct CoupledEnds {
 }
 
 impl CoupledEnds {
-    /// `A_χ` of exchange state `mask` (`c`: the bar's `C`), constrained at the displacement
-    /// unknowns `unknowns` (at most two); solved by the twisted twin of the block factor
-    /// when `twisted` ([`crate::linalg::kernels::block_tridiag_fast`]).
+    /// `A_χ` of exchange state `mask` (`c`: the bar's `C`), in its implicit Euler form when
+    /// `implicit` ([`ThermalMatrices::coupled`]), constrained at the displacement unknowns
+    /// `unknowns` (at most two); solved by the twisted twin of the block factor when `twisted`
+    /// ([`crate::linalg::kernels::block_tridiag_fast`]).
     pub fn new(
         m: &ThermalMatrices,
         c: &SymTridiag,
-        mask: usize,
+        state: (usize, bool),
         unknowns: &[usize],
         twisted: bool,
     ) -> Result<Self, SingularBlock> {
         let nodes: Vec<usize> = unknowns.iter().map(|&i| i + m.u_first).collect();
-        let factor = Factor::new(&m.coupled(c, mask, &[]), twisted)?;
+        let factor = Factor::new(&m.coupled(c, state, &[]), twisted)?;
         let reduced = (1u8..(1 << nodes.len()))
             .map(|active| {
                 let subset: Vec<usize> = (nodes.iter().enumerate())
                     .filter(|&(j, _)| active & (1 << j) != 0)
                     .map(|(_, &node)| node)
                     .collect();
-                Factor::new(&m.coupled(c, mask, &subset), twisted)
+                Factor::new(&m.coupled(c, state, &subset), twisted)
             })
             .collect::<Result<Vec<_>, _>>()?;
+        let weight = heat_weight(state.1);
         let theta = [0, 1].map(|j| {
             let Some(&node) = nodes.get(j) else {
                 return Vec::new();
@@ -82,7 +85,7 @@ impl CoupledEnds {
                 .filter_map(|t| {
                     let g = coupling_entry(node, t, m.nodes);
                     let k = m.theta_unknown(t)?;
-                    (g != 0.0).then_some((k, -0.5 * m.gamma * g))
+                    (g != 0.0).then_some((k, -weight * m.gamma * g))
                 })
                 .collect()
         });
