@@ -555,8 +555,9 @@ impl PlaneDraw {
         let frictional =
             |e: &Edge| matches!(e, Edge::Signorini { friction: Some(f), .. } if *f > 0.0);
         let free = |e: &Edge| matches!(e, Edge::Free);
-        if !(free(&self.edges[0]) && free(&self.edges[1]))
-            || !self.edges[2..].iter().any(frictional)
+        let travels =
+            free(&self.edges[0]) && free(&self.edges[1]) && self.edges[2..].iter().any(frictional);
+        if !travels
             || self.edges.iter().any(|e| matches!(e, Edge::Clamped))
             || self.solver != "exact"
         {
