@@ -113,6 +113,7 @@ fn check_records(
             r.identity_residual,
             r.obstacle_work,
             r.friction_dissipation,
+            r.sliding_work,
             r.contact.total_reaction,
             r.contact.min_gap,
             r.contact.min_reaction,
