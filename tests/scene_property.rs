@@ -114,6 +114,7 @@ fn check_records(
             r.identity_residual,
             r.obstacle_work,
             r.friction_dissipation,
+            r.sliding_work,
             r.contact.total_reaction,
             r.contact.min_gap,
             r.contact.min_reaction,
@@ -369,15 +370,14 @@ fn plane_relations(d: &PlaneDraw, records: &[StepRecord], u: &[f64]) -> Result<(
     // A belt against its Galilean twin: frictional bottom and top obstacles sliding at `c`
     // against fixed ones with the velocity lowered by `c`, so that u_fixed = u_belt − c t along
     // x (every unknown is free: x components at even indices).
-    if let Some((belt, fixed, shift)) = d.belt_twins() {
-        if let (Some((_, ub)), Some((_, uf))) =
+    if let Some((belt, fixed, shift)) = d.belt_twins()
+        && let (Some((_, ub)), Some((_, uf))) =
             (twin(&belt.toml(), &text)?, twin(&fixed.toml(), &text)?)
-        {
-            let shifted: Vec<f64> = (ub.iter().enumerate())
-                .map(|(i, x)| if i % 2 == 0 { x - shift } else { *x })
-                .collect();
-            prop_assert!(close(&shifted, &uf, TWIN_TOL), "belt twins\n{}", text);
-        }
+    {
+        let shifted: Vec<f64> = (ub.iter().enumerate())
+            .map(|(i, x)| if i % 2 == 0 { x - shift } else { *x })
+            .collect();
+        prop_assert!(close(&shifted, &uf, TWIN_TOL), "belt twins\n{}", text);
     }
     let Some(plain) = d.without_zero_friction() else {
         return Ok(());

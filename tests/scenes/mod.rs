@@ -568,8 +568,9 @@ impl PlaneDraw {
     pub fn belt_twins(&self) -> Option<(Self, Self, f64)> {
         let frictional = |e: &Edge| matches!(e, Edge::Signorini { friction: Some(f), .. } if !is_zero_friction(f));
         let free = |e: &Edge| matches!(e, Edge::Free);
-        if !(free(&self.edges[0]) && free(&self.edges[1]))
-            || !self.edges[2..].iter().any(frictional)
+        let travels =
+            free(&self.edges[0]) && free(&self.edges[1]) && self.edges[2..].iter().any(frictional);
+        if !travels
             || self.edges.iter().any(|e| matches!(e, Edge::Clamped))
             || self.solver != "exact"
         {
