@@ -21,7 +21,9 @@ use crate::scheme::{Body, RunError, Scheme, State};
 use std::path::{Path, PathBuf};
 
 /// What a kept step shows besides the state: the body, its constraints, their reactions and
-/// the increments that classify its frictional nodes.
+/// the increments that classify its frictional nodes (all but the body read by the VTU writer
+/// only).
+#[cfg_attr(not(feature = "vtk"), allow(dead_code))]
 pub struct Kept<'a, B> {
     pub body: &'a B,
     pub contact: &'a ContactSet,
