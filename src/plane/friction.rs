@@ -1,6 +1,7 @@
 //! Coulomb friction on the plane body's Signorini edges: the frictional node of each normal of
-//! an edge with `friction = μ(s)` where `μ(s) > 0` (each node its own `μ`), its tangent `t` the edge's direction of increasing `s`
-//! (`+e_y` along left and right, `+e_x` along bottom and top); the step solver that has the law
+//! an edge with `friction = μ(s)` where `μ(s) > 0` (each node its own `μ`), its tangent `t` the
+//! edge's direction of increasing `s` (`+e_y` along left and right, `+e_x` along bottom and
+//! top); the step solver that has the law
 //! is [`crate::step::algorithm`]'s choice for [`crate::step::Shape::PlaneFriction`]. A corner
 //! shared with another Signorini edge carries that edge's normal on its tangential component
 //! and no friction. An edge's obstacle may slide along `t` ([`sliding_obstacles`]).

@@ -84,9 +84,9 @@ impl Edges {
     }
 
     /// The sliding speed of each edge's obstacle, `[left, right, bottom, top]` (`None` where
-    /// absent): an expression in `t` on a Signorini edge with a `friction` key (not the constant 0), finite at `t = 0`
-    /// (later times are checked as the run reaches them); an error names
-    /// `edges.<edge>.velocity`.
+    /// absent): an expression in `t` on a Signorini edge with a `friction` key (not the
+    /// constant 0), finite at `t = 0` (later times are checked as the run reaches them); an
+    /// error names `edges.<edge>.velocity`.
     pub fn velocities(&self) -> Result<[Option<Expression>; 4], SceneError> {
         let mu = self.frictions()?;
         let mut out: [Option<Expression>; 4] = Default::default();

@@ -2,8 +2,8 @@
 //! dissipation `D_f = −½ Σ_j r_T,j δ_j` of the energy identity (`δ_j = (u^{n+1} − u^{n−1})_{t_j}`,
 //! the central slip; `= ½ Σ_j μ_j r_N,j |δ_j| >= 0` by Coulomb's law), and the frictional nodes
 //! in contact that stick or slip ([`is_slipping`], one definition for every output). An
-//! obstacle sliding along its edge ([`crate::scheme::Slide`]) makes the slip relative, `δ_j − v_j`, and does
-//! the work `½ Σ_j r_T,j v_j`. Derivation: `docs/friction.md`.
+//! obstacle sliding along its edge ([`crate::scheme::Slide`]) makes the slip relative,
+//! `δ_j − v_j`, and does the work `½ Σ_j r_T,j v_j`. Derivation: `docs/friction.md`.
 
 use crate::scheme::contact::{ContactSet, GroupState, in_contact};
 

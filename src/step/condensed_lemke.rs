@@ -1,15 +1,14 @@
 //! The exact frictional step: Coulomb friction at the frictional nodes, with the central slip
-//! `δ_j = (z + w)_{t_j} − v_j` (`w` the previous increment, `v_j` a sliding obstacle's) and the law `|r_T| <= μ r_N`,
-//! `r_T = −μ r_N sign δ` where `δ ≠ 0`. Condensed onto the normals and the tangents,
+//! `δ_j = (z + w)_{t_j} − v_j` (`w` the previous increment, `v_j` a sliding obstacle's) and the
+//! law `|r_T| <= μ r_N`, `r_T = −μ r_N sign δ` where `δ ≠ 0`. Condensed onto the normals and the tangents,
 //! `S = E C⁻¹ Eᵀ` (`E` the normal rows `s_k e_{i_k}ᵀ` and the tangential rows `e_{t_j}ᵀ`), the
 //! step is the Stewart–Trinkle LCP in `(r_N, β⁺, β⁻, λ)` (`r_T = β⁺ − β⁻`, `λ` the slip
 //! multiplier; size `m + 3p`), solved by [`Lemke`]; a step whose free motion is admissible is
 //! `r = 0` without it. The start-up step is the same law with `w = 0` (the slip `u^1 − u^0`,
 //! until [`StepSolver::set_previous_increment`] is first called). On the cone's boundary `r_T`
-//! is set to `∓μ r_N` exactly;
-//! `z` then comes from `C z = b + Eᵀ r` by a second solve. Every answer is audited
-//! ([`crate::step::audit`]). Derivation, termination, audit:
-//! `docs/friction.md`.
+//! is set to `∓μ r_N` exactly; `z` then comes from `C z = b + Eᵀ r` by a second solve. Every
+//! answer is audited ([`crate::step::audit`]); a warm-started answer the audit refuses is
+//! replaced by a cold run's. Derivation, termination, audit: `docs/friction.md`.
 
 use crate::linalg::system::SpdSystem;
 use crate::step::audit::{KktAudit, Slack};

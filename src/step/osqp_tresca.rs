@@ -6,9 +6,9 @@
 //!   minimise ½ rᵀ S r + qᵀ r   subject to   r_N >= 0,   −g <= r_T <= g,
 //! ```
 //!
-//! (`S`, `q` of [`crate::step::condensed_lemke`]; its KKT conditions are Signorini on the normals and
-//! Tresca's law on the central slip, relative to a sliding obstacle), solved by OSQP, set up once and warm-started; `z` then
-//! from `C z = b + Eᵀ r`, and each answer audited against the Tresca law it solved
+//! (`S`, `q` of [`crate::step::condensed_lemke`]; its KKT conditions are Signorini on the
+//! normals and Tresca's law on the central slip, relative to a sliding obstacle), solved by
+//! OSQP, set up once and warm-started; `z` then from `C z = b + Eᵀ r`, and each answer audited against the Tresca law it solved
 //! ([`crate::step::audit`]). The iteration starts from the previous step's normal
 //! reactions and stops when they change by at most [`FIXED_POINT_TOL`] (relative); beyond
 //! [`FIXED_POINT_MAX_ITERATIONS`] it is an error. The start-up step is the same fixed point with
