@@ -10,6 +10,7 @@
 
 use crate::output::text::{push_time, push_value};
 use crate::scheme::StepRecord;
+use crate::scheme::body::HeatOutputs;
 use crate::scheme::contact::{ContactSet, Group, MAX_GROUPS};
 use std::io::Write;
 
@@ -39,6 +40,9 @@ pub struct OptionalColumns {
     /// The body has a temperature: `thermal_energy`, `thermal_dissipation`, `exchange`,
     /// `heat_supply`, `smoothing_dissipation`.
     pub thermal: bool,
+    /// The heat balance of a body that reports one: `heat_content`, `frictional_supply`,
+    /// `frictional_heating`, `heat_to_obstacle` ([`HeatOutputs`]).
+    pub heat: HeatOutputs,
     /// The groups, in order, with frictional nodes: `tangential_reaction_G` after
     /// `reaction_G`.
     pub tangential: [bool; MAX_GROUPS],
@@ -47,7 +51,7 @@ pub struct OptionalColumns {
 impl OptionalColumns {
     /// The columns of a run with the constraints `contact`, of a body with a temperature or
     /// not.
-    pub fn of(contact: &ContactSet, thermal: bool) -> Self {
+    pub fn of(contact: &ContactSet, thermal: bool, heat: HeatOutputs) -> Self {
         let mut tangential = [false; MAX_GROUPS];
         for &k in &contact.friction().normals {
             if let Some(g) = contact.groups().iter().position(|g| g.range.contains(&k)) {
@@ -59,6 +63,7 @@ impl OptionalColumns {
             friction: !contact.friction().is_empty(),
             sliding: contact.is_sliding(),
             thermal,
+            heat,
             tangential,
         }
     }
@@ -78,6 +83,15 @@ pub fn header(groups: &[Group], optional: OptionalColumns) -> String {
     }
     if optional.thermal {
         h.push_str(THERMAL_COLUMNS);
+    }
+    if optional.heat.heat_content {
+        h.push_str(",heat_content");
+    }
+    if optional.heat.frictional_heating {
+        h.push_str(",frictional_supply,frictional_heating");
+    }
+    if optional.heat.obstacle_heating {
+        h.push_str(",heat_to_obstacle");
     }
     for (g, tangential) in groups.iter().zip(optional.tangential) {
         let n = g.name;
@@ -141,6 +155,24 @@ pub fn row(r: &StepRecord, groups: &[Group], optional: OptionalColumns, row: &mu
                 push_value(v, row);
             }
         }
+    }
+    // The heat balance is kept at every step (the identity's term only where measured).
+    let h = r.heat.unwrap_or_default();
+    if optional.heat.heat_content {
+        row.push(b',');
+        push_value(h.heat_content, row);
+    }
+    if optional.heat.frictional_heating {
+        row.push(b',');
+        if r.measured {
+            push_value(h.frictional_supply, row);
+        }
+        row.push(b',');
+        push_value(h.frictional_heating, row);
+    }
+    if optional.heat.obstacle_heating {
+        row.push(b',');
+        push_value(h.obstacle_heating, row);
     }
     for ((g, s), tangential) in groups
         .iter()

@@ -153,7 +153,12 @@ fn record_prepared<B: Body>(
     start: Instant,
 ) -> Result<Recorded, RunError> {
     let groups = prepared.contact().groups().to_vec();
-    let optional = history::OptionalColumns::of(prepared.contact(), B::TEMPERATURE);
+    let has_theta = prepared.body().has_temperature();
+    let optional = history::OptionalColumns::of(
+        prepared.contact(),
+        has_theta,
+        prepared.body().heat_outputs(),
+    );
     let header = history::header(&groups, optional);
     let history_columns: Vec<String> = header.trim_end().split(',').map(String::from).collect();
     let mut rows = History {
@@ -177,7 +182,7 @@ fn record_prepared<B: Body>(
         components,
         x: nodes.iter().map(|&i| rounded(i).0).collect(),
         y: nodes.iter().filter_map(|&i| rounded(i).1).collect(),
-        has_theta: B::TEMPERATURE,
+        has_theta,
         ..Profile::default()
     };
     // Sized once: the kept steps are known (`sampling.kept_steps`).
@@ -185,12 +190,12 @@ fn record_prepared<B: Body>(
     profile.times.reserve_exact(kept);
     profile.displacement.reserve_exact(kept * dofs.len());
     profile.velocity.reserve_exact(kept * dofs.len());
-    if B::TEMPERATURE {
+    if has_theta {
         profile.theta.reserve_exact(kept * nodes.len());
     }
     let keep_step = |profile: &mut Profile, t: f64, state: State<'_>, body: &B| {
         profile.keep(t, state, &dofs);
-        if B::TEMPERATURE {
+        if has_theta {
             let theta = nodes.iter().map(|&i| body.temperature(state.u, i));
             profile.theta.extend(theta.map(|v| v.unwrap_or(0.0)));
         }

@@ -72,7 +72,7 @@ impl Profiles {
         body: &B,
         sampling: &OutputSampling,
     ) -> std::io::Result<Self> {
-        let theta = B::TEMPERATURE;
+        let theta = body.has_temperature();
         let stride = usize::try_from(sampling.node_stride).unwrap_or(usize::MAX);
         let nodes = written_nodes(body.lattice(), stride);
         let components = body.components();

@@ -305,7 +305,11 @@ impl Run<'_> {
         let hist_path = dir.join("history.csv");
         let mut hist = std::io::BufWriter::with_capacity(1 << 16, create(&hist_path)?);
         let groups = prepared.contact().groups().to_vec();
-        let optional = history::OptionalColumns::of(prepared.contact(), B::TEMPERATURE);
+        let optional = history::OptionalColumns::of(
+            prepared.contact(),
+            prepared.body().has_temperature(),
+            prepared.body().heat_outputs(),
+        );
         hist.write_all(history::header(&groups, optional).as_bytes())
             .map_err(io(&hist_path))?;
         // `t = 0` is written before the start-up step moves `u^0` on (no reactions yet).

@@ -9,8 +9,8 @@
 //! force `Σ_k r_k s_k e_{c_k}` at the node), `contact_force` (that plus a frictional node's
 //! tangential reaction `r_T t`), `friction_state` ([`crate::scheme::NodeState`]: 0 open or
 //! frictionless, 1 stick, 2 slip), `gap` (the least gap of the node's constraints, 0 at a node
-//! without one) and `contact_constraints` (their number: 0, 1, or 2 at a corner). At `t = 0` no
-//! step has acted: every reaction and state is 0.
+//! without one), `contact_constraints` (their number: 0, 1, or 2 at a corner) and, with
+//! `[heat]`, `theta` (`θ^{n+1/2}`). At `t = 0` no step has acted: every reaction and state is 0.
 
 use crate::output::profiles::Profiles;
 #[cfg(feature = "vtk")]
@@ -286,7 +286,10 @@ pub mod series {
                     data: data.into(),
                 })
             };
-            let point = vec![
+            let theta: Option<Vec<f64>> = (self.nodes.iter())
+                .map(|&n| body.temperature(state.u, n))
+                .collect();
+            let mut point = vec![
                 vectors("displacement", displacement),
                 vectors("velocity", velocity),
                 scalar("sigma_xx", component(0)),
@@ -299,6 +302,9 @@ pub mod series {
                 scalar("gap", gap),
                 scalar("contact_constraints", count),
             ];
+            if let Some(theta) = theta {
+                point.push(scalar("theta", theta));
+            }
             let vtk = Vtk {
                 version: Version::XML { major: 1, minor: 0 },
                 byte_order: ByteOrder::LittleEndian,

@@ -9,6 +9,7 @@ use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::sparse::Pattern;
 use crate::linalg::system::SparseSystem;
 use crate::plane::energy::{StrainForms, measure};
+use crate::plane::heat::PlaneHeat;
 use crate::plane::matrices::{Material, assemble, assemble_with};
 use crate::plane::mesh::Grid;
 use crate::plane::normals::{Normal, edge_motion, normals};
@@ -17,7 +18,7 @@ use crate::scene::SceneError;
 use crate::scene::expr::Expression;
 use crate::scene::plane::PENALTY_CONDENSED_MAX_NORMALS;
 use crate::scene::plane::{EDGE_NAMES, PlaneScene};
-use crate::scheme::body::{Body, EnergySums, FullMassRows};
+use crate::scheme::body::{Body, EnergySums, FullMassRows, HeatOutputs, HeatTerms};
 use crate::scheme::certify::{
     LAMBDA_IDENTITY_ULPS, MAX_IDENTITY_BOUND, PLANE_IDENTITY_TOL, conditioned_bound,
 };
@@ -132,6 +133,8 @@ pub struct PlaneBody {
     c_w: f64,
     /// An upper bound on `κ(C)` ([`condition_bound`]), for the identity's bound.
     condition: f64,
+    /// The temperature of a scene with `[heat]` ([`crate::plane::heat`]).
+    heat: Option<Box<PlaneHeat>>,
 }
 
 /// An upper bound on `κ₂(C)` in one pass over the pattern: `λ_max(C)` is at most the largest
@@ -298,6 +301,46 @@ impl Body for PlaneBody {
         let cells = stress::cell_stress(&d.grid, d.material, d.alpha, &uf, &vf);
         Some(stress::nodal_stress(&d.grid, &cells))
     }
+
+    fn has_temperature(&self) -> bool {
+        self.heat.is_some()
+    }
+
+    fn heat_outputs(&self) -> HeatOutputs {
+        self.heat
+            .as_ref()
+            .map_or_else(HeatOutputs::default, |h| h.outputs())
+    }
+
+    fn prepare_step(&mut self, n: usize, lower: &[f64]) -> Result<(), RunError> {
+        match &mut self.heat {
+            Some(heat) => heat.prepare(n, lower),
+            None => Ok(()),
+        }
+    }
+
+    fn heat_step(&mut self, n: usize, friction_work: &[f64]) -> Result<(), RunError> {
+        match &mut self.heat {
+            Some(heat) => heat.step(n, friction_work),
+            None => Ok(()),
+        }
+    }
+
+    fn start_up_heat(&self, _u: &[f64]) -> Option<HeatTerms> {
+        self.heat.as_ref().map(|h| h.start_up_terms())
+    }
+
+    fn heat_energy(&self, _u: &[f64]) -> Option<f64> {
+        self.heat.as_ref().map(|h| h.energy())
+    }
+
+    fn heat_terms(&self, _u: &[f64], _z: &[f64], _w: &[f64]) -> Option<HeatTerms> {
+        self.heat.as_ref().map(|h| h.terms())
+    }
+
+    fn temperature(&self, _u: &[f64], node: usize) -> Option<f64> {
+        self.heat.as_ref().map(|h| h.temperature(node))
+    }
 }
 
 /// The contact set of the Signorini edges' normals: `u·n <= g` at each, `n = σ e_c`, is the
@@ -365,6 +408,7 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
         .with_motion(edge_motion(&gaps, &normals))
         .with_friction(friction.clone())
         .with_slide(slide);
+    let friction_nodes = friction.clone();
     let restrict = |v: &[f64]| disc.free.iter().map(|&d| v[d]).collect::<Vec<f64>>();
     let (displacement, velocity) = (restrict(&u0_full), restrict(&v0_full));
     let c = disc.step_matrix();
@@ -426,7 +470,21 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
         }
         .into());
     }
+    let heat = match &scene.heat {
+        Some(table) => {
+            let parsed = table.validate(&scene.edges)?;
+            Some(Box::new(PlaneHeat::new(
+                grid,
+                &normals,
+                &friction_nodes,
+                parsed,
+                dt,
+            )?))
+        }
+        None => None,
+    };
     let body = PlaneBody {
+        heat,
         normals,
         condition,
         c,

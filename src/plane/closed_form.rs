@@ -203,6 +203,7 @@ impl Manufactured {
             time: Time { step: dt, end },
             solver: Default::default(),
             output: Default::default(),
+            heat: None,
         }
     }
 }

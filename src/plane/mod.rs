@@ -15,6 +15,7 @@ pub(crate) mod body;
 pub mod closed_form;
 pub(crate) mod energy;
 pub(crate) mod friction;
+pub(crate) mod heat;
 pub(crate) mod matrices;
 pub(crate) mod mesh;
 pub(crate) mod normals;

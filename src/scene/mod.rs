@@ -12,6 +12,7 @@ pub(crate) mod nodal;
 pub(crate) mod output;
 pub(crate) mod parser;
 pub mod plane;
+pub mod plane_heat;
 pub(crate) mod schema;
 pub(crate) mod separation;
 pub(crate) mod solver;

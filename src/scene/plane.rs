@@ -41,6 +41,9 @@ pub struct PlaneScene {
     /// The bar's `[output]` table, keys and defaults.
     #[serde(default)]
     pub output: OutputSpec,
+    /// The temperature (`[heat]`, [`crate::scene::plane_heat`]); absent: the body has none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heat: Option<crate::scene::plane_heat::PlaneHeat>,
 }
 
 /// The `[plane]` table: geometry and material.
@@ -387,13 +390,6 @@ impl PlaneScene {
     pub fn from_toml(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
         let table: toml::Table = toml::from_str(text).map_err(toml_syntax)?;
         let table = crate::scene::schema::overridden(table, overrides)?;
-        if table.contains_key("heat") {
-            return Err(SceneError::Invalid {
-                field: "heat".into(),
-                value: "(set)".into(),
-                allowed: "the plane body has no temperature: [heat] belongs to bar scenes".into(),
-            });
-        }
         let scene: PlaneScene = with_overrides(table, &[])?;
         scene.validate()?;
         Ok(scene)
@@ -486,6 +482,17 @@ impl PlaneScene {
         self.expressions()?;
         self.edges.gaps()?;
         self.validate_friction()?;
+        if let Some(heat) = &self.heat {
+            heat.validate(&self.edges)?;
+            if self.solver.method != SolverMethod::Exact {
+                return Err(SceneError::Invalid {
+                    field: "solver.method".into(),
+                    value: self.solver.method.name().into(),
+                    allowed: "a plane scene with [heat] takes the exact step solver (\"exact\")"
+                        .into(),
+                });
+            }
+        }
         let m = self.contact_normals();
         if self.solver.method == SolverMethod::Exact {
             let dense = m

@@ -33,6 +33,28 @@ pub struct HeatTerms {
     /// `(w − ½)|θ^{n+1/2} − θ^{n−1/2}|²_M >= 0`: the numerical dissipation of an implicit
     /// Euler heat step (`w = 1`; 0 on a Crank–Nicolson step, `w = ½`).
     pub smoothing: f64,
+    /// `Σ_j θ_w,j q_j`: the thermal energy the frictional heat `q` brings (plane body).
+    pub frictional_supply: f64,
+    /// `Σ_j q_j = Σ_j η_j d_j`: the heat friction puts into the body over the step (`d_j` a
+    /// frictional node's share of `D_f`, `η_j` its edge's `frictional_heating`).
+    pub frictional_heating: f64,
+    /// `Σ_j (1 − η_j) d_j`: the rest of `D_f`, the heat that goes to the obstacles.
+    pub obstacle_heating: f64,
+    /// `1ᵀ M θ^{n+1/2}`: the body's heat content (plane body; 0 on the bar).
+    pub heat_content: f64,
+}
+
+/// Which heat balance a body with a temperature reports beside the identity's thermal terms
+/// (the plane body's: its heat content, and the heat friction puts into it and into the
+/// obstacles).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct HeatOutputs {
+    /// `1ᵀ M θ`.
+    pub heat_content: bool,
+    /// Frictional heating (`Σ θ_w q`, `Σ q`).
+    pub frictional_heating: bool,
+    /// Heat to the obstacles, where some `η < 1`.
+    pub obstacle_heating: bool,
 }
 
 /// `x ↦ (M x)` restricted to the unknowns, for `x` given at every degree of freedom of the
@@ -101,7 +123,9 @@ pub trait Body {
     // those of a body without one, and leave its steps as they are.
 
     /// Whether the body has a temperature (its outputs gain the thermal columns).
-    const TEMPERATURE: bool = false;
+    fn has_temperature(&self) -> bool {
+        false
+    }
     /// Brings the body's data to the step from `t_n` (boundary temperatures at `t_{n+1/2}`,
     /// which ends exchange heat), before the step's right-hand side; `n = 0` before the
     /// start-up step. `lower` are the step's bounds `lo_k = −g_k − s_k u^n_{i_k}`, the
@@ -119,6 +143,27 @@ pub trait Body {
         _increment: &mut [f64],
     ) -> Result<(), RunError> {
         Ok(())
+    }
+    /// The heat balance the body reports ([`HeatOutputs`]; none by default).
+    fn heat_outputs(&self) -> HeatOutputs {
+        HeatOutputs::default()
+    }
+    /// The heat step of a body whose temperature follows its mechanics (the plane body's,
+    /// not coupled to its displacement), after the solve of the step from `t_n`:
+    /// `θ^{n−1/2} → θ^{n+1/2}` (`n = 0`: the start-up's half step `θ^0 → θ^{1/2}`), with
+    /// `friction_work[j]` frictional node `j`'s share of the step's `D_f` (empty without
+    /// friction). Allocates nothing once each contact state's matrix is factorised.
+    fn heat_step(&mut self, _n: usize, _friction_work: &[f64]) -> Result<(), RunError> {
+        Ok(())
+    }
+    /// The thermal terms of the start-up's record: `E^{1/2}`'s thermal part and, for a body
+    /// whose heat step follows its mechanics, the start-up's heat inputs (`None` without a
+    /// temperature).
+    fn start_up_heat(&self, u: &[f64]) -> Option<HeatTerms> {
+        self.heat_energy(u).map(|energy| HeatTerms {
+            energy,
+            ..Default::default()
+        })
     }
     /// `½ |θ|²_M` of the state `u` (`None` without a temperature).
     fn heat_energy(&self, _u: &[f64]) -> Option<f64> {

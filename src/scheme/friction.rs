@@ -51,6 +51,31 @@ impl ContactSet {
         state
     }
 
+    /// Each frictional node's share of the friction work over the step just taken,
+    /// `out[j] = −scale r_T,j δ_j` (`δ_j` the relative slip over the increments `z` and `w`,
+    /// `w = None` for the start-up's slip `u^1 − u^0`; `scale` ½ for a central slip, so that
+    /// the shares sum to [`FrictionState::dissipation`] in its order). Fills as many nodes as
+    /// `out` holds (none for a body that does not ask).
+    pub fn friction_work_into(
+        &self,
+        r: &[f64],
+        (z, w): (&[f64], Option<&[f64]>),
+        scale: f64,
+        out: &mut [f64],
+    ) {
+        let m = self.len();
+        for (j, o) in out.iter_mut().enumerate() {
+            let slip = match w {
+                Some(w) => self.relative_slip(j, (z, w)),
+                None => {
+                    let t = self.friction().tangents[j];
+                    z[t] + 0.0 - self.slide().map_or(0.0, |s| s.displacement()[j])
+                }
+            };
+            *o = -scale * r[m + j] * slip;
+        }
+    }
+
     /// The sliding obstacles' work over the step just taken, `½ Σ_j r_T,j v_j` (`r` the normal
     /// then the tangential reactions): positive when an obstacle drags the body along its
     /// motion (0 when none slides).

@@ -17,7 +17,7 @@ pub(crate) mod load;
 pub(crate) mod slide;
 pub(crate) mod stepper;
 
-pub use body::{Body, EnergySums, HeatTerms};
+pub use body::{Body, EnergySums, HeatOutputs, HeatTerms};
 pub use certify::{Certificate, CertificateFailure};
 pub use contact::{CONTACT_GAP_TOL, ContactSet, ContactState, GroupState, in_contact};
 pub use error::RunError;

@@ -29,9 +29,9 @@ pub struct StepRecord {
     pub contact_dissipation: f64,
     /// `|E^{n+1/2} − E^{n−1/2} − work − obstacle_work − sliding_work + viscous + D + D_f|` over
     /// the largest of those terms (with a temperature: `+ thermal dissipation + exchange +
-    /// smoothing − supply`, [`HeatTerms`]), or over the run's energy resolution
-    /// `ENERGY_RESOLUTION` times the
-    /// largest term measured so far where that is larger.
+    /// smoothing − supply − frictional supply`, [`HeatTerms`]), or over the run's energy
+    /// resolution `ENERGY_RESOLUTION` times the largest term measured so far where that is
+    /// larger.
     pub identity_residual: f64,
     /// The bound the run's certificate holds `identity_residual` to on a measured step: the
     /// body's round-off tolerance plus the step solver's allowance ([`crate::scheme::certify`]).
@@ -104,6 +104,9 @@ pub struct Scheme<B: Body> {
     b: Vec<f64>,
     lower: Vec<f64>,
     reactions: Vec<f64>,
+    /// Each frictional node's share of the step's `D_f`, for a body whose heat step follows
+    /// its mechanics ([`Body::heat_step`]; empty otherwise).
+    friction_work: Vec<f64>,
     balance: Balance,
     diagnostics_every: usize,
     last_step: usize,
@@ -124,6 +127,11 @@ impl<B: Body> Scheme<B> {
     pub fn unstarted(setup: Setup<B>) -> Unstarted<B> {
         let n = setup.body.unknowns();
         let (k, reactions) = (setup.contact.len(), setup.contact.reaction_len());
+        let frictional = if setup.body.has_temperature() {
+            setup.contact.friction().len()
+        } else {
+            0
+        };
         let scheme = Self {
             solver: setup.solver,
             contact: setup.contact,
@@ -135,6 +143,7 @@ impl<B: Body> Scheme<B> {
             b: vec![0.0; n],
             lower: vec![0.0; k],
             reactions: vec![0.0; reactions],
+            friction_work: vec![0.0; frictional],
             balance: Balance {
                 energy: 0.0,
                 potential: 0.0,
@@ -196,16 +205,17 @@ impl<B: Body> Scheme<B> {
         let info = (self.solver)
             .solve(&self.b, &self.lower, &mut self.z, &mut self.reactions)
             .map_err(|failure| self.failure(1, failure))?;
+        // The friction work over the start-up, `−r_T,j (u^1 − u^0)_{t_j}`, and the heat step.
+        let work = &mut self.friction_work;
+        (self.contact).friction_work_into(&self.reactions, (&self.z, None), 1.0, work);
+        self.body.heat_step(0, &self.friction_work)?;
         let potential0 = self.body.stiffness_form(&self.u);
         add_in_place(&mut self.u, &self.z);
         self.body.mass_mul(&self.z, &mut self.b);
         let potential = self.body.stiffness_form(&self.u);
         let mut energy =
             0.5 * dot(&self.z, &self.b) * (1.0 / (dt * dt)) + 0.25 * (potential + potential0);
-        let heat = self.body.heat_energy(&self.u).map(|energy| HeatTerms {
-            energy,
-            ..Default::default()
-        });
+        let heat = self.body.start_up_heat(&self.u);
         if let Some(h) = heat {
             energy += h.energy;
         }
@@ -315,6 +325,10 @@ impl<B: Body> Scheme<B> {
                 &mut self.u,
             )
             .map_err(|failure| self.failure(n + 1, failure))?;
+        // A temperature that follows the mechanics takes its step, heated by friction.
+        let work = &mut self.friction_work;
+        (self.contact).friction_work_into(&self.reactions, (&self.z, Some(&self.w)), 0.5, work);
+        self.body.heat_step(n, &self.friction_work)?;
         let clock = clock.lap(&mut self.timing.solve_ns);
         // 4. The contact state and the energy identity.
         let mut record = StepRecord {
@@ -334,6 +348,10 @@ impl<B: Body> Scheme<B> {
             record.sliding_work = self.contact.sliding_work(&self.reactions);
             let heat = self.body.heat_terms(&self.u, &self.z, &self.w);
             self.close_balance(&mut record, sums, [contact, friction.dissipation], heat)?;
+        }
+        if !measure && self.body.heat_outputs().heat_content {
+            // A heat balance is kept at every step.
+            record.heat = self.body.heat_terms(&self.u, &self.z, &self.w);
         }
         self.balance.measured = measure;
         std::mem::swap(&mut self.w, &mut self.z);
@@ -398,9 +416,18 @@ impl<B: Body> Scheme<B> {
         if let Some(h) = heat {
             // A zero smoothing term (Crank–Nicolson steps) adds nothing: their bits stay.
             residual += h.dissipation + h.exchange + h.smoothing - h.supply;
-            scale = [h.dissipation, h.exchange.abs(), h.supply.abs(), h.smoothing]
-                .into_iter()
-                .fold(scale, f64::max);
+            // Zero without friction heating the body: the thermal bar keeps its bits.
+            residual -= h.frictional_supply;
+            let heating = h.frictional_supply.abs();
+            scale = [
+                h.dissipation,
+                h.exchange.abs(),
+                h.supply.abs(),
+                h.smoothing,
+                heating,
+            ]
+            .into_iter()
+            .fold(scale, f64::max);
         }
         if !(energy.is_finite() && residual.is_finite()) {
             return Err(self.failure(record.step, StepFailure::NonFinite));
@@ -456,7 +483,7 @@ impl<B: Body> Scheme<B> {
         self.load.force().is_some()
             || self.contact.is_moving()
             || self.contact.is_sliding()
-            || B::TEMPERATURE
+            || self.body.has_temperature()
     }
 
     /// The load vector `F^n` on the unknowns (zeros without a load), as the step from `t_n`

@@ -253,7 +253,10 @@ fn sample_scheme<B: Body>(
     let steps = scene.steps();
     let rows = nodes.len() * steps_sampled.len();
     let mut u = Vec::with_capacity(rows);
-    let mut theta = B::TEMPERATURE.then(|| Vec::with_capacity(rows));
+    let mut theta = prepared
+        .body()
+        .has_temperature()
+        .then(|| Vec::with_capacity(rows));
     let mut energy = Vec::with_capacity(steps_sampled.len());
     // `u` at every mesh node from the unknowns `state` (clamped nodes 0), and `θ` beside it.
     let mut full = vec![0.0; prepared.body().nodes()];

@@ -534,7 +534,9 @@ impl Body for ThermalBody {
     }
 
     const NAME: &'static str = "bar";
-    const TEMPERATURE: bool = true;
+    fn has_temperature(&self) -> bool {
+        true
+    }
 
     fn unknowns(&self) -> usize {
         self.m.n_u + self.m.n_t
@@ -815,6 +817,7 @@ impl Body for ThermalBody {
             exchange,
             supply,
             smoothing,
+            ..Default::default()
         })
     }
 

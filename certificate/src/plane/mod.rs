@@ -179,6 +179,7 @@ pub fn plane_of_bar(bar: &Scene, height: f64, ny: u64, y_grading: f64) -> Option
         time: bar.time.clone(),
         solver: Default::default(),
         output: Default::default(),
+        heat: None,
     })
 }
 

@@ -1,0 +1,577 @@
+//! The plane body's temperature: `θ_t − κ Δθ = q`, Q1 on the body's mesh at the half steps,
+//! stepped after each mechanical step (the coupling `γ` is 0 on the plane, so the step of `θ`
+//! follows from `u^{n+1}`): Crank–Nicolson, or implicit Euler where the data are not smooth
+//! (the thermal bar's Rannacher start, [`crate::thermal::smoothing`]). Edges are insulated,
+//! held at a temperature, or exchange heat with their obstacle where in contact (lumped on the
+//! edge's nodes); the friction work of each frictional node enters it as nodal heat, the
+//! share `η` of its edge. Each contact state's matrix is factorised once, when first met.
+//! Derivation and the thermal terms of the energy identity: docs/thermal.md, "The plane body".
+
+use crate::linalg::cholesky::SparseCholesky;
+use crate::linalg::sparse::Pattern;
+use crate::plane::mesh::Grid;
+use crate::plane::normals::Normal;
+use crate::scene::expr::Expression;
+use crate::scene::plane::EDGE_NAMES;
+use crate::scene::plane_heat::{EdgeHeat, PlaneHeatExpressions};
+use crate::scheme::body::{HeatOutputs, HeatTerms};
+use crate::scheme::{RunError, in_contact};
+use crate::step::Friction;
+use crate::thermal::smoothing::{Smoothing, jumps_within, starts_with_a_jump};
+
+/// A node held at its edge's temperature: the node, its edge and coordinate `s`.
+#[derive(Clone, Copy, Debug)]
+struct FixedNode {
+    node: usize,
+    edge: usize,
+    s: f64,
+}
+
+/// A node of an exchange edge: the node, its contact constraint, its trapezoid share of the
+/// edge and the edge.
+#[derive(Clone, Copy, Debug)]
+struct ExchangeNode {
+    node: usize,
+    constraint: usize,
+    weight: f64,
+    edge: usize,
+}
+
+/// The factor of one step matrix `(M + c A_χ)` on the unknown temperatures: its exchange
+/// state `χ` and whether `c = Δt` (an implicit Euler step) or `Δt/2`.
+struct StepFactor {
+    chi: Vec<bool>,
+    implicit: bool,
+    factor: SparseCholesky,
+}
+
+/// The plane body's temperature and its step.
+pub struct PlaneHeat {
+    kappa: f64,
+    dt: f64,
+    /// Scalar Q1 mass and stiffness on every node (one pattern).
+    pattern: Pattern,
+    mass: Vec<f64>,
+    stiffness: Vec<f64>,
+    /// The unknown temperatures (nodes not held): their pattern and each entry's position in
+    /// `pattern`; `free[i]` the node of unknown `i`.
+    reduced: Pattern,
+    from: Vec<usize>,
+    free: Vec<usize>,
+    fixed: Vec<FixedNode>,
+    values: [Option<Expression>; 4],
+    exchange: Vec<ExchangeNode>,
+    /// `h` and `θ_obs(t)` of each exchange edge.
+    exchange_edges: [Option<(f64, Expression)>; 4],
+    source: Option<Expression>,
+    /// The node and `η` of each frictional node.
+    heated: Vec<(usize, f64)>,
+    points: Vec<(f64, f64)>,
+    factors: Vec<StepFactor>,
+    /// The step's exchange state, `θ_obs` of each exchange edge at `t_n`, and its weight.
+    chi: Vec<bool>,
+    theta_obs: [f64; 4],
+    implicit: bool,
+    smoothing: Smoothing,
+    start_jump: bool,
+    /// `θ^{n−1/2}` and `θ^{n+1/2}` on every node.
+    old: Vec<f64>,
+    new: Vec<f64>,
+    /// Scratch (every node): `Q`, the frictional heat `q`, `θ_w`, products, the right-hand
+    /// side; the unknowns' increment; matrix values.
+    source_load: Vec<f64>,
+    heat: Vec<f64>,
+    weighted: Vec<f64>,
+    product: Vec<f64>,
+    a_weighted: Vec<f64>,
+    rhs: Vec<f64>,
+    unknown: Vec<f64>,
+    values_full: Vec<f64>,
+    values_reduced: Vec<f64>,
+    terms: HeatTerms,
+}
+
+/// The 3 × 3 node stencil of every node: the pattern of the scalar Q1 matrices.
+fn node_stencil(grid: &Grid) -> Pattern {
+    let n = grid.nodes();
+    let mut row_ptr = Vec::with_capacity(n + 1);
+    let mut cols = Vec::with_capacity(9 * n);
+    row_ptr.push(0);
+    for node in 0..n {
+        let (i, j) = grid.position(node);
+        for jj in j.saturating_sub(1)..=(j + 1).min(grid.ny) {
+            for ii in i.saturating_sub(1)..=(i + 1).min(grid.nx) {
+                cols.push(grid.node(ii, jj));
+            }
+        }
+        row_ptr.push(cols.len());
+    }
+    Pattern { n, row_ptr, cols }
+}
+
+/// The scalar Q1 mass and stiffness on the grid, cell by cell as tensor products of the P1
+/// element matrices in `x` and in `y` (exact on rectangles).
+fn assemble(grid: &Grid, pattern: &Pattern) -> (Vec<f64>, Vec<f64>) {
+    let (mut mass, mut stiffness) = (vec![0.0; pattern.nnz()], vec![0.0; pattern.nnz()]);
+    let m1 = |h: f64| [[h / 3.0, h / 6.0], [h / 6.0, h / 3.0]];
+    let k1 = |h: f64| [[1.0 / h, -1.0 / h], [-1.0 / h, 1.0 / h]];
+    for j in 0..grid.ny {
+        for i in 0..grid.nx {
+            let (hx, hy) = (grid.xs[i + 1] - grid.xs[i], grid.ys[j + 1] - grid.ys[j]);
+            let (mx, my, kx, ky) = (m1(hx), m1(hy), k1(hx), k1(hy));
+            for (a, b) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let row = grid.node(i + a, j + b);
+                for (c, d) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let p = pattern.position(row, grid.node(i + c, j + d));
+                    mass[p] += mx[a][c] * my[b][d];
+                    stiffness[p] += kx[a][c] * my[b][d] + mx[a][c] * ky[b][d];
+                }
+            }
+        }
+    }
+    (mass, stiffness)
+}
+
+/// `f` finite, or the error naming `key`.
+fn finite(v: f64, key: &str) -> Result<f64, RunError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(crate::scene::error::invalid(key, v, "must be finite at every node and time").into())
+    }
+}
+
+/// The edge coordinate `s` of `node` on edge `edge` (`y` on left and right, `x` on bottom and
+/// top).
+fn edge_coordinate(grid: &Grid, node: usize, edge: usize) -> f64 {
+    let (x, y) = grid.point(node);
+    if edge < 2 { y } else { x }
+}
+
+/// Whether `node` lies on edge `edge`.
+fn on_edge(grid: &Grid, node: usize, edge: usize) -> bool {
+    let (i, j) = grid.position(node);
+    match edge {
+        0 => i == 0,
+        1 => i == grid.nx,
+        2 => j == 0,
+        _ => j == grid.ny,
+    }
+}
+
+impl PlaneHeat {
+    /// The temperature of a plane body on `grid` with the contact `normals`, the frictional
+    /// nodes `friction` and the parsed `[heat]`; `θ^0` evaluated at every node.
+    pub fn new(
+        grid: &Grid,
+        normals: &[Normal],
+        friction: &Friction,
+        heat: PlaneHeatExpressions,
+        dt: f64,
+    ) -> Result<Self, RunError> {
+        let pattern = node_stencil(grid);
+        let (mass, stiffness) = assemble(grid, &pattern);
+        let nodes = grid.nodes();
+        let PlaneHeatExpressions {
+            diffusivity,
+            temperature,
+            source,
+            edges,
+            frictional_heating,
+        } = heat;
+        let mut values: [Option<Expression>; 4] = Default::default();
+        let mut exchange_edges: [Option<(f64, Expression)>; 4] = Default::default();
+        for (k, e) in edges.into_iter().enumerate() {
+            match e {
+                EdgeHeat::Insulated => {}
+                EdgeHeat::Temperature(v) => values[k] = Some(v),
+                EdgeHeat::Exchange {
+                    coefficient,
+                    obstacle,
+                } => exchange_edges[k] = Some((coefficient, obstacle)),
+            }
+        }
+        let points: Vec<(f64, f64)> = (0..nodes).map(|n| grid.point(n)).collect();
+        let mut old = Vec::with_capacity(nodes);
+        for &(x, y) in &points {
+            old.push(finite(temperature.eval_xy(x, y, 0.0)?, "heat.temperature")?);
+        }
+        // A node on two held edges takes the first in the order left, right, bottom, top.
+        let mut held = vec![false; nodes];
+        let mut fixed = Vec::new();
+        let mut start_jump = false;
+        for (edge, value) in values.iter().enumerate() {
+            let Some(value) = value else { continue };
+            let key = format!("heat.{}.value", EDGE_NAMES[edge]);
+            for node in 0..nodes {
+                if !on_edge(grid, node, edge) || held[node] {
+                    continue;
+                }
+                held[node] = true;
+                let s = edge_coordinate(grid, node, edge);
+                let v0 = finite(value.eval(s, 0.0)?, &key)?;
+                start_jump |= starts_with_a_jump(old[node], v0);
+                fixed.push(FixedNode { node, edge, s });
+            }
+        }
+        let keep: Vec<Option<usize>> = {
+            let mut next = 0;
+            (0..nodes)
+                .map(|n| {
+                    (!held[n]).then(|| {
+                        next += 1;
+                        next - 1
+                    })
+                })
+                .collect()
+        };
+        let free: Vec<usize> = (0..nodes).filter(|&n| !held[n]).collect();
+        let (reduced, from) = pattern.restrict(&keep);
+        let exchange: Vec<ExchangeNode> = (normals.iter().enumerate())
+            .filter(|(_, nk)| exchange_edges[nk.edge].is_some())
+            .map(|(k, nk)| ExchangeNode {
+                node: nk.node,
+                constraint: k,
+                weight: nk.weight,
+                edge: nk.edge,
+            })
+            .collect();
+        let heated = (friction.normals.iter())
+            .map(|&k| (normals[k].node, frictional_heating[normals[k].edge]))
+            .collect();
+        let source_load = vec![0.0; if source.is_some() { nodes } else { 0 }];
+        let n_free = free.len();
+        Ok(Self {
+            kappa: diffusivity,
+            dt,
+            values_full: vec![0.0; pattern.nnz()],
+            values_reduced: vec![0.0; reduced.nnz()],
+            pattern,
+            mass,
+            stiffness,
+            reduced,
+            from,
+            free,
+            fixed,
+            values,
+            chi: vec![false; exchange.len()],
+            exchange,
+            exchange_edges,
+            source,
+            heated,
+            points,
+            factors: Vec::new(),
+            theta_obs: [0.0; 4],
+            implicit: false,
+            smoothing: Smoothing::default(),
+            start_jump,
+            new: old.clone(),
+            old,
+            source_load,
+            heat: vec![0.0; nodes],
+            weighted: vec![0.0; nodes],
+            product: vec![0.0; nodes],
+            a_weighted: vec![0.0; nodes],
+            rhs: vec![0.0; nodes],
+            unknown: vec![0.0; n_free],
+            terms: HeatTerms::default(),
+        })
+    }
+
+    /// `θ^{n+1/2}` at `node` (`θ^0` before the start-up).
+    pub fn temperature(&self, node: usize) -> f64 {
+        self.new[node]
+    }
+
+    /// `½ |θ^{n+1/2}|²_M`.
+    pub fn energy(&self) -> f64 {
+        0.5 * self.pattern.quad(&self.mass, &self.new)
+    }
+
+    /// The heat balance a run reports: the heat content, frictional heating where some node is
+    /// frictional, heat to the obstacles where some such node's edge has `η < 1`.
+    pub fn outputs(&self) -> HeatOutputs {
+        HeatOutputs {
+            heat_content: true,
+            frictional_heating: !self.heated.is_empty(),
+            obstacle_heating: self.heated.iter().any(|&(_, eta)| eta < 1.0),
+        }
+    }
+
+    /// The thermal terms of the last heat step.
+    pub fn terms(&self) -> HeatTerms {
+        self.terms
+    }
+
+    /// The start-up's record: `½|θ^{1/2}|²_M` and its heat inputs (its half step takes no
+    /// part in an identity).
+    pub fn start_up_terms(&self) -> HeatTerms {
+        let t = self.terms;
+        HeatTerms {
+            energy: t.energy,
+            frictional_heating: t.frictional_heating,
+            obstacle_heating: t.obstacle_heating,
+            heat_content: t.heat_content,
+            ..Default::default()
+        }
+    }
+
+    /// The step from `t_n` (`n = 0` the start-up): the exchange state read off the step's
+    /// bounds `lower`, `θ_obs(t_n)`, and whether the heat step is implicit Euler.
+    pub fn prepare(&mut self, n: usize, lower: &[f64]) -> Result<(), RunError> {
+        let t = n as f64 * self.dt;
+        for (k, e) in self.exchange_edges.iter().enumerate() {
+            if let Some((_, obstacle)) = e {
+                let key = format!("heat.{}.obstacle", EDGE_NAMES[k]);
+                self.theta_obs[k] = finite(obstacle.eval(0.0, t)?, &key)?;
+            }
+        }
+        // An exchange switching on or off (on at t = 0: in contact from the start) is a jump
+        // of its flux; at t = 0 so is an edge temperature that disagrees with θ^0.
+        let mut jump = n == 0 && self.start_jump;
+        for (chi, x) in self.chi.iter_mut().zip(&self.exchange) {
+            let contact = in_contact(-lower[x.constraint]);
+            jump |= contact != *chi || (n == 0 && contact);
+            *chi = contact;
+        }
+        if n > 0 {
+            let (t_old, t_new) = self.half_steps(n);
+            for f in &self.fixed {
+                let value = self.values[f.edge]
+                    .as_ref()
+                    .expect("a held edge has a value");
+                if !value.depends_on_t() {
+                    continue;
+                }
+                let key = format!("heat.{}.value", EDGE_NAMES[f.edge]);
+                let at = |t: f64| finite(value.eval(f.s, t)?, &key);
+                let (a, b) = (at(t_old)?, at(t_new)?);
+                jump |= jumps_within(at, (t_old, t_new), (a, b))?;
+                if jump {
+                    break;
+                }
+            }
+        }
+        self.implicit = self.smoothing.schedule(n, jump) && n > 0;
+        Ok(())
+    }
+
+    /// `t_{n−1/2}` and `t_{n+1/2}` of step `n` (`0` and `Δt/2` for the start-up).
+    fn half_steps(&self, n: usize) -> (f64, f64) {
+        let dt = self.dt;
+        if n == 0 {
+            (0.0, 0.5 * dt)
+        } else {
+            ((2 * n - 1) as f64 * 0.5 * dt, (2 * n + 1) as f64 * 0.5 * dt)
+        }
+    }
+
+    /// `y ← A_χ x = κ K x + h X χ x` on every node.
+    fn apply_a(&self, x: &[f64], y: &mut [f64]) {
+        self.pattern.mul_into(&self.stiffness, x, y);
+        for yi in y.iter_mut() {
+            *yi *= self.kappa;
+        }
+        for (x_e, &chi) in self.exchange.iter().zip(&self.chi) {
+            if chi {
+                let h = self.coefficient(x_e.edge);
+                y[x_e.node] += h * x_e.weight * x[x_e.node];
+            }
+        }
+    }
+
+    /// The factor of `(M + c A_χ)` on the unknown temperatures, `c = Δt` when `implicit`, else
+    /// `Δt/2` (Crank–Nicolson, and the start-up's half step); made when the state is first met.
+    fn factor_index(&mut self, implicit: bool) -> Result<usize, RunError> {
+        if let Some(i) =
+            (self.factors.iter()).position(|f| f.implicit == implicit && f.chi == self.chi)
+        {
+            return Ok(i);
+        }
+        let c = if implicit { self.dt } else { 0.5 * self.dt };
+        for ((v, m), k) in self
+            .values_full
+            .iter_mut()
+            .zip(&self.mass)
+            .zip(&self.stiffness)
+        {
+            *v = m + c * self.kappa * k;
+        }
+        for (x_e, &chi) in self.exchange.iter().zip(&self.chi) {
+            if chi {
+                let h = self.exchange_edges[x_e.edge].as_ref().map_or(0.0, |e| e.0);
+                let p = self.pattern.position(x_e.node, x_e.node);
+                self.values_full[p] += c * h * x_e.weight;
+            }
+        }
+        for (v, &p) in self.values_reduced.iter_mut().zip(&self.from) {
+            *v = self.values_full[p];
+        }
+        let factor = SparseCholesky::new(&self.reduced, &self.values_reduced, "the heat step")?;
+        self.factors.push(StepFactor {
+            chi: self.chi.clone(),
+            implicit,
+            factor,
+        });
+        Ok(self.factors.len() - 1)
+    }
+
+    /// The heat step `θ^{n−1/2} → θ^{n+1/2}` after the mechanical step from `t_n`
+    /// (`n = 0`: `θ^0 → θ^{1/2}`, an implicit Euler half step), with frictional node `j`'s
+    /// share `friction_work[j]` of `D_f`; records the step's thermal terms.
+    pub fn step(&mut self, n: usize, friction_work: &[f64]) -> Result<(), RunError> {
+        std::mem::swap(&mut self.old, &mut self.new);
+        let (tau, w) = if n == 0 {
+            (0.5 * self.dt, 1.0)
+        } else if self.implicit {
+            (self.dt, 1.0)
+        } else {
+            (self.dt, 0.5)
+        };
+        let t_n = n as f64 * self.dt;
+        let (_, t_new) = self.half_steps(n);
+        // θ^{n+1/2} at the held nodes; the others start from θ^{n−1/2}.
+        self.new.copy_from_slice(&self.old);
+        for f in &self.fixed {
+            let key = format!("heat.{}.value", EDGE_NAMES[f.edge]);
+            let value = self.values[f.edge]
+                .as_ref()
+                .expect("a held edge has a value");
+            self.new[f.node] = finite(value.eval(f.s, t_new)?, &key)?;
+        }
+        // The source Q = M q(·, t_n) and the frictional heat q_j = η_j d_j.
+        if let Some(source) = &self.source {
+            for (node, &(x, y)) in self.points.iter().enumerate() {
+                self.weighted[node] = finite(source.eval_xy(x, y, t_n)?, "heat.source")?;
+            }
+            self.pattern
+                .mul_into(&self.mass, &self.weighted, &mut self.source_load);
+        }
+        self.heat.fill(0.0);
+        let (mut heating, mut obstacle) = (0.0, 0.0);
+        for (&(node, eta), &d) in self.heated.iter().zip(friction_work) {
+            self.heat[node] += eta * d;
+            heating += eta * d;
+            obstacle += (1.0 - eta) * d;
+        }
+        // rhs = τ (Q + h X χ θ_obs − A θ^{n−1/2}) + q − (M + wτ A) ζ_held.
+        let mut product = std::mem::take(&mut self.product);
+        self.apply_a(&self.old, &mut product);
+        self.product = product;
+        for (node, r) in self.rhs.iter_mut().enumerate() {
+            let q = self.source_load.get(node).copied().unwrap_or(0.0);
+            *r = tau * (q - self.product[node]) + self.heat[node];
+        }
+        for (x_e, &chi) in self.exchange.iter().zip(&self.chi) {
+            if chi {
+                let h = self.coefficient(x_e.edge);
+                self.rhs[x_e.node] += tau * h * x_e.weight * self.theta_obs[x_e.edge];
+            }
+        }
+        // ζ on every node (held nodes' increments; 0 at the unknowns for now), in `weighted`.
+        for (z, (a, b)) in self.weighted.iter_mut().zip(self.old.iter().zip(&self.new)) {
+            *z = b - a;
+        }
+        for &node in &self.free {
+            self.weighted[node] = 0.0;
+        }
+        if !self.fixed.is_empty() {
+            self.pattern
+                .mul_into(&self.mass, &self.weighted, &mut self.product);
+            for (r, p) in self.rhs.iter_mut().zip(&self.product) {
+                *r -= p;
+            }
+            let zeta = std::mem::take(&mut self.weighted);
+            let mut product = std::mem::take(&mut self.product);
+            self.apply_a(&zeta, &mut product);
+            for (r, p) in self.rhs.iter_mut().zip(&product) {
+                *r -= w * tau * p;
+            }
+            (self.weighted, self.product) = (zeta, product);
+        }
+        let index = self.factor_index(n > 0 && self.implicit)?;
+        for (u, &node) in self.unknown.iter_mut().zip(&self.free) {
+            *u = self.rhs[node];
+        }
+        self.factors[index].factor.solve_in_place(&mut self.unknown);
+        for (u, &node) in self.unknown.iter().zip(&self.free) {
+            self.new[node] = self.old[node] + u;
+        }
+        if self.new.iter().any(|v| !v.is_finite()) {
+            return Err(RunError::Step {
+                step: n + 1,
+                time: (n + 1) as f64 * self.dt,
+                solver: "heat".into(),
+                failure: crate::step::StepFailure::NonFinite,
+            });
+        }
+        self.measure(tau, w, (heating, obstacle));
+        Ok(())
+    }
+
+    /// The thermal terms of the step just taken (docs/thermal.md, "The plane body").
+    fn measure(&mut self, tau: f64, w: f64, (heating, obstacle): (f64, f64)) {
+        // ζ in `product`, θ_w in `weighted`.
+        for (node, z) in self.product.iter_mut().enumerate() {
+            *z = self.new[node] - self.old[node];
+            self.weighted[node] = self.old[node] + w * *z;
+        }
+        let smoothing = (w - 0.5) * self.pattern.quad(&self.mass, &self.product);
+        // The held rows' residuals ρ = M ζ + τ (A θ_w − h X χ θ_obs − Q) − q: M ζ in `rhs`,
+        // A θ_w in `a_weighted`.
+        self.pattern
+            .mul_into(&self.mass, &self.product, &mut self.rhs);
+        let mut a_weighted = std::mem::take(&mut self.a_weighted);
+        self.apply_a(&self.weighted, &mut a_weighted);
+        let mut exchange = 0.0;
+        for (x_e, &chi) in self.exchange.iter().zip(&self.chi) {
+            if chi {
+                let theta = self.weighted[x_e.node];
+                let h = self.coefficient(x_e.edge);
+                exchange += tau * h * x_e.weight * (theta - self.theta_obs[x_e.edge]) * theta;
+            }
+        }
+        let dissipation = tau * self.kappa * self.pattern.quad(&self.stiffness, &self.weighted);
+        let mut supply = 0.0;
+        for (q, t) in self.source_load.iter().zip(&self.weighted) {
+            supply += tau * q * t;
+        }
+        for f in &self.fixed {
+            let node = f.node;
+            let mut rho = self.rhs[node] + tau * a_weighted[node];
+            for (x_e, &chi) in self.exchange.iter().zip(&self.chi) {
+                if chi && x_e.node == node {
+                    let h = self.coefficient(x_e.edge);
+                    rho -= tau * h * x_e.weight * self.theta_obs[x_e.edge];
+                }
+            }
+            rho -= tau * self.source_load.get(node).copied().unwrap_or(0.0) + self.heat[node];
+            supply += self.weighted[node] * rho;
+        }
+        let mut frictional_supply = 0.0;
+        for (q, t) in self.heat.iter().zip(&self.weighted) {
+            frictional_supply += q * t;
+        }
+        // 1ᵀ M θ^{n+1/2}.
+        self.pattern
+            .mul_into(&self.mass, &self.new, &mut a_weighted);
+        let heat_content = a_weighted.iter().sum();
+        self.a_weighted = a_weighted;
+        self.terms = HeatTerms {
+            energy: self.energy(),
+            dissipation,
+            exchange,
+            supply,
+            smoothing,
+            frictional_supply,
+            frictional_heating: heating,
+            obstacle_heating: obstacle,
+            heat_content,
+        };
+    }
+
+    /// `h` of exchange edge `edge`.
+    fn coefficient(&self, edge: usize) -> f64 {
+        self.exchange_edges[edge].as_ref().map_or(0.0, |e| e.0)
+    }
+}

@@ -1,0 +1,260 @@
+//! The `[heat]` table of a plane scene: the temperature deviation `θ` of the plane body,
+//! `θ_t − κ Δθ = q` (the coupling `γ` to the displacement must be 0 on the plane), its initial
+//! value (an expression in `x`, `y`), source (in `x`, `y`, `t`), and per edge (`left`, `right`,
+//! `bottom`, `top`) the bar's thermal conditions: insulated (the default), a fixed temperature
+//! `value` (in the edge's coordinate `s` and `t`) or, on a Signorini edge, an exchange with
+//! the obstacle while in contact; on a frictional edge, `frictional_heating = η` (0 ≤ η ≤ 1,
+//! default 1) is the share of the friction dissipation that enters the body as heat. Errors
+//! name the key. Scheme: docs/thermal.md, "The plane body".
+
+use crate::scene::SceneError;
+use crate::scene::error::invalid;
+use crate::scene::expr::{Expression, number_or_expression};
+use crate::scene::heat::ThermalCondition;
+use crate::scene::plane::{EDGE_NAMES, EdgeCondition, Edges};
+use serde::{Deserialize, Serialize};
+
+/// `[heat]` of a plane scene.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneHeat {
+    /// `γ`: the thermal stress `−γ θ I` and the heating `γ div u_t`; 0 on the plane body.
+    pub coupling: f64,
+    /// `κ > 0`.
+    pub diffusivity: f64,
+    /// `θ(x, y, 0)` (default 0).
+    #[serde(default = "zero", deserialize_with = "number_or_expression")]
+    pub temperature: String,
+    /// `q(x, y, t)` (default: no source).
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "optional_expression"
+    )]
+    pub source: Option<String>,
+    #[serde(default)]
+    pub left: ThermalEdge,
+    #[serde(default)]
+    pub right: ThermalEdge,
+    #[serde(default)]
+    pub bottom: ThermalEdge,
+    #[serde(default)]
+    pub top: ThermalEdge,
+}
+
+fn zero() -> String {
+    "0".to_string()
+}
+
+fn optional_expression<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
+    number_or_expression(d).map(Some)
+}
+
+/// `heat.<edge>`: its thermal condition and, on a frictional edge, `frictional_heating`.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThermalEdge {
+    #[serde(default)]
+    pub condition: ThermalCondition,
+    /// `θ_edge(s, t)` of a `temperature` edge.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "optional_expression"
+    )]
+    pub value: Option<String>,
+    /// `h >= 0` of an `exchange` edge.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coefficient: Option<f64>,
+    /// `θ_obs(t)` of an `exchange` edge (default 0).
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "optional_expression"
+    )]
+    pub obstacle: Option<String>,
+    /// `η`, the share of the edge's friction dissipation put into the body (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frictional_heating: Option<f64>,
+}
+
+/// The parsed condition of one edge.
+#[derive(Clone, Debug)]
+pub enum EdgeHeat {
+    Insulated,
+    /// `θ = value(s, t)`.
+    Temperature(Expression),
+    /// `h` and `θ_obs(t)`.
+    Exchange {
+        coefficient: f64,
+        obstacle: Expression,
+    },
+}
+
+/// The parsed `[heat]` of a plane scene.
+#[derive(Clone, Debug)]
+pub struct PlaneHeatExpressions {
+    pub diffusivity: f64,
+    /// `θ(x, y, 0)`.
+    pub temperature: Expression,
+    pub source: Option<Expression>,
+    /// `left, right, bottom, top`.
+    pub edges: [EdgeHeat; 4],
+    /// `η` of each edge (1 where not given; read on frictional edges only).
+    pub frictional_heating: [f64; 4],
+}
+
+impl PlaneHeat {
+    /// The edges' tables in the order `left, right, bottom, top`.
+    pub fn edges(&self) -> [&ThermalEdge; 4] {
+        [&self.left, &self.right, &self.bottom, &self.top]
+    }
+
+    /// Checks every key against its range and against the mechanical edges; the error names
+    /// the key.
+    pub fn validate(&self, edges: &Edges) -> Result<PlaneHeatExpressions, SceneError> {
+        if !(self.coupling.is_finite() && self.coupling >= 0.0) {
+            return Err(invalid(
+                "heat.coupling",
+                self.coupling,
+                "must be a finite number >= 0",
+            ));
+        }
+        if self.coupling != 0.0 {
+            return Err(invalid(
+                "heat.coupling",
+                self.coupling,
+                "must be 0 on the plane body: its temperature is not coupled to the displacement",
+            ));
+        }
+        if !(self.diffusivity.is_finite() && self.diffusivity > 0.0) {
+            return Err(invalid(
+                "heat.diffusivity",
+                self.diffusivity,
+                "must be a finite number > 0",
+            ));
+        }
+        let temperature = Expression::parse_plane("heat.temperature", &self.temperature, false)?;
+        let source = match &self.source {
+            Some(text) => Some(Expression::parse_plane("heat.source", text, true)?),
+            None => None,
+        };
+        let frictions = edges.frictions()?;
+        let mut parsed: [EdgeHeat; 4] = Default::default();
+        let mut eta = [1.0; 4];
+        for (k, spec) in self.edges().into_iter().enumerate() {
+            let mechanical = edges.all()[k];
+            parsed[k] = spec.validate(k, mechanical.condition)?;
+            if let Some(value) = spec.frictional_heating {
+                let key = format!("heat.{}.frictional_heating", EDGE_NAMES[k]);
+                if frictions[k].is_none() {
+                    return Err(SceneError::Invalid {
+                        field: key,
+                        value: value.to_string(),
+                        allowed: format!(
+                            "frictional heating belongs to an edge with friction \
+                             (`edges.{}.friction` is absent or 0)",
+                            EDGE_NAMES[k]
+                        ),
+                    });
+                }
+                if !(0.0..=1.0).contains(&value) {
+                    return Err(invalid(&key, value, "must be a number in [0, 1]"));
+                }
+                eta[k] = value;
+            }
+        }
+        Ok(PlaneHeatExpressions {
+            diffusivity: self.diffusivity,
+            temperature,
+            source,
+            edges: parsed,
+            frictional_heating: eta,
+        })
+    }
+}
+
+impl Default for EdgeHeat {
+    fn default() -> Self {
+        EdgeHeat::Insulated
+    }
+}
+
+impl ThermalEdge {
+    fn validate(&self, edge: usize, mechanical: EdgeCondition) -> Result<EdgeHeat, SceneError> {
+        let key = |k: &str| format!("heat.{}.{k}", EDGE_NAMES[edge]);
+        let only = |k: &str, condition: &str| SceneError::Invalid {
+            field: key(k),
+            value: "(set)".into(),
+            allowed: format!(
+                "only a `{condition}` edge has `{k}` (this edge is `{}`)",
+                self.condition.name()
+            ),
+        };
+        if self.value.is_some() && self.condition != ThermalCondition::Temperature {
+            return Err(only("value", "temperature"));
+        }
+        if self.condition != ThermalCondition::Exchange {
+            if self.coefficient.is_some() {
+                return Err(only("coefficient", "exchange"));
+            }
+            if self.obstacle.is_some() {
+                return Err(only("obstacle", "exchange"));
+            }
+        }
+        match self.condition {
+            ThermalCondition::Insulated => Ok(EdgeHeat::Insulated),
+            ThermalCondition::Temperature => {
+                let text = self.value.as_ref().ok_or_else(|| SceneError::Invalid {
+                    field: key("value"),
+                    value: "missing".into(),
+                    allowed: "a `temperature` edge needs its temperature, an expression in s and t"
+                        .into(),
+                })?;
+                Ok(EdgeHeat::Temperature(Expression::parse_edge(
+                    &key("value"),
+                    text,
+                )?))
+            }
+            ThermalCondition::Exchange => {
+                if mechanical != EdgeCondition::Signorini {
+                    return Err(SceneError::Invalid {
+                        field: key("condition"),
+                        value: "\"exchange\"".into(),
+                        allowed: format!(
+                            "an exchange with the obstacle needs a signorini edge \
+                             (`edges.{}.condition` is \"{}\")",
+                            EDGE_NAMES[edge],
+                            format!("{mechanical:?}").to_lowercase()
+                        ),
+                    });
+                }
+                let h = self.coefficient.ok_or_else(|| SceneError::Invalid {
+                    field: key("coefficient"),
+                    value: "missing".into(),
+                    allowed: "an `exchange` edge needs its coefficient h >= 0".into(),
+                })?;
+                if !(h.is_finite() && h >= 0.0) {
+                    return Err(invalid(
+                        &key("coefficient"),
+                        h,
+                        "must be a finite number >= 0",
+                    ));
+                }
+                let text = self.obstacle.as_deref().unwrap_or("0");
+                let obstacle = Expression::parse_edge(&key("obstacle"), text)?;
+                if obstacle.depends_on_x() {
+                    return Err(SceneError::Invalid {
+                        field: key("obstacle"),
+                        value: format!("\"{text}\""),
+                        allowed: "the obstacle's temperature is an expression in t alone".into(),
+                    });
+                }
+                Ok(EdgeHeat::Exchange {
+                    coefficient: h,
+                    obstacle,
+                })
+            }
+        }
+    }
+}
