@@ -38,6 +38,9 @@ const TWIN_TOL: f64 = 1e-10;
 /// `friction = 0` against no friction key: Lemke's answer against block pivoting's on the same
 /// step problems, each exact to round-off (the tangential rows carry zero reactions).
 const FRICTIONLESS_TOL: f64 = 1e-10;
+/// A closed body's heat content against its frictional heating, per step, relative to the
+/// largest content: sums of a few hundred products and a backward-stable solve.
+const HEAT_BALANCE_TOL: f64 = 1e-12;
 
 /// The plane's condensed exact solver takes `z` from a second solve with the reactions, without
 /// writing an active node onto its bound: its gap is that solve's forward error, measured up to
@@ -378,6 +381,28 @@ fn plane_relations(d: &PlaneDraw, records: &[StepRecord], u: &[f64]) -> Result<(
             .map(|(i, x)| if i % 2 == 0 { x - shift } else { *x })
             .collect();
         prop_assert!(close(&shifted, &uf, TWIN_TOL), "belt twins\n{}", text);
+    }
+    // An uncoupled temperature leaves the mechanics' bits; an insulated body without a source
+    // gains heat only by friction, to round-off at every step.
+    if let Some(plain) = d.without_heat_if_uncoupled()
+        && let Some((_, up)) = twin(&plain.toml(), &text)?
+    {
+        prop_assert_eq!(u, &up[..], "[heat] moved the mechanics\n{}", text);
+    }
+    if d.heat_is_closed() {
+        let content = |r: &StepRecord| r.heat.map_or(0.0, |h| h.heat_content);
+        let largest = max_abs(records.iter().map(content));
+        let mut before = d.initial_heat_content();
+        for r in records {
+            let h = r.heat.unwrap();
+            let gap = (h.heat_content - before - h.frictional_heating).abs();
+            prop_assert!(
+                gap <= HEAT_BALANCE_TOL * largest.max(f64::MIN_POSITIVE),
+                "heat balance, step {}: {gap:e}\n{text}",
+                r.step
+            );
+            before = h.heat_content;
+        }
     }
     let Some(plain) = d.without_zero_friction() else {
         return Ok(());

@@ -10,7 +10,7 @@
 //! tangential reaction `r_T t`), `friction_state` ([`crate::scheme::NodeState`]: 0 open or
 //! frictionless, 1 stick, 2 slip), `gap` (the least gap of the node's constraints, 0 at a node
 //! without one), `contact_constraints` (their number: 0, 1, or 2 at a corner) and, with
-//! `[heat]`, `theta` (`θ^{n+1/2}`). At `t = 0` no step has acted: every reaction and state is 0.
+//! `[heat]`, `theta` (`θ^{n−1/2}`, as the profile file). At `t = 0` no step has acted: every reaction and state is 0.
 
 use crate::output::profiles::Profiles;
 #[cfg(feature = "vtk")]

@@ -278,7 +278,8 @@ impl PlaneHeat {
         })
     }
 
-    /// `θ^{n+1/2}` at `node` (`θ^0` before the start-up).
+    /// The latest temperature at `node`: `θ^{n−1/2}` while the scheme holds `u^n` (`θ^0`
+    /// before the start-up).
     pub fn temperature(&self, node: usize) -> f64 {
         self.new[node]
     }

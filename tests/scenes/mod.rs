@@ -400,6 +400,70 @@ fn edge() -> impl Strategy<Value = Edge> {
     ]
 }
 
+/// A plane edge's thermal condition.
+#[derive(Clone, Copy, Debug)]
+pub enum PlaneHeatEdge {
+    Insulated,
+    /// `value`, without `s` (a mirror keeps it).
+    Temperature(&'static str),
+    /// `coefficient`, `obstacle`.
+    Exchange(f64, &'static str),
+}
+
+/// A plane scene's `[heat]`: data a mirror `x → W − x` keeps.
+#[derive(Clone, Debug)]
+pub struct PlaneHeatDraw {
+    /// 0, or a coupling (refused on the plane).
+    pub coupling: f64,
+    pub diffusivity: f64,
+    pub temperature: &'static str,
+    pub source: Option<&'static str>,
+    /// `[left, right, bottom, top]`, each with its `frictional_heating` (refused on an edge
+    /// without friction, and outside [0, 1]).
+    pub edges: [(PlaneHeatEdge, Option<f64>); 4],
+}
+
+fn plane_heat_edge() -> impl Strategy<Value = (PlaneHeatEdge, Option<f64>)> {
+    (
+        prop_oneof![
+            3 => Just(PlaneHeatEdge::Insulated),
+            1 => Just(PlaneHeatEdge::Temperature("0")),
+            1 => Just(PlaneHeatEdge::Temperature("min(1, 20*t)")),
+            1 => Just(PlaneHeatEdge::Exchange(2.0, "1")),
+        ],
+        prop_oneof![
+            6 => Just(None),
+            1 => Just(Some(0.0)),
+            2 => Just(Some(0.5)),
+            1 => Just(Some(1.5)),
+        ],
+    )
+}
+
+fn plane_heat() -> impl Strategy<Value = PlaneHeatDraw> {
+    (
+        prop_oneof![6 => Just(0.0), 1 => Just(0.3)],
+        prop_oneof![Just(0.1), Just(1.0), Just(50.0)],
+        prop_oneof![Just("0"), Just("1"), Just("y")],
+        prop_oneof![Just(None), Just(Some("t*y"))],
+        [
+            plane_heat_edge(),
+            plane_heat_edge(),
+            plane_heat_edge(),
+            plane_heat_edge(),
+        ],
+    )
+        .prop_map(
+            |(coupling, diffusivity, temperature, source, edges)| PlaneHeatDraw {
+                coupling,
+                diffusivity,
+                temperature,
+                source,
+                edges,
+            },
+        )
+}
+
 /// A plane scene.
 #[derive(Clone, Debug)]
 pub struct PlaneDraw {
@@ -418,6 +482,8 @@ pub struct PlaneDraw {
     pub dt: f64,
     pub steps: u64,
     pub solver: &'static str,
+    /// `[heat]`, if any.
+    pub heat: Option<PlaneHeatDraw>,
     /// Seen from the other side: `x → W − x` (the bottom and top gaps' `s` read as `W − s`, the
     /// `x` components of the velocity and the load negated; the caller swaps left and right).
     pub mirrored: bool,
@@ -448,11 +514,12 @@ pub fn plane_draw() -> impl Strategy<Value = PlaneDraw> {
         prop_oneof![Just(0.005), Just(0.02), Just(0.1)],
         5u64..20,
         prop_oneof![3 => Just("exact"), 1 => Just("osqp"), 1 => Just("penalty")],
+        prop_oneof![3 => Just(None), 1 => plane_heat().prop_map(Some)],
     );
     (body, rest).prop_map(
         |(
             ((width, height), (lambda, mu), viscosity, integration, edges),
-            (velocity, load, nx, ny, dt, steps, solver),
+            (velocity, load, nx, ny, dt, steps, solver, heat),
         )| PlaneDraw {
             width,
             height,
@@ -468,6 +535,7 @@ pub fn plane_draw() -> impl Strategy<Value = PlaneDraw> {
             dt,
             steps,
             solver,
+            heat,
             mirrored: false,
         },
     )
@@ -549,7 +617,64 @@ impl PlaneDraw {
             self.dt * self.steps as f64,
             self.solver
         );
+        if let Some(h) = &self.heat {
+            t += &format!(
+                "\n[heat]\ncoupling = {:?}\ndiffusivity = {:?}\ntemperature = \"{}\"\n",
+                h.coupling, h.diffusivity, h.temperature
+            );
+            if let Some(q) = h.source {
+                t += &format!("source = \"{q}\"\n");
+            }
+            for (name, (e, eta)) in ["left", "right", "bottom", "top"].iter().zip(h.edges) {
+                let eta = eta.map_or(String::new(), |v| format!(", frictional_heating = {v:?}"));
+                t += &match e {
+                    PlaneHeatEdge::Insulated if eta.is_empty() => continue,
+                    PlaneHeatEdge::Insulated => {
+                        format!("{name} = {{ condition = \"insulated\"{eta} }}\n")
+                    }
+                    PlaneHeatEdge::Temperature(v) => {
+                        format!(
+                            "{name} = {{ condition = \"temperature\", value = \"{v}\"{eta} }}\n"
+                        )
+                    }
+                    PlaneHeatEdge::Exchange(h, obstacle) => format!(
+                        "{name} = {{ condition = \"exchange\", coefficient = {h:?}, \
+                         obstacle = \"{obstacle}\"{eta} }}\n"
+                    ),
+                };
+            }
+        }
         t
+    }
+
+    /// With `[heat]` uncoupled, the scene without it (its mechanics are the same, bit for bit).
+    pub fn without_heat_if_uncoupled(&self) -> Option<Self> {
+        let h = self.heat.as_ref()?;
+        (h.coupling == 0.0).then(|| Self {
+            heat: None,
+            ..self.clone()
+        })
+    }
+
+    /// `∫ θ^0` (exact in Q1: the initial temperatures drawn are at most linear).
+    pub fn initial_heat_content(&self) -> f64 {
+        let (w, h) = (self.width, self.height);
+        match self.heat.as_ref().map(|d| d.temperature) {
+            Some("1") => w * h,
+            Some("y") => w * h * h / 2.0,
+            _ => 0.0,
+        }
+    }
+
+    /// Whether the scene's heat content changes only by frictional heating: `[heat]` with
+    /// every edge insulated and no source.
+    pub fn heat_is_closed(&self) -> bool {
+        self.heat.as_ref().is_some_and(|h| {
+            h.source.is_none()
+                && h.edges
+                    .iter()
+                    .all(|(e, _)| matches!(e, PlaneHeatEdge::Insulated))
+        })
     }
 
     /// The same scene seen from the other side: `x → W − x`, left and right swapped.
@@ -557,6 +682,9 @@ impl PlaneDraw {
         let mut m = self.clone();
         m.mirrored = !self.mirrored;
         m.edges.swap(0, 1);
+        if let Some(h) = &mut m.heat {
+            h.edges.swap(0, 1);
+        }
         m
     }
 
