@@ -280,3 +280,122 @@ fn bad_heat_keys_are_refused_naming_the_key() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The slowest decay rate of an exchange edge, relative to the analytic one: the Q1 and
+/// Crank–Nicolson errors of the slowest mode at 32 cells over the height and `Δt = 0.005`.
+const DECAY_RATE_TOL: f64 = 2e-3;
+
+/// A block resting on a floor that takes its heat, `−κ ∂θ/∂n = h θ` while in contact
+/// (insulated elsewhere, `θ^0 = 1`): uniform in `x`, its temperature is the bar's exchange
+/// problem in `y`, whose slowest mode decays at `κμ²`, `μ tan μH = h/κ`; the exchange term of
+/// the identity is the heat the floor takes.
+#[test]
+fn an_exchanging_floor_takes_the_heat_at_the_slowest_rate() {
+    let (kappa, h, height) = (1.0, 2.0, 0.5);
+    let text = format!(
+        r#"
+[plane]
+width = 0.25
+height = {height}
+lambda = 100.0
+mu = 100.0
+viscosity = 0.5
+
+[edges]
+bottom = {{ condition = "signorini", gap = 0 }}
+
+[load]
+density = ["0", "-1"]
+
+[mesh]
+nx = 2
+ny = 32
+
+[time]
+step = 0.005
+end = 1.0
+
+[heat]
+coupling = 0
+diffusivity = {kappa}
+temperature = "1"
+bottom = {{ condition = "exchange", coefficient = {h}, obstacle = "0" }}
+"#
+    );
+    let scene = PlaneScene::from_toml(&text, &[]).unwrap();
+    let (records, _) = run(&scene);
+    // μ tan μH = h/κ on (0, π/(2H)), by bisection.
+    let f = |m: f64| m * (m * height).tan() - h / kappa;
+    let (mut a, mut b) = (1e-9, std::f64::consts::PI / (2.0 * height) - 1e-9);
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if f(m) < 0.0 { a = m } else { b = m }
+    }
+    let mu = 0.5 * (a + b);
+    assert!(f(mu).abs() < 1e-9, "the root");
+    let rate = kappa * mu * mu;
+    let content = |t: f64| {
+        let r = records.iter().find(|r| (r.time - t).abs() < 1e-9).unwrap();
+        r.heat.unwrap().heat_content
+    };
+    let observed = (content(0.6) / content(1.0)).ln() / 0.4;
+    assert!(
+        (observed - rate).abs() <= DECAY_RATE_TOL * rate,
+        "decay rate {observed} against κμ² = {rate}"
+    );
+    assert!(
+        records
+            .iter()
+            .skip(1)
+            .all(|r| r.heat.unwrap().exchange > 0.0)
+    );
+}
+
+/// An edge held at 1 from `t = 0` on a body at 0, square cells, `κΔt/h²` = 0.5, 5 and 100 (the
+/// bar's range): the implicit start keeps θ within the data's range [0, 1] at every node and
+/// step. (The step resolves the body's slowest mode, `κΔt/W² <= 0.04`: Crank–Nicolson
+/// alternates the sign of every mode with `κλΔt > 2`, so a step longer than the whole body's
+/// diffusion time rings whatever the start.)
+#[test]
+fn a_sudden_edge_temperature_keeps_theta_within_the_datas_range() {
+    for kappa in [0.005, 0.05, 1.0] {
+        let text = format!(
+            r#"
+[plane]
+width = 1.0
+height = 0.1
+lambda = 1.0
+mu = 1.0
+
+[mesh]
+nx = 50
+ny = 5
+
+[time]
+step = 0.04
+end = 1.0
+
+[heat]
+coupling = 0
+diffusivity = {kappa}
+left = {{ condition = "temperature", value = "1" }}
+"#
+        );
+        let scene = PlaneScene::from_toml(&text, &[]).unwrap();
+        let mut sim = PlaneSimulation::new(&scene).unwrap();
+        for _ in 1..scene.steps() {
+            sim.step().unwrap();
+            let body: &PlaneBody = sim.body();
+            for node in 0..body.nodes() {
+                let theta = body.temperature(sim.displacement(), node).unwrap();
+                assert!(
+                    (-MAX_PRINCIPLE_TOL..=1.0 + MAX_PRINCIPLE_TOL).contains(&theta),
+                    "κ = {kappa}, node {node}: θ = {theta}"
+                );
+            }
+        }
+    }
+}
+
+/// The excursion allowed outside the data's range: round-off of the steps' sums.
+const MAX_PRINCIPLE_TOL: f64 = 1e-12;

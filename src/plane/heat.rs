@@ -49,6 +49,8 @@ struct StepFactor {
 pub struct PlaneHeat {
     kappa: f64,
     dt: f64,
+    /// The least cell side.
+    least_side: f64,
     /// Scalar Q1 mass and stiffness on every node (one pattern).
     pattern: Pattern,
     mass: Vec<f64>,
@@ -241,9 +243,13 @@ impl PlaneHeat {
             .collect();
         let source_load = vec![0.0; if source.is_some() { nodes } else { 0 }];
         let n_free = free.len();
+        let sides = (grid.xs.windows(2))
+            .chain(grid.ys.windows(2))
+            .map(|p| p[1] - p[0]);
         Ok(Self {
             kappa: diffusivity,
             dt,
+            least_side: sides.fold(f64::INFINITY, f64::min),
             values_full: vec![0.0; pattern.nnz()],
             values_reduced: vec![0.0; reduced.nnz()],
             pattern,
@@ -276,6 +282,12 @@ impl PlaneHeat {
             unknown: vec![0.0; n_free],
             terms: HeatTerms::default(),
         })
+    }
+
+    /// `κΔt/h²`, `h` the least cell side: the heat step's conditioning, part of the identity's
+    /// round-off bound.
+    pub fn diffusion_ratio(&self) -> f64 {
+        self.kappa * self.dt / (self.least_side * self.least_side)
     }
 
     /// The latest temperature at `node`: `θ^{n−1/2}` while the scheme holds `u^n` (`θ^0`
