@@ -16,9 +16,9 @@ use viscobar_certificate::tolerances::{
     HEAT_BALANCE_TOL, PLANE_DECAY_RATE_TOL, PLANE_MAX_PRINCIPLE_TOL, STEADY_TEMPERATURE_TOL,
 };
 
-/// The least observed order of the manufactured solution's nodal error (Q1 nodes and
-/// Crank–Nicolson both second order).
-const PLANE_HEAT_ORDER_MIN: f64 = 1.9;
+/// The observed orders of the manufactured solution's nodal error (Q1 nodes and
+/// Crank–Nicolson both second order; VERIFICATION.md gives the measured orders).
+const PLANE_HEAT_ORDER_BAND: (f64, f64) = (1.9, 2.1);
 
 fn run(scene: &PlaneScene) -> (Vec<StepRecord>, viscobar::PlaneSimulation) {
     plane_heat::run(scene).expect("the run certifies")
