@@ -386,3 +386,50 @@ fn the_friction_force_and_state_read_back_to_the_run() {
     );
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// A plane scene with `[heat]` written every step: each file's `theta` is the run's temperature
+/// at every written node, bit for bit, and a scene without `[heat]` has no `theta`.
+#[test]
+fn theta_reads_back_to_the_run() {
+    let out = fresh("theta");
+    let text = format!(
+        "{}\n[heat]\ncoupling = 0\ndiffusivity = 0.3\n",
+        plane_builtin_text("plane-friction-launch").unwrap()
+    );
+    let overrides = [
+        "output.format=\"vtu\"".to_string(),
+        "output.every=1".into(),
+        "time.end=0.2".into(),
+    ];
+    let scene = PlaneScene::from_toml(&text, &overrides).unwrap();
+    run_plane_to_dir("theta", &scene, &out, false).unwrap();
+    let mut sim = PlaneSimulation::new(&scene).unwrap();
+    let nodes = viscobar::internals::output::profiles::written_nodes(sim.body().lattice(), 1);
+    let mut heated = 0;
+    for n in 1..=scene.steps() {
+        if n > 1 {
+            sim.step().unwrap();
+        }
+        let file = read(&out.join(format!("vtu/step-{n:02}.vtu")));
+        let expected: Vec<f64> = (nodes.iter())
+            .map(|&i| sim.body().temperature(sim.displacement(), i).unwrap())
+            .collect();
+        assert_eq!(bits(file.array("theta")), bits(&expected), "step {n}");
+        heated += usize::from(expected.iter().any(|&t| t > 0.0));
+    }
+    assert!(heated > 0, "friction heats the body");
+    let _ = std::fs::remove_dir_all(&out);
+    let plain = fresh("no-theta");
+    run_plane_to_dir("plain", &scene_of_launch(&overrides), &plain, false).unwrap();
+    let file = read(&plain.join("vtu/step-01.vtu"));
+    assert!(file.arrays.iter().all(|(n, _)| n != "theta"));
+    let _ = std::fs::remove_dir_all(&plain);
+}
+
+fn scene_of_launch(overrides: &[String]) -> PlaneScene {
+    PlaneScene::from_toml(
+        plane_builtin_text("plane-friction-launch").unwrap(),
+        overrides,
+    )
+    .unwrap()
+}
