@@ -4,7 +4,8 @@
 //! sampled and bounded as the other outputs, written whole or not at all. With friction: the
 //! obstacle's full force (its normal part the reaction, its tangential part the tangential
 //! reactions, summing to `history.csv`'s totals, inside Coulomb's cone) and the nodes' states
-//! (agreeing with the records' stick and slip counts).
+//! (agreeing with the records' stick and slip counts). With `[heat]`: `theta`, the run's
+//! temperature.
 
 use std::path::{Path, PathBuf};
 use viscobar::internals::plane::stress::von_mises;
