@@ -4,13 +4,7 @@
 //! with `Δt`. Run in release (VERIFICATION.md, "Plane friction").
 
 use viscobar_certificate::friction::period_two::{order, resting, table};
-
-/// The resting block's step-to-step change of the floor's total reaction, relative to it, that
-/// a start-up step without friction leaves: 9e-4 as first reported (1.5e-3 by this measure,
-/// `period_two::PeriodTwo::reaction`, measured on the code before friction entered the start-up
-/// step); the bound is a hundredth of the smaller.
-const FRICTIONLESS_START_ALTERNATION: f64 = 9e-4;
-const RESTING_ALTERNATION_BOUND: f64 = FRICTIONLESS_START_ALTERNATION / 100.0;
+use viscobar_certificate::tolerances::RESTING_ALTERNATION_BOUND;
 
 #[test]
 fn a_block_resting_on_a_frictional_floor_keeps_no_period_two_reaction() {

@@ -17,7 +17,8 @@ use viscobar_certificate::friction::*;
 // The tolerances of this file: in the registry (viscobar_certificate::tolerances), which measures
 // their worst values (`viscobar-certificate verify --tolerances`).
 use viscobar_certificate::tolerances::{
-    RIGID_LIMIT_BOUND, RIGID_SELF_TEST_TOL, STICK_VELOCITY_BOUND, rigid_limit_worst,
+    RIGID_LIMIT_BOUND, RIGID_SELF_TEST_TOL, STICK_VELOCITY_BOUND, STOP_TIME_BOUND,
+    rigid_limit_worst,
 };
 
 #[test]
@@ -34,11 +35,6 @@ fn zero_friction_reproduces_every_frictionless_contact_run_bit_for_bit() {
 /// stiffness: measured 0.95 to 0.97 (VERIFICATION.md, "Plane friction"; elastic transients of
 /// order 1/κ); the band is those ± 0.2.
 const RIGID_RATE_BAND: (f64, f64) = (0.75, 1.17);
-/// The launch's stop time from `κ = 100` up: friction acts from `t = 0`, so the mean velocity
-/// follows the rigid law exactly (the momentum balance) but for `μ` times the vertical mean
-/// velocity, decayed by the stop; measured at most 5.5e-10, the round-off of `C` at `κ = 1e5`
-/// (whose identity residual is of the same size), the bound 20 times that.
-const STOP_TIME_BOUND: f64 = 1e-8;
 
 #[test]
 fn the_rigid_limit_closed_forms_are_approached_as_the_block_stiffens() {
