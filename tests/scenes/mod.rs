@@ -608,8 +608,10 @@ impl PlaneDraw {
             Edge::Signorini { friction, .. } => friction.is_none_or(is_zero_friction),
         };
         let signorini = |e: &Edge| matches!(e, Edge::Signorini { .. });
-        if !(frictionless(&self.edges[0]) && frictionless(&self.edges[1]))
-            || !self.edges[2..].iter().any(signorini)
+        let travels = frictionless(&self.edges[0])
+            && frictionless(&self.edges[1])
+            && self.edges[2..].iter().any(signorini);
+        if !travels
             || self.edges.iter().any(|e| matches!(e, Edge::Clamped))
             || self.solver == "osqp"
         {
