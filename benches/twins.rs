@@ -1,9 +1,10 @@
 //! What each optimised twin of the bar's kernels buys on a step: the steps of `benches/step.rs`
 //! (`unconstrained`, `exact-two-ends`) with one kernel plain (`Simulation::with_kernels`) beside
-//! the default, at J = 1e4, 1e5 and 1e6; and, for a load that does not separate, the load
-//! evaluation compiled (`NodalEvaluator`) and node by node (`Expression::eval`, the plain
-//! version) beside that load's step. `cargo run --release -p viscobar-certificate --
-//! bench-compare --twins --update benches/README.md` writes the factors.
+//! the default, at J = 1e4, 1e5 and 1e6; the specialised step solvers (`EndEnumeration`, and
+//! `BlockPivoting` under an obstacle) beside the general `CondensedLcp`; and, for a load that
+//! does not separate, the load evaluation compiled (`NodalEvaluator`) and node by node
+//! (`Expression::eval`, the plain version) beside that load's step. `cargo run --release -p
+//! viscobar-certificate -- bench-compare --twins --update benches/README.md` writes the factors.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use viscobar::bar::Kernels;
@@ -28,8 +29,9 @@ fn scene(elements: u64, ends: &str, load: &str) -> Scene {
     Scene::from_toml(&text, &[]).unwrap()
 }
 
-/// The kernels of each variant: the default, each twin replaced by its plain version, all plain.
-const VARIANTS: [(&str, Kernels); 6] = [
+/// The kernels of each variant: the default, each twin replaced by its plain version, all
+/// plain; and the step solved by the general `CondensedLcp` (contact steps only).
+const VARIANTS: [(&str, Kernels); 7] = [
     ("twins", Kernels::TWINS),
     (
         "plain-solve",
@@ -60,6 +62,13 @@ const VARIANTS: [(&str, Kernels); 6] = [
         },
     ),
     ("plain", Kernels::PLAIN),
+    (
+        "general-solver",
+        Kernels {
+            general_solver: true,
+            ..Kernels::TWINS
+        },
+    ),
 ];
 
 fn bench_twins(c: &mut Criterion) {
@@ -68,8 +77,8 @@ fn bench_twins(c: &mut Criterion) {
         group.throughput(Throughput::Elements(elements + 1));
         for (step, ends) in [("unconstrained", "free"), ("exact-two-ends", "signorini")] {
             for (variant, kernels) in VARIANTS {
-                // The warm start acts on contact steps only.
-                if variant == "no-warm-start" && ends == "free" {
+                // The warm start and the step solver act on contact steps only.
+                if matches!(variant, "no-warm-start" | "general-solver") && ends == "free" {
                     continue;
                 }
                 let mut sim =
@@ -80,6 +89,46 @@ fn bench_twins(c: &mut Criterion) {
                 let id = BenchmarkId::new(format!("{step}-{variant}"), elements);
                 group.bench_function(id, |b| b.iter(|| sim.step().unwrap()));
             }
+        }
+    }
+    group.finish();
+}
+
+/// The obstacle under every node of `benches/step.rs`'s `distributed-exact` (gap 0, the load
+/// `−10 cos(πx)` pressing the left half onto it, free ends, `Δt = Δx`): its step by
+/// `BlockPivoting` (the default) and by the general `CondensedLcp`, whose dense `S` of
+/// `(J + 1)²` doubles and dense pivoting are run up to [`DENSE_OBSTACLE_MAX_ELEMENTS`] only.
+fn obstacle(elements: u64) -> Scene {
+    let text = format!(
+        "[bar]\nlength = 1.0\nviscosity = 0.1\n[left]\ncondition = \"free\"\n[right]\n\
+         condition = \"free\"\n[initial]\ndisplacement = \"0\"\nvelocity = \"0\"\n[load]\n\
+         density = \"-10*cos(pi*x)\"\n[obstacle]\ngap = \"0.0\"\n[mesh]\nelements = {elements}\n\
+         [time]\nstep = {dt}\nend = {t_end}\n",
+        dt = 1.0 / elements as f64,
+        t_end = 1000.0 / elements as f64,
+    );
+    Scene::from_toml(&text, &[]).unwrap()
+}
+
+/// The largest obstacle bar stepped by the general `CondensedLcp`: its `S` and the Cholesky
+/// buffer of `S_AA` hold `2 (J + 1)²` doubles, 2.6 MB here and 1.6 GB at J = 1e4; its set-up
+/// factorises all of `S`, and a step's `w = q + S r` is dense.
+const DENSE_OBSTACLE_MAX_ELEMENTS: u64 = 400;
+
+fn bench_obstacle(c: &mut Criterion) {
+    let mut group = c.benchmark_group("twins-obstacle");
+    for elements in [100u64, 400, 10_000] {
+        group.throughput(Throughput::Elements(elements + 1));
+        for (variant, kernels) in [VARIANTS[0], VARIANTS[6]] {
+            if variant == "general-solver" && elements > DENSE_OBSTACLE_MAX_ELEMENTS {
+                continue;
+            }
+            let mut sim = Simulation::with_kernels(&obstacle(elements), kernels).unwrap();
+            for _ in 0..50 {
+                sim.step().unwrap();
+            }
+            let id = BenchmarkId::new(format!("distributed-exact-{variant}"), elements);
+            group.bench_function(id, |b| b.iter(|| sim.step().unwrap()));
         }
     }
     group.finish();
@@ -122,6 +171,6 @@ fn bench_load(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().without_plots();
-    targets = bench_twins, bench_load
+    targets = bench_twins, bench_obstacle, bench_load
 }
 criterion_main!(benches);

@@ -15,20 +15,16 @@ use viscobar_certificate::plane::contact::plane_scene;
 
 mod common;
 
+use common::snapshot::{Row, round_quantity, round_times, sampled};
+
 /// Significant digits kept, relative to the largest magnitude of each quantity.
 const SIGNIFICANT_DIGITS: i32 = 7;
 /// Rows of the snapshot (10 intervals).
 const T_POINTS: usize = 11;
 
-/// [`common::round_to_digits`] with this file's [`SIGNIFICANT_DIGITS`].
-fn round_sig(x: f64, scale: f64) -> f64 {
-    common::round_to_digits(x, scale, SIGNIFICANT_DIGITS)
-}
-
+/// The columns of a row.
 #[derive(Serialize)]
-struct Row {
-    step: usize,
-    t: f64,
+struct Columns {
     energy: f64,
     /// `Σ D_f` up to this step.
     friction_dissipation: f64,
@@ -70,15 +66,13 @@ fn snapshot(name: &str) {
             dissipated += record.friction_dissipation;
             sliding_work += record.sliding_work;
         }
-        if n > 1 && !(n * (T_POINTS - 1)).is_multiple_of(steps) {
+        if !sampled(n, steps, T_POINTS) {
             continue;
         }
         let u = sim.displacement_dofs();
         let nodes = sim.discretisation().grid.nodes() as f64;
         let mean_u = [0, 1].map(|k| u.iter().skip(k).step_by(2).sum::<f64>() / nodes);
-        rows.push(Row {
-            step: n,
-            t: n as f64 * scene.time.step,
+        let columns = Columns {
             energy: record.energy,
             friction_dissipation: dissipated,
             stick: record.stick_nodes,
@@ -87,26 +81,29 @@ fn snapshot(name: &str) {
             tangential_force: sim.tangential_reactions().iter().sum::<f64>() + 0.0,
             mean_u,
             sliding_work: sliding.then_some(sliding_work),
+        };
+        let t = n as f64 * scene.time.step;
+        rows.push(Row {
+            step: n,
+            t,
+            columns,
         });
     }
-    let scale = |f: &dyn Fn(&Row) -> f64| rows.iter().map(|r| f(r).abs()).fold(0.0, f64::max);
-    let (se, sd, sn, st) = (
-        scale(&|r| r.energy),
-        scale(&|r| r.friction_dissipation),
-        scale(&|r| r.normal_force),
-        scale(&|r| r.tangential_force),
-    );
-    let su = scale(&|r| r.mean_u[0].abs().max(r.mean_u[1].abs()));
-    let sw = scale(&|r| r.sliding_work.unwrap_or(0.0));
-    for r in &mut rows {
-        r.t = round_sig(r.t, 1.0);
-        r.energy = round_sig(r.energy, se);
-        r.friction_dissipation = round_sig(r.friction_dissipation, sd);
-        r.normal_force = round_sig(r.normal_force, sn);
-        r.tangential_force = round_sig(r.tangential_force, st);
-        r.mean_u = r.mean_u.map(|v| round_sig(v, su));
-        r.sliding_work = r.sliding_work.map(|v| round_sig(v, sw));
-    }
+    round_times(&mut rows, SIGNIFICANT_DIGITS);
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| vec![&mut c.energy]);
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| {
+        vec![&mut c.friction_dissipation]
+    });
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| vec![&mut c.normal_force]);
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| {
+        vec![&mut c.tangential_force]
+    });
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| {
+        c.mean_u.iter_mut().collect()
+    });
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| {
+        c.sliding_work.iter_mut().collect()
+    });
     assert_eq!(rows.len(), T_POINTS);
     with_settings!({snapshot_path => "../snapshots/plane", prepend_module_to_snapshot => false}, {
         insta::assert_yaml_snapshot!(name, &rows);

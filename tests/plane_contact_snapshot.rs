@@ -14,20 +14,16 @@ use viscobar_certificate::plane::contact::plane_scene;
 
 mod common;
 
+use common::snapshot::{Row, round_quantity, round_times, sampled};
+
 /// Significant digits kept, relative to the largest magnitude of each quantity.
 const SIGNIFICANT_DIGITS: i32 = 7;
 /// Rows of the snapshot (10 intervals).
 const T_POINTS: usize = 11;
 
-/// [`common::round_to_digits`] with this file's [`SIGNIFICANT_DIGITS`].
-fn round_sig(x: f64, scale: f64) -> f64 {
-    common::round_to_digits(x, scale, SIGNIFICANT_DIGITS)
-}
-
+/// The columns of a row.
 #[derive(Serialize)]
-struct Row {
-    step: usize,
-    t: f64,
+struct Columns {
     energy: f64,
     /// Normals in contact, and the extent `[s_min, s_max]` of the touching nodes.
     in_contact: usize,
@@ -51,7 +47,7 @@ fn the_tilted_drop_matches_its_reviewed_snapshot() {
         if n > 1 {
             energy = sim.step().unwrap().energy;
         }
-        if n > 1 && !(n * (T_POINTS - 1)).is_multiple_of(steps) {
+        if !sampled(n, steps, T_POINTS) {
             continue;
         }
         let u = sim.displacement_dofs();
@@ -66,9 +62,7 @@ fn the_tilted_drop_matches_its_reviewed_snapshot() {
             .zip(sim.reactions())
             .filter(|(_, r)| **r > 0.0)
             .collect();
-        rows.push(Row {
-            step: n,
-            t: n as f64 * scene.time.step,
+        let columns = Columns {
             energy,
             in_contact: touching.len(),
             contact_s: (!touching.is_empty())
@@ -80,29 +74,25 @@ fn the_tilted_drop_matches_its_reviewed_snapshot() {
                 .fold(0.0, f64::max),
             mean_u,
             min_bottom_uy,
+        };
+        let t = n as f64 * scene.time.step;
+        rows.push(Row {
+            step: n,
+            t,
+            columns,
         });
     }
     // Round each quantity relative to its largest magnitude.
-    let scale = |f: &dyn Fn(&Row) -> f64| rows.iter().map(|r| f(r).abs()).fold(0.0, f64::max);
-    let (se, sr, sp) = (
-        scale(&|r| r.energy),
-        scale(&|r| r.total_reaction),
-        scale(&|r| r.max_pressure),
-    );
-    let su = scale(&|r| {
-        r.mean_u[0]
-            .abs()
-            .max(r.mean_u[1].abs())
-            .max(r.min_bottom_uy.abs())
+    round_times(&mut rows, SIGNIFICANT_DIGITS);
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| vec![&mut c.energy]);
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| {
+        vec![&mut c.total_reaction]
     });
-    for r in &mut rows {
-        r.t = round_sig(r.t, 1.0);
-        r.energy = round_sig(r.energy, se);
-        r.total_reaction = round_sig(r.total_reaction, sr);
-        r.max_pressure = round_sig(r.max_pressure, sp);
-        r.mean_u = r.mean_u.map(|v| round_sig(v, su));
-        r.min_bottom_uy = round_sig(r.min_bottom_uy, su);
-    }
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| vec![&mut c.max_pressure]);
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| {
+        let [x, y] = &mut c.mean_u;
+        vec![x, y, &mut c.min_bottom_uy]
+    });
     assert_eq!(rows.len(), T_POINTS);
     with_settings!({snapshot_path => "../snapshots/plane", prepend_module_to_snapshot => false}, {
         insta::assert_yaml_snapshot!("plane-tilted-drop", &rows);

@@ -21,6 +21,8 @@ use viscobar::study::figures;
 
 mod common;
 
+use common::snapshot::Row;
+
 /// Significant digits kept, relative to the largest magnitude of each quantity.
 const SIGNIFICANT_DIGITS: i32 = 8;
 /// Grid of the snapshot: nodes by steps (8 and 10 intervals).
@@ -44,10 +46,9 @@ fn round_sig(x: f64, scale: f64) -> f64 {
     rounded + 0.0 // -0.0 -> 0.0
 }
 
+/// The columns of a row.
 #[derive(Serialize)]
-struct Row {
-    step: usize,
-    t: f64,
+struct Columns {
     /// `E^{n−1/2}`, recorded by step `n` (none at `n = 0`).
     energy: Option<f64>,
     u: Vec<f64>,
@@ -74,7 +75,7 @@ struct Snapshot {
     /// The sampled nodes and their `x`.
     nodes: Vec<usize>,
     x: Vec<f64>,
-    rows: Vec<Row>,
+    rows: Vec<Row<Columns>>,
     contact_intervals: BTreeMap<String, Vec<[f64; 2]>>,
     /// Distributed obstacles only: per time bin (between consecutive sampled steps), the
     /// extent `[x_min, x_max]` of the nodes in contact at some step of the bin (`~` if none).
@@ -106,12 +107,14 @@ fn snapshot_of(name: &str, mass: Option<&str>) -> Snapshot {
         .map(|k| Row {
             step: run.steps_sampled[k],
             t: round_sig(run.ts[k], t_scale),
-            energy: run.energy[k].map(|e| round_sig(e, e_scale)),
-            u: run
-                .u_row(k)
-                .iter()
-                .map(|&u| round_sig(u, u_scale))
-                .collect(),
+            columns: Columns {
+                energy: run.energy[k].map(|e| round_sig(e, e_scale)),
+                u: run
+                    .u_row(k)
+                    .iter()
+                    .map(|&u| round_sig(u, u_scale))
+                    .collect(),
+            },
         })
         .collect();
     let contact_intervals = run

@@ -15,21 +15,17 @@ use viscobar::thermal::ThermalSimulation;
 
 mod common;
 
+use common::snapshot::{Row, round_quantity, round_times, sampled};
+
 /// Significant digits kept, relative to the largest magnitude of each quantity.
 const SIGNIFICANT_DIGITS: i32 = 7;
 /// Rows of the snapshot (10 intervals) and nodes sampled (4 intervals).
 const T_POINTS: usize = 11;
 const X_POINTS: usize = 5;
 
-/// [`common::round_to_digits`] with this file's [`SIGNIFICANT_DIGITS`].
-fn round_sig(x: f64, scale: f64) -> f64 {
-    common::round_to_digits(x, scale, SIGNIFICANT_DIGITS)
-}
-
+/// The columns of a row.
 #[derive(Serialize)]
-struct Row {
-    step: usize,
-    t: f64,
+struct Columns {
     energy: f64,
     thermal_energy: f64,
     gap_left: f64,
@@ -38,12 +34,12 @@ struct Row {
     theta: Vec<f64>,
 }
 
-fn rows_of(name: &str) -> Vec<Row> {
+fn rows_of(name: &str) -> Vec<Row<Columns>> {
     let (_, scene) = scene::load(name, &[]).unwrap();
     let steps = scene.steps();
     let mut sim = ThermalSimulation::new(&scene).unwrap();
     let nodes = sim.body().nodes();
-    let sampled: Vec<usize> = (0..X_POINTS)
+    let nodes_sampled: Vec<usize> = (0..X_POINTS)
         .map(|k| k * (nodes - 1) / (X_POINTS - 1))
         .collect();
     let mut rows = Vec::new();
@@ -52,42 +48,41 @@ fn rows_of(name: &str) -> Vec<Row> {
         if n > 1 {
             record = sim.step().unwrap();
         }
-        if n > 1 && !(n * (T_POINTS - 1)).is_multiple_of(steps) {
+        if !sampled(n, steps, T_POINTS) {
             continue;
         }
         let u = sim.displacement_dofs();
         let body = sim.body();
-        rows.push(Row {
-            step: n,
-            t: n as f64 * scene.time.step,
+        let columns = Columns {
             energy: record.energy,
             thermal_energy: record.heat.unwrap_or_default().energy,
             gap_left: record.contact.groups[0].min_gap,
             reaction_left: record.contact.groups[0].reaction,
-            u: sampled.iter().map(|&i| u[i]).collect(),
-            theta: (sampled.iter())
+            u: nodes_sampled.iter().map(|&i| u[i]).collect(),
+            theta: (nodes_sampled.iter())
                 .map(|&i| body.temperature(sim.displacement(), i).unwrap())
                 .collect(),
+        };
+        let t = n as f64 * scene.time.step;
+        rows.push(Row {
+            step: n,
+            t,
+            columns,
         });
     }
-    let scale = |f: &dyn Fn(&Row) -> f64| rows.iter().map(|r| f(r).abs()).fold(0.0, f64::max);
-    let (se, sh, sg, sr) = (
-        scale(&|r| r.energy),
-        scale(&|r| r.thermal_energy),
-        scale(&|r| r.gap_left),
-        scale(&|r| r.reaction_left),
-    );
-    let su = scale(&|r| r.u.iter().fold(0.0, |m, v| m.max(v.abs())));
-    let st = scale(&|r| r.theta.iter().fold(0.0, |m, v| m.max(v.abs())));
-    for r in &mut rows {
-        r.t = round_sig(r.t, 1.0);
-        r.energy = round_sig(r.energy, se);
-        r.thermal_energy = round_sig(r.thermal_energy, sh);
-        r.gap_left = round_sig(r.gap_left, sg);
-        r.reaction_left = round_sig(r.reaction_left, sr);
-        r.u = r.u.iter().map(|v| round_sig(*v, su)).collect();
-        r.theta = r.theta.iter().map(|v| round_sig(*v, st)).collect();
-    }
+    round_times(&mut rows, SIGNIFICANT_DIGITS);
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| vec![&mut c.energy]);
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| {
+        vec![&mut c.thermal_energy]
+    });
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| vec![&mut c.gap_left]);
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| {
+        vec![&mut c.reaction_left]
+    });
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| c.u.iter_mut().collect());
+    round_quantity(&mut rows, SIGNIFICANT_DIGITS, |c| {
+        c.theta.iter_mut().collect()
+    });
     assert_eq!(rows.len(), T_POINTS);
     rows
 }

@@ -11,6 +11,7 @@ use crate::bar::kernels::rhs_fast::rhs_into_uniform;
 use crate::bar::matrices;
 use crate::linalg::kernels::ldlt::NotPositiveDefinite;
 use crate::linalg::kernels::ldlt_fast::TwistedLdlt;
+use crate::linalg::system::TridiagSystem;
 use crate::linalg::tridiag::Uniform;
 use crate::scene::expr::Expression;
 use crate::scene::{Condition, Scene, SceneError};
@@ -19,8 +20,8 @@ use crate::scheme::certify::{IDENTITY_TOL, MAX_IDENTITY_BOUND, conditioned_bound
 use crate::scheme::contact::{ContactSet, Group, Positions};
 use crate::scheme::{Load, RunError, Scheme, Setup, Unstarted};
 use crate::step::{
-    Algorithm, BlockPivoting, EndEnumeration, EndPenalty, Osqp, SetupError, Shape, StepSolver,
-    algorithm_for,
+    Algorithm, BlockPivoting, CondensedLcp, Constraints, EndEnumeration, EndPenalty, Osqp,
+    SetupError, Shape, StepSolver, algorithm_for,
 };
 
 /// A run of a bar scene: the scheme stepping the bar.
@@ -40,6 +41,11 @@ pub struct Kernels {
     pub uniform_rhs: bool,
     /// On a uniform mesh, the energy sums by `energy_sums_uniform`.
     pub uniform_energy: bool,
+    /// `method = "exact"` by the general `CondensedLcp` on the step matrix in place of the
+    /// specialised `EndEnumeration` (ends) or `BlockPivoting` (obstacle), their twin (false in
+    /// both [`Kernels::TWINS`] and [`Kernels::PLAIN`]; the dense `S` of an obstacle needs
+    /// `(J + 1)²` doubles).
+    pub general_solver: bool,
 }
 
 impl Kernels {
@@ -48,12 +54,14 @@ impl Kernels {
         warm_start: true,
         uniform_rhs: true,
         uniform_energy: true,
+        general_solver: false,
     };
     pub const PLAIN: Kernels = Kernels {
         twisted_solve: false,
         warm_start: false,
         uniform_rhs: false,
         uniform_energy: false,
+        general_solver: false,
     };
 }
 
@@ -278,7 +286,18 @@ fn make_solver_with(
     } else {
         Shape::BarObstacle
     };
-    match algorithm_for(scene.solver.method, shape) {
+    let algorithm = algorithm_for(scene.solver.method, shape);
+    if kernels.general_solver
+        && matches!(
+            algorithm,
+            Some(Algorithm::EndEnumeration | Algorithm::BlockPivoting)
+        )
+    {
+        let system = TridiagSystem::new(&disc.step_matrix)?;
+        let constraints = Constraints::lower_bounds(&nodes);
+        return Ok(Box::new(CondensedLcp::new(system, constraints, 0.0)?));
+    }
+    match algorithm {
         Some(Algorithm::EndEnumeration) => Ok(Box::new(EndEnumeration::with_options(
             &disc.step_matrix,
             &nodes,

@@ -155,8 +155,8 @@ impl EndPenalty {
     /// The direct solve on support `mask` (see the module documentation); returns whether it
     /// meets the conditions, `z_j <= lo_j` on the support and `z_j >= lo_j` off it (false on a
     /// NaN). On the support `r_j = (lo_j − z_j)/ε = (C z − b)_j` up to the solve's residual
-    /// `δ ~ u (‖C‖ + 1/ε) |z|` (`u` the unit round-off). Taken from the gap, the penalty law
-    /// holds to round-off and stationarity is off by `δ` plus the gap's rounding times `1/ε`;
+    /// `δ ~ u (‖C‖ + 1/ε) |z|` (`u` the unit round-off). Taken from the gap (the law's own
+    /// [`Law::penalty_reaction`]), the penalty law holds to round-off and stationarity is off by `δ` plus the gap's rounding times `1/ε`;
     /// taken from stationarity, stationarity holds and the law is off by `ε δ`, where `δ`
     /// includes the rounding of the row `(C z − b)_j` itself, `u (|C||z| + |b|)_j`: with a stiff
     /// `C` (a coarse mesh) its terms cancel to a much smaller reaction. Each node
@@ -180,17 +180,17 @@ impl EndPenalty {
         self.springs[mask as usize - 1].solve_in_place(z);
         let mut met = true;
         for (j, &i) in self.nodes.iter().enumerate() {
-            let gap = lower[j] - z[i];
+            let compression = lower[j] - z[i];
             if mask & (1 << j) != 0 {
-                met &= gap >= 0.0;
-                let rj = if self.from_gap[j] {
-                    self.stiffness * gap
+                met &= compression >= 0.0;
+                reactions[j] = if self.from_gap[j] {
+                    Law::penalty_reaction(compression, self.epsilon)
                 } else {
-                    row_product(self.rows[j], i, z) - rhs[i]
+                    let rj = row_product(self.rows[j], i, z) - rhs[i];
+                    if rj < 0.0 { 0.0 } else { rj }
                 };
-                reactions[j] = if rj < 0.0 { 0.0 } else { rj };
             } else {
-                met &= gap <= 0.0;
+                met &= compression <= 0.0;
                 reactions[j] = 0.0;
             }
         }

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod alloc;
+pub mod snapshot;
 
 use proptest::prelude::*;
 use viscobar::Scene;

@@ -723,6 +723,44 @@ impl PlaneDraw {
         Some((belt, fixed, sign * c * t_end))
     }
 
+    /// Where the body may travel along `y` with its bottom and top obstacles (no clamped edge,
+    /// left and right free or frictionless, a Signorini bottom or top, a solver exact to
+    /// round-off): the scene whose bottom and top obstacles move by `−c t` along `y` besides
+    /// their drawn motion (gaps `g + c t` below, `g − c t` above: `u·n <= g`, `n` outward) and
+    /// its twin with them as drawn and the initial velocity's `y` raised by `c`, whose final
+    /// `y` displacement is the first's plus `c t_N`. The shift leaves the left and right
+    /// normals (along `x`) and the bottom and top slips (along `x`) as they are.
+    pub fn galilean_twins(&self) -> Option<(Self, Self, f64)> {
+        let frictionless = |e: &Edge| match e {
+            Edge::Free => true,
+            Edge::Clamped => false,
+            Edge::Signorini { friction, .. } => friction.is_none_or(is_zero_friction),
+        };
+        let signorini = |e: &Edge| matches!(e, Edge::Signorini { .. });
+        let travels = frictionless(&self.edges[0])
+            && frictionless(&self.edges[1])
+            && self.edges[2..].iter().any(signorini);
+        if !travels
+            || self.edges.iter().any(|e| matches!(e, Edge::Clamped))
+            || self.solver == "osqp"
+        {
+            return None;
+        }
+        let c = 0.3;
+        let mut moving = self.clone();
+        for (k, sign) in [(2, "+"), (3, "-")] {
+            if let Edge::Signorini { gap, .. } = &mut moving.edges[k] {
+                *gap = Box::leak(format!("({gap}) {sign} {c:?}*t").into_boxed_str());
+            }
+        }
+        let mut fixed = self.clone();
+        let vy = format!("({}) + {c:?}", self.velocity[1]);
+        fixed.velocity[1] = Box::leak(vy.into_boxed_str());
+        // u_fixed = u_moving + c t at t_N = N Δt (the run's last step); the mirror (in x)
+        // leaves y as it is.
+        Some((moving, fixed, c * self.steps as f64 * self.dt))
+    }
+
     /// With some friction zero at every node (`0`, `"0*s"`), the scene without those keys.
     pub fn without_zero_friction(&self) -> Option<Self> {
         let zero = |e: &Edge| matches!(e, Edge::Signorini { friction: Some(f), .. } if is_zero_friction(f));

@@ -224,7 +224,7 @@ pub fn markdown(o: &Options) -> Result<String, String> {
 
 /// The twins of [`twins_markdown`]: name, plain version, the step and the variant of
 /// `benches/twins.rs` whose median over the default's is the factor.
-const TWINS: [(&str, &str, &str, &str); 7] = [
+const TWINS: [(&str, &str, &str, &str); 8] = [
     (
         "`ldlt_fast::TwistedLdlt`",
         "`ldlt::Ldlt`",
@@ -257,7 +257,18 @@ const TWINS: [(&str, &str, &str, &str); 7] = [
     ),
     ("all of the above", "all plain", "unconstrained", "plain"),
     ("all of the above", "all plain", "exact-two-ends", "plain"),
+    (
+        "`EndEnumeration`",
+        "`CondensedLcp`",
+        "exact-two-ends",
+        "general-solver",
+    ),
 ];
+
+/// The sizes of the obstacle's step in `benches/twins.rs` (`twins-obstacle`), and those at
+/// which the general `CondensedLcp` is run (its `DENSE_OBSTACLE_MAX_ELEMENTS`).
+const OBSTACLE_SIZES: [&str; 3] = ["100", "400", "10000"];
+const DENSE_OBSTACLE_SIZES: [&str; 2] = ["100", "400"];
 
 /// The block `bench-twins`: each twin's factor on a step (the step's median with the plain
 /// version over its median with the twin) at J = 1e4, 1e5, 1e6, from this checkout's last run
@@ -323,6 +334,7 @@ pub fn twins_markdown() -> Result<String, String> {
     for (j, t) in SIZES[..2].iter().zip(&thermal) {
         unpaired.push(t / read(format!("thermal/mechanical/{j}"))?);
     }
+    let obstacle = obstacle_table(&mut read)?;
     let mut paired = Vec::new();
     for j in &SIZES[..2] {
         let (ratio, at) = paired_ratio(&root, j)?;
@@ -360,6 +372,40 @@ pub fn twins_markdown() -> Result<String, String> {
     );
     out.push_str(&rows);
     out.push_str(&thermal_line);
+    out.push_str(&obstacle);
+    Ok(out)
+}
+
+/// The obstacle's table: `BlockPivoting`'s factor over the general `CondensedLcp` on the step
+/// of an obstacle under every node, at the sizes the dense solver is run.
+fn obstacle_table(read: &mut impl FnMut(String) -> Result<f64, String>) -> Result<String, String> {
+    let mut cells = Vec::new();
+    for j in OBSTACLE_SIZES {
+        let t = read(format!("twins-obstacle/distributed-exact-twins/{j}"))?;
+        cells.push(if DENSE_OBSTACLE_SIZES.contains(&j) {
+            let p = read(format!(
+                "twins-obstacle/distributed-exact-general-solver/{j}"
+            ))?;
+            format!("{:.2}x", p / t)
+        } else {
+            "not run".into()
+        });
+    }
+    let mut out = String::from(
+        "\nUnder an obstacle at every node (the step of `distributed-exact`, `benches/step.rs`), \
+         the specialised solver over the general one. The general `CondensedLcp` holds the dense \
+         `S = E C⁻¹ Eᵀ` of the J + 1 bounds and a Cholesky buffer for `S_AA`, `2 (J + 1)²` \
+         doubles; its set-up forms `S` by J + 1 solves and factorises it whole, and a step's \
+         `w = q + S r` and refactorisations of `S_AA` are dense: it is not run beyond J = 400 \
+         (at J = 1e4 its arrays alone would take 1.6 GB).\n\n\
+         | twin | general solver | step | J = 100 | J = 400 | J = 1e4 |\n|---|---|---|---|---|---|\n",
+    );
+    writeln!(
+        out,
+        "| `BlockPivoting` | `CondensedLcp` | distributed-exact | {} |",
+        cells.join(" | ")
+    )
+    .unwrap();
     Ok(out)
 }
 
