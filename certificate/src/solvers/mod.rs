@@ -3,6 +3,7 @@
 //! - [`agreement`]: OSQP and the penalty law against the exact solver on every built-in scene,
 //!   the penalty's order in ε, OSQP's failures on stiff steps, random step problems
 //!   (`solver-agreement`);
+//! - [`general_twins`]: the bar's specialised exact solvers against the general one;
 //! - [`oracle`]: the dense brute-force reference of the step problem;
 //! - [`scale`]: contact at scale, the sparse penalty solver against the condensed one.
 //!
@@ -11,5 +12,6 @@
 //! [`crate::friction`].
 
 pub mod agreement;
+pub mod general_twins;
 pub mod oracle;
 pub mod scale;

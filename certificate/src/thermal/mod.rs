@@ -1,9 +1,11 @@
 //! The thermal bar's certificate: the heat equation's Fourier mode (`γ = 0`) under refinement,
 //! the exact total-energy identity on every thermal scene, the steady state with contact, the
 //! coupled thermoelastic modes (the cubic's roots against the run's, extracted by Prony's
-//! method) and a manufactured solution with contact. Closed forms and derivations: `docs/thermal.md`. Fast enough for `cargo test`.
+//! method) and a manufactured solution with contact; Rannacher's start (`smoothing`). Closed
+//! forms and derivations: `docs/thermal.md`. Fast enough for `cargo test`.
 
 pub mod boundary;
+pub mod smoothing;
 
 use nalgebra::{Complex, Matrix3, Vector3};
 use std::fmt::Write;

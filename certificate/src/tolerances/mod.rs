@@ -78,7 +78,18 @@ pub struct Uncovered {
 pub fn measured() -> Result<Vec<Measured>, RunError> {
     let [identity, rise, gap, reaction, complementarity] = scene_worst()?;
     let common = "tests/common (energy_and_contact, solvers, …)";
+    let general = (crate::solvers::general_twins::general_twins()?.iter())
+        .map(|t| t.deviation)
+        .fold(0.0, f64::max);
     let mut v = vec![
+        Measured {
+            name: "GENERAL_TWIN_TOL".into(),
+            used_in: "tests/general_solver_twins.rs",
+            tolerance: GENERAL_TWIN_TOL,
+            worst: general,
+            note: "both-ends, one-end and distributed: the general solver's run against the \
+                   specialised one's",
+        },
         Measured {
             name: "IDENTITY_TOL".into(),
             used_in: common,

@@ -46,7 +46,7 @@ fn reason(name: &str, file: &str) -> &'static str {
             "the rounding of three quotients of one total and of their sum (timing shares in \
              summary.json), not a tolerance of the numerics"
         }
-        ("TWIN_TOL" | "FRICTIONLESS_TOL" | "CLOSED_BODY_HEAT_TOL", _) => {
+        ("TWIN_TOL" | "FRICTIONLESS_TOL" | "CLOSED_BODY_HEAT_TOL" | "PLANE_GALILEAN_TOL", _) => {
             "a metamorphic relation over random draws (`tests/scene_property.rs`): the worst is \
              that of the seed's draws, printed by the soak, not of a fixed scene set"
         }
