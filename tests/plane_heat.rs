@@ -13,7 +13,8 @@ use viscobar_certificate::plane_heat::{
     sudden_edge_excursion, uniform_end,
 };
 use viscobar_certificate::tolerances::{
-    HEAT_BALANCE_TOL, PLANE_DECAY_RATE_TOL, PLANE_MAX_PRINCIPLE_TOL, STEADY_TEMPERATURE_TOL,
+    HEAT_BALANCE_TOL, PLANE_DECAY_RATE_TOL, PLANE_MAX_PRINCIPLE_TOL, PLANE_MONOTONE_TOL,
+    STEADY_TEMPERATURE_TOL,
 };
 
 /// The observed orders of the manufactured solution's nodal error (Q1 nodes and
@@ -211,4 +212,12 @@ fn the_profile_file_gains_theta() {
         );
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// An initial temperature that jumps inside a cell starts implicitly: θ stays nondecreasing in
+/// `x` at every step, as the exact solution does (a Crank–Nicolson start rings).
+#[test]
+fn an_initial_jump_starts_implicitly_and_keeps_theta_monotone() {
+    let decrease = plane_heat::initial_jump_monotonicity().unwrap();
+    assert!(decrease <= PLANE_MONOTONE_TOL, "{decrease:e}");
 }

@@ -6,9 +6,10 @@
 
 use viscobar::scene;
 use viscobar_certificate::thermal::smoothing::{
-    SWITCHED_DIFFUSIVITIES, exchange_decay_rate, excursions, switched_end,
+    SWITCHED_DIFFUSIVITIES, exchange_decay_rate, excursions, initial_jump_monotonicity,
+    switched_end,
 };
-use viscobar_certificate::tolerances::{DECAY_RATE_TOL, MAX_PRINCIPLE_TOL};
+use viscobar_certificate::tolerances::{BAR_MONOTONE_TOL, DECAY_RATE_TOL, MAX_PRINCIPLE_TOL};
 
 /// `heated-expansion` at every step (its end raised from 0 to 1 at `t = 0`, `κΔt/Δx² = 100`)
 /// stays within `[0, 1]`; so does a bar without coupling whose end temperature is switched on
@@ -50,4 +51,15 @@ fn an_exchange_end_decays_at_the_slowest_rate() {
         (rate - exact).abs() <= DECAY_RATE_TOL * exact,
         "rate {rate} against {exact}"
     );
+}
+
+/// An initial temperature that jumps inside an element is non-smooth data at `t = 0`: the
+/// start-up and the next two steps are implicit, and θ stays nondecreasing in `x` at every
+/// step, as the exact solution does (a Crank–Nicolson start rings).
+#[test]
+fn an_initial_jump_starts_implicitly_and_keeps_theta_monotone() {
+    let (decrease, implicit) = initial_jump_monotonicity().unwrap();
+    eprintln!("largest decrease {decrease:e}, implicit steps {implicit:?}");
+    assert_eq!(implicit, vec![2, 3]);
+    assert!(decrease <= BAR_MONOTONE_TOL, "{decrease:e}");
 }

@@ -349,3 +349,43 @@ pub fn markdown() -> Result<String, RunError> {
     );
     Ok(s)
 }
+
+/// A body at 0 left of `x = 0.503` and 1 right of it (a jump inside a cell), insulated,
+/// `κΔt/h² = 100`: the largest decrease of `θ` from a node to the next along `x`, over every
+/// row and step (the exact solution stays nondecreasing in `x`).
+pub fn initial_jump_monotonicity() -> Result<f64, RunError> {
+    let text = r#"
+[plane]
+width = 1.0
+height = 0.1
+lambda = 1.0
+mu = 1.0
+
+[mesh]
+nx = 50
+ny = 5
+
+[time]
+step = 0.04
+end = 1.0
+
+[heat]
+coupling = 0
+diffusivity = 1.0
+temperature = "x > 0.503"
+"#;
+    let scene = PlaneScene::from_toml(text, &[]).expect("a valid scene");
+    let mut sim = PlaneSimulation::new(&scene)?;
+    let [nx, ny] = sim.body().lattice();
+    let mut worst = 0.0f64;
+    for _ in 1..scene.steps() {
+        sim.step()?;
+        for j in 0..ny {
+            for i in 1..nx {
+                let (a, b) = (theta(&sim, j * nx + i - 1), theta(&sim, j * nx + i));
+                worst = worst.max(a - b);
+            }
+        }
+    }
+    Ok(worst)
+}

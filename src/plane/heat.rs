@@ -16,7 +16,7 @@ use crate::scene::plane_heat::{EdgeHeat, PlaneHeatExpressions};
 use crate::scheme::body::{HeatOutputs, HeatTerms};
 use crate::scheme::{RunError, in_contact};
 use crate::step::Friction;
-use crate::thermal::smoothing::{Smoothing, jumps_within, starts_with_a_jump};
+use crate::thermal::smoothing::{Smoothing, jumps_within, profile_jumps, starts_with_a_jump};
 
 /// A node held at its edge's temperature: the node, its edge and coordinate `s`.
 #[derive(Clone, Copy, Debug)]
@@ -230,6 +230,11 @@ impl PlaneHeat {
                 fixed.push(FixedNode { node, edge, s });
             }
         }
+        // A jump inside the initial temperature, along a row or a column of nodes, is
+        // non-smooth data at t = 0 too.
+        let theta0 = |x: f64, y: f64| temperature.eval_xy(x, y, 0.0).unwrap_or(f64::NAN);
+        start_jump |= (grid.ys.iter()).any(|&y| profile_jumps(|x| theta0(x, y), &grid.xs))
+            || (grid.xs.iter()).any(|&x| profile_jumps(|y| theta0(x, y), &grid.ys));
         let keep: Vec<Option<usize>> = {
             let mut next = 0;
             (0..nodes)

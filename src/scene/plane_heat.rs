@@ -14,8 +14,9 @@ use crate::scene::heat::ThermalCondition;
 use crate::scene::plane::{EDGE_NAMES, EdgeCondition, Edges, PlaneHeat, ThermalEdge};
 
 /// The parsed condition of one edge.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub enum EdgeHeat {
+    #[default]
     Insulated,
     /// `θ = value(s, t)`.
     Temperature(Expression),
@@ -106,12 +107,6 @@ impl PlaneHeat {
             edges: parsed,
             frictional_heating: eta,
         })
-    }
-}
-
-impl Default for EdgeHeat {
-    fn default() -> Self {
-        EdgeHeat::Insulated
     }
 }
 

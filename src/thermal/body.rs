@@ -16,7 +16,7 @@ use crate::scheme::body::{Body, EnergySums, FullMassRows, HeatTerms};
 use crate::scheme::certify::{MAX_IDENTITY_BOUND, THERMAL_IDENTITY_TOL, conditioned_bound};
 use crate::thermal::heat_rows;
 use crate::thermal::matrices::{ThermalMatrices, heat_weight};
-use crate::thermal::smoothing::{Smoothing, jumps_within, starts_with_a_jump};
+use crate::thermal::smoothing::{Smoothing, jumps_within, profile_jumps, starts_with_a_jump};
 use crate::thermal::solver::{ImplicitFlag, exchange_state};
 
 /// An exchange end: its node, constraint, coefficient `h` and `θ_obs(t)`. Its gap is the
@@ -134,6 +134,9 @@ impl ThermalBody {
                 }
             }
         }
+        // A jump inside the initial temperature is non-smooth data at t = 0 too.
+        let xs: Vec<f64> = (0..nodes).map(|j| j as f64 * dx).collect();
+        start_jump |= profile_jumps(|x| temperature.eval(x, 0.0).unwrap_or(f64::NAN), &xs);
         let is_fixed = [0, nodes - 1].map(|n| fixed.iter().any(|f| f.node == n));
         let m = ThermalMatrices::new(
             nodes,

@@ -68,6 +68,16 @@ pub fn jumps_within(
     Ok(true)
 }
 
+/// Whether an initial temperature `f` jumps between consecutive points of a line of nodes
+/// (`points`): [`jumps_within`] on each interval, its change not shrinking under bisection. A
+/// value that is not finite inside an interval counts as a jump.
+pub fn profile_jumps(f: impl Fn(f64) -> f64, points: &[f64]) -> bool {
+    points.windows(2).any(|w| {
+        let (a, b) = (w[0], w[1]);
+        jumps_within(|x| Ok(f(x)), (a, b), (f(a), f(b))).unwrap_or(true)
+    })
+}
+
 /// Which heat steps are implicit Euler ones; shares its answer with the step solver.
 #[derive(Clone, Debug, Default)]
 pub struct Smoothing {

@@ -138,3 +138,26 @@ pub fn exchange_decay_rate() -> Result<(f64, f64), RunError> {
     let rate = (at_four / largest(&sim)).ln() / 1.0;
     Ok((rate, slowest_exchange_rate(kappa, h)))
 }
+
+/// A bar at 0 left of `x = 0.503` and 1 right of it (a jump inside an element), insulated,
+/// `κΔt/Δx² = 100`: the largest decrease of `θ` from a node to the next along `x` over every
+/// step (the exact solution stays nondecreasing), and the implicit steps.
+pub fn initial_jump_monotonicity() -> Result<(f64, Vec<usize>), RunError> {
+    let text = "[bar]\nlength = 1.0\nviscosity = 0.1\n[left]\ncondition = \"clamped\"\n\
+                [right]\ncondition = \"clamped\"\n[initial]\ndisplacement = \"0\"\n\
+                velocity = \"0\"\n[heat]\ncoupling = 0.0\ndiffusivity = 2.0\n\
+                temperature = \"x > 0.503\"\n\
+                [mesh]\nelements = 100\n[time]\nstep = 0.005\nend = 1.0\n";
+    let scene = Scene::from_toml(text, &[])?;
+    let mut sim = ThermalSimulation::new(&scene)?;
+    let (mut worst, mut implicit) = (0.0f64, Vec::new());
+    for _ in 1..scene.steps() {
+        let record = sim.step()?;
+        if sim.body().implicit_step() {
+            implicit.push(record.step);
+        }
+        let theta = temperatures(&sim);
+        worst = (theta.windows(2)).fold(worst, |m, w| m.max(w[0] - w[1]));
+    }
+    Ok((worst, implicit))
+}
