@@ -7,30 +7,21 @@
 
 mod common;
 
-use viscobar::plane::PlaneBody;
-use viscobar::{Body, PlaneScene, PlaneSimulation, StepRecord, run_plane_in_memory};
+use viscobar::{PlaneScene, StepRecord};
+use viscobar_certificate::plane_heat::{
+    self, LAUNCH, belt, exchange_decay, launch_with_heat, manufactured_errors, orders,
+    sudden_edge_excursion, uniform_end,
+};
+use viscobar_certificate::tolerances::{
+    HEAT_BALANCE_TOL, PLANE_DECAY_RATE_TOL, PLANE_MAX_PRINCIPLE_TOL, STEADY_TEMPERATURE_TOL,
+};
 
-/// The heat-content balance per step, relative to the largest heat content of the run: the
-/// content and the step's heat are sums of a few hundred products, the solve backward stable.
-const HEAT_BALANCE_TOL: f64 = 1e-13;
-/// A uniform or a linear steady temperature, relative to its size: round-off of the steady
-/// state the decaying modes have reached (their slowest factor is below 1e-20 at the end).
-const STEADY_TEMPERATURE_TOL: f64 = 1e-10;
 /// The least observed order of the manufactured solution's nodal error (Q1 nodes and
 /// Crank–Nicolson both second order).
-const MIN_ORDER: f64 = 1.9;
+const PLANE_HEAT_ORDER_MIN: f64 = 1.9;
 
-const LAUNCH: &str = include_str!("../scenes/plane-friction-launch.toml");
-
-fn launch_with_heat(heat: &str, overrides: &[&str]) -> PlaneScene {
-    let text = format!("{LAUNCH}\n[heat]\n{heat}\n");
-    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    PlaneScene::from_toml(&text, &overrides).expect("a valid scene")
-}
-
-fn run(scene: &PlaneScene) -> (Vec<StepRecord>, PlaneSimulation) {
-    let (records, _, sim) = run_plane_in_memory("plane-heat", scene).expect("the run certifies");
-    (records, sim)
+fn run(scene: &PlaneScene) -> (Vec<StepRecord>, viscobar::PlaneSimulation) {
+    plane_heat::run(scene).expect("the run certifies")
 }
 
 /// At every step (the start-up's half step included) the heat content `1ᵀMθ` grows by the
@@ -76,25 +67,9 @@ fn heat_content_grows_by_the_frictional_heating_at_every_step() {
 /// out: `θ = η Σ D_f / (W H)` at every node (`θ^0 = 0`; `1ᵀ M 1 = W H`).
 #[test]
 fn a_launched_block_ends_at_the_uniform_temperature_of_its_friction_work() {
-    let scene = launch_with_heat("coupling = 0\ndiffusivity = 1.0", &["time.end=8"]);
-    let (records, sim) = run(&scene);
-    let work: f64 = records.iter().map(|r| r.friction_dissipation).sum();
-    let (w, h) = (scene.plane.width, scene.plane.height);
-    let expected = work / (w * h);
-    let body: &PlaneBody = sim.body();
-    for node in 0..body.nodes() {
-        let theta = body.temperature(sim.displacement(), node).unwrap();
-        let error = (theta - expected).abs() / expected;
-        assert!(
-            error <= STEADY_TEMPERATURE_TOL,
-            "node {node}: {theta} against {expected}"
-        );
-    }
-    assert_eq!(
-        records.last().unwrap().slip_nodes,
-        0,
-        "the block has stopped"
-    );
+    let (deviation, stopped) = uniform_end().unwrap();
+    assert!(stopped, "the block has stopped");
+    assert!(deviation <= STEADY_TEMPERATURE_TOL, "{deviation:e}");
 }
 
 /// A block (1 × 0.5, ρ g = 1) on a belt moving at `v = −1` under it, dragged against a
@@ -105,69 +80,16 @@ fn a_launched_block_ends_at_the_uniform_temperature_of_its_friction_work() {
 /// (trapezoidal) bottom temperature is then `η μ p |v| H / κ`, exactly.
 #[test]
 fn a_block_on_a_belt_settles_to_the_flux_of_kinetic_friction() {
-    let (mu, v, kappa) = (0.5, 1.0, 1.0);
-    let text = format!(
-        r#"
-[plane]
-width = 1.0
-height = 0.5
-lambda = 100.0
-mu = 100.0
-viscosity = 0.05
-
-[edges]
-left = {{ condition = "signorini", gap = 0 }}
-bottom = {{ condition = "signorini", gap = 0, friction = {mu}, velocity = "-{v}" }}
-
-[load]
-density = ["0", "-1"]
-
-[mesh]
-nx = 8
-ny = 4
-
-[time]
-step = 0.01
-end = 6.0
-
-[heat]
-coupling = 0
-diffusivity = {kappa}
-top = {{ condition = "temperature", value = 0 }}
-"#
-    );
-    let scene = PlaneScene::from_toml(&text, &[]).unwrap();
-    let (records, sim) = run(&scene);
-    let last = records.last().unwrap();
-    let (w, h, dt) = (scene.plane.width, scene.plane.height, scene.time.step);
-    assert_eq!(last.stick_nodes, 0);
-    // The heat the step's friction puts in, per unit time and length of edge: η μ p |v|.
-    let flux = last.heat.unwrap().frictional_heating / dt / w;
-    let tangential: f64 = last
-        .contact
-        .groups
-        .iter()
-        .map(|g| g.tangential_reaction)
-        .sum();
-    let p = tangential.abs() / (mu * w);
-    assert!(p > 0.4 * h, "pressed by its weight: p = {p}");
+    let [p, flux, mean, sticking] = belt().unwrap();
+    assert_eq!(sticking, 0.0, "every frictional node slips");
+    assert!(p > 0.4 * 0.5, "pressed by its weight: p = {p}");
     assert!(
-        (flux - mu * p * v).abs() <= STEADY_TEMPERATURE_TOL * mu * p * v,
-        "flux {flux} against η μ p v = {}",
-        mu * p * v
+        flux <= STEADY_TEMPERATURE_TOL,
+        "flux against μ p v: {flux:e}"
     );
-    let body: &PlaneBody = sim.body();
-    let [nx, _] = body.lattice();
-    let hx = w / (nx - 1) as f64;
-    let mut mean = 0.0;
-    for i in 0..nx {
-        let weight = if i == 0 || i == nx - 1 { hx / 2.0 } else { hx };
-        mean += weight * body.temperature(sim.displacement(), i).unwrap() / w;
-    }
-    let expected = flux * h / kappa;
     assert!(
-        (mean - expected).abs() <= STEADY_TEMPERATURE_TOL * expected,
-        "edge mean {mean} against {expected}"
+        mean <= STEADY_TEMPERATURE_TOL,
+        "edge mean against flux H / κ: {mean:e}"
     );
 }
 
@@ -176,54 +98,12 @@ top = {{ condition = "temperature", value = 0 }}
 /// halve together.
 #[test]
 fn the_heat_step_converges_at_order_two() {
-    let kappa = 0.5;
-    let mut errors = Vec::new();
-    for (n, dt) in [(4, 0.04), (8, 0.02), (16, 0.01)] {
-        let text = format!(
-            r#"
-[plane]
-width = 1.0
-height = 1.0
-lambda = 1.0
-mu = 1.0
-
-[mesh]
-nx = {n}
-ny = {n}
-
-[time]
-step = {dt}
-end = 0.4
-
-[heat]
-coupling = 0
-diffusivity = {kappa}
-temperature = "sin(pi*x)*sin(pi*y)"
-source = "sin(pi*x)*sin(pi*y)*(1 + 2*pi*pi*{kappa}*(1 + t))"
-left = {{ condition = "temperature", value = 0 }}
-right = {{ condition = "temperature", value = 0 }}
-bottom = {{ condition = "temperature", value = 0 }}
-top = {{ condition = "temperature", value = 0 }}
-"#
+    let errors = manufactured_errors().unwrap();
+    for order in orders(&errors) {
+        assert!(
+            order >= PLANE_HEAT_ORDER_MIN,
+            "errors {errors:?}: order {order}"
         );
-        let scene = PlaneScene::from_toml(&text, &[]).unwrap();
-        let (_, sim) = run(&scene);
-        // The state at t_N holds θ^{N−1/2}.
-        let t = 0.4 - dt / 2.0;
-        let body: &PlaneBody = sim.body();
-        let pi = std::f64::consts::PI;
-        let error = (0..body.nodes())
-            .map(|node| {
-                let (x, y) = body.point(node);
-                let exact = (1.0 + t) * (pi * x).sin() * (pi * y.unwrap()).sin();
-                (body.temperature(sim.displacement(), node).unwrap() - exact).abs()
-            })
-            .fold(0.0, f64::max);
-        errors.push(error);
-    }
-    for pair in errors.windows(2) {
-        let order = (pair[0] / pair[1]).log2();
-        assert!(order >= MIN_ORDER, "errors {errors:?}: order {order}");
     }
 }
 
@@ -279,4 +159,26 @@ fn bad_heat_keys_are_refused_naming_the_key() {
         &out,
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A block resting on a floor that takes its heat, `−κ ∂θ/∂n = h θ` while in contact
+/// (insulated elsewhere, `θ^0 = 1`): uniform in `x`, its temperature is the bar's exchange
+/// problem in `y`, whose slowest mode decays at `κμ²`, `μ tan μH = h/κ`; the exchange term of
+/// the identity is the heat the floor takes.
+#[test]
+fn an_exchanging_floor_takes_the_heat_at_the_slowest_rate() {
+    let (error, exchanging) = exchange_decay().unwrap();
+    assert!(exchanging, "every step gives heat to the floor");
+    assert!(error <= PLANE_DECAY_RATE_TOL, "decay rate off by {error:e}");
+}
+
+/// An edge held at 1 from `t = 0` on a body at 0, square cells, `κΔt/h²` = 0.5, 5 and 100 (the
+/// bar's range): the implicit start keeps θ within the data's range [0, 1] at every node and
+/// step. (The step resolves the body's slowest mode, `κΔt/W² <= 0.04`: Crank–Nicolson
+/// alternates the sign of every mode with `κλΔt > 2`, so a step longer than the whole body's
+/// diffusion time rings whatever the start.)
+#[test]
+fn a_sudden_edge_temperature_keeps_theta_within_the_datas_range() {
+    let excursion = sudden_edge_excursion().unwrap();
+    assert!(excursion <= PLANE_MAX_PRINCIPLE_TOL, "{excursion:e}");
 }

@@ -40,7 +40,7 @@ const TWIN_TOL: f64 = 1e-10;
 const FRICTIONLESS_TOL: f64 = 1e-10;
 /// A closed body's heat content against its frictional heating, per step, relative to the
 /// largest content: sums of a few hundred products and a backward-stable solve.
-const HEAT_BALANCE_TOL: f64 = 1e-12;
+const CLOSED_BODY_HEAT_TOL: f64 = 1e-12;
 
 /// The plane's condensed exact solver takes `z` from a second solve with the reactions, without
 /// writing an active node onto its bound: its gap is that solve's forward error, measured up to
@@ -397,7 +397,7 @@ fn plane_relations(d: &PlaneDraw, records: &[StepRecord], u: &[f64]) -> Result<(
             let h = r.heat.unwrap();
             let gap = (h.heat_content - before - h.frictional_heating).abs();
             prop_assert!(
-                gap <= HEAT_BALANCE_TOL * largest.max(f64::MIN_POSITIVE),
+                gap <= CLOSED_BODY_HEAT_TOL * largest.max(f64::MIN_POSITIVE),
                 "heat balance, step {}: {gap:e}\n{text}",
                 r.step
             );

@@ -4,6 +4,7 @@
 //! - [`bar`]: the stiff case matrix, the rigid mode's round-off, mass variants, viscous contact;
 //! - [`plane`]: the plane body, its contact, symmetry, locking, moving obstacles (both bodies);
 //! - [`friction`]: plane friction and its rigid-limit closed forms; [`thermal`]: the thermal bar;
+//!   [`plane_heat`]: the plane body's temperature;
 //! - [`solvers`]: the step solvers' agreement, the dense brute-force oracle, contact at scale;
 //! - [`tolerances`]: the registry, every tolerance of the tests against the worst value it guards;
 //! - [`performance`]: error against run time, the READMEs' benches and peak memory.
@@ -17,6 +18,7 @@ pub mod bar;
 pub mod friction;
 pub mod performance;
 pub mod plane;
+pub mod plane_heat;
 pub mod solvers;
 pub mod thermal;
 pub mod tolerances;

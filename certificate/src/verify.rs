@@ -68,7 +68,7 @@ fn keep<'a, T: Send + Sync>(
 pub fn sections() -> Result<Vec<Section>, ConvergeError> {
     let stiff = OnceLock::new();
     let drift = OnceLock::new();
-    let registry: [OnceLock<Vec<crate::tolerances::Measured>>; 4] = Default::default();
+    let registry: [OnceLock<Vec<crate::tolerances::Measured>>; 5] = Default::default();
     let backward = OnceLock::new();
     let jobs: Vec<Job> = vec![
         // The longest first.
@@ -83,6 +83,9 @@ pub fn sections() -> Result<Vec<Section>, ConvergeError> {
         keep(&registry[1], || Ok(crate::tolerances::plane_measured()?)),
         keep(&registry[2], || Ok(crate::tolerances::friction_measured()?)),
         keep(&registry[3], || Ok(crate::tolerances::thermal_measured()?)),
+        keep(&registry[4], || {
+            Ok(crate::tolerances::plane_heat_measured()?)
+        }),
         job("solver-agreement", || Ok(agreement::markdown()?)),
         job("plane-contact", crate::plane::contact::markdown),
         Box::new(|| Ok(vec![convergence_section()?, falling_bar_section()?])),
@@ -98,6 +101,7 @@ pub fn sections() -> Result<Vec<Section>, ConvergeError> {
         job("locking", || Ok(crate::plane::locking::markdown()?)),
         job("moving", || Ok(crate::plane::moving::markdown()?)),
         job("thermal", || Ok(crate::thermal::markdown()?)),
+        job("plane-heat", || Ok(crate::plane_heat::markdown()?)),
     ];
     let mut out = run_jobs(jobs)?;
     let (stiff, drift) = (stiff.get().expect("kept"), *drift.get().expect("kept"));

@@ -1,7 +1,7 @@
 //! The profile file of a run, for either body: at each kept step, one row per written node,
 //! its time, coordinates, displacement and velocity (`t,x,u,v` on the bar's line,
 //! `t,x,y,ux,uy,vx,vy` on the plane; 0 at clamped degrees of freedom; the velocity is the
-//! scheme's `(u^n − u^{n−1})/Δt` at `t_{n−1/2}`; a bar with a temperature adds `theta`, the
+//! scheme's `(u^n − u^{n−1})/Δt` at `t_{n−1/2}`; a body with a temperature adds `theta`, the
 //! scheme's `θ^{n−1/2}`). `displacement.csv` in text, or
 //! `displacement.npy` (cargo feature `npy`), sampled as [`OutputSampling`] says.
 
@@ -33,6 +33,8 @@ pub fn columns(components: usize, theta: bool) -> &'static [&'static str] {
         &["t", "x", "u", "v", "theta"]
     } else if components == 1 {
         &["t", "x", "u", "v"]
+    } else if theta {
+        &["t", "x", "y", "ux", "uy", "vx", "vy", "theta"]
     } else {
         &["t", "x", "y", "ux", "uy", "vx", "vy"]
     }
@@ -51,6 +53,8 @@ enum Writer {
     LineTheta(crate::output::npy::ProfileNpy<5>, Vec<[f64; 2]>),
     #[cfg(feature = "npy")]
     Plane(crate::output::npy::ProfileNpy<7>, Vec<[f64; 2]>),
+    #[cfg(feature = "npy")]
+    PlaneTheta(crate::output::npy::ProfileNpy<8>, Vec<[f64; 2]>),
 }
 
 /// The profile file's writer.
@@ -110,8 +114,10 @@ impl Profiles {
                 use crate::output::npy::ProfileNpy;
                 let points = nodes.iter().map(|&i| rounded(i)).collect();
                 let cols = columns(components, theta);
-                if theta {
+                if theta && components == 1 {
                     Writer::LineTheta(ProfileNpy::new(file, cols, sampling.rows)?, points)
+                } else if theta {
+                    Writer::PlaneTheta(ProfileNpy::new(file, cols, sampling.rows)?, points)
                 } else if components == 1 {
                     Writer::Line(ProfileNpy::new(file, cols, sampling.rows)?, points)
                 } else {
@@ -203,6 +209,14 @@ impl Profiles {
                     npy.push([t, p[0], p[1], ux, uy, vx, vy])?;
                 }
             }
+            #[cfg(feature = "npy")]
+            Writer::PlaneTheta(npy, points) => {
+                let t = output_time(t);
+                for (j, p) in points.iter().enumerate() {
+                    let ((ux, vx), (uy, vy)) = (value(2 * j), value(2 * j + 1));
+                    npy.push([t, p[0], p[1], ux, uy, vx, vy, theta(j)])?;
+                }
+            }
         }
         Ok(())
     }
@@ -217,6 +231,8 @@ impl Profiles {
             Writer::LineTheta(npy, _) => npy.finish(),
             #[cfg(feature = "npy")]
             Writer::Plane(npy, _) => npy.finish(),
+            #[cfg(feature = "npy")]
+            Writer::PlaneTheta(npy, _) => npy.finish(),
         }
     }
 

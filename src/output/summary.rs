@@ -215,7 +215,8 @@ impl Tracker {
             iterations_sum: 0,
             iterations_max: 0,
             records: 0,
-            friction: (!sim.contact().friction().is_empty()).then_some(0.0),
+            // The start-up's D_f (friction acts from the first step) opens the sum.
+            friction: (!sim.contact().friction().is_empty()).then_some(first.friction_dissipation),
             certificate: Certificate::new(),
             started: std::time::Instant::now(),
         };

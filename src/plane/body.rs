@@ -185,10 +185,15 @@ impl Body for PlaneBody {
     fn identity_tolerance(&self) -> f64 {
         let m = self.disc.material;
         let volumetric = LAMBDA_IDENTITY_ULPS * f64::EPSILON * m.lambda / m.mu;
+        // A temperature adds its nodes' sums and its heat step's `κΔt/h²`.
+        let (nodes, ratio) = self
+            .heat
+            .as_ref()
+            .map_or((0, 0.0), |h| (self.disc.grid.nodes(), h.diffusion_ratio()));
         conditioned_bound(
             PLANE_IDENTITY_TOL + volumetric,
-            self.unknowns(),
-            self.condition,
+            self.unknowns() + nodes,
+            self.condition + ratio,
         )
     }
 
@@ -483,6 +488,29 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
         }
         None => None,
     };
+    if let Some(h) = &heat {
+        let bound = conditioned_bound(
+            PLANE_IDENTITY_TOL,
+            disc.unknowns() + disc.grid.nodes(),
+            condition + h.diffusion_ratio(),
+        );
+        if bound > MAX_IDENTITY_BOUND {
+            return Err(SceneError::Invalid {
+                field: "heat.diffusivity".into(),
+                value: scene
+                    .heat
+                    .as_ref()
+                    .map_or(0.0, |t| t.diffusivity)
+                    .to_string(),
+                allowed: format!(
+                    "a heat step with κΔt/h² = {:.1e} holds the energy identity only to \
+                     {bound:.1e}, above {MAX_IDENTITY_BOUND:e}: take a smaller diffusivity or step",
+                    h.diffusion_ratio()
+                ),
+            }
+            .into());
+        }
+    }
     let body = PlaneBody {
         heat,
         normals,

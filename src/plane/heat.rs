@@ -12,7 +12,6 @@ use crate::linalg::sparse::Pattern;
 use crate::plane::mesh::Grid;
 use crate::plane::normals::Normal;
 use crate::scene::expr::Expression;
-use crate::scene::plane::EDGE_NAMES;
 use crate::scene::plane_heat::{EdgeHeat, PlaneHeatExpressions};
 use crate::scheme::body::{HeatOutputs, HeatTerms};
 use crate::scheme::{RunError, in_contact};
@@ -49,6 +48,8 @@ struct StepFactor {
 pub struct PlaneHeat {
     kappa: f64,
     dt: f64,
+    /// The least cell side.
+    least_side: f64,
     /// Scalar Q1 mass and stiffness on every node (one pattern).
     pattern: Pattern,
     mass: Vec<f64>,
@@ -132,6 +133,21 @@ fn assemble(grid: &Grid, pattern: &Pattern) -> (Vec<f64>, Vec<f64>) {
     (mass, stiffness)
 }
 
+/// The keys the step's data are read from, `heat.<edge>.value` and `heat.<edge>.obstacle`
+/// (an error names them; the step allocates nothing).
+const VALUE_KEYS: [&str; 4] = [
+    "heat.left.value",
+    "heat.right.value",
+    "heat.bottom.value",
+    "heat.top.value",
+];
+const OBSTACLE_KEYS: [&str; 4] = [
+    "heat.left.obstacle",
+    "heat.right.obstacle",
+    "heat.bottom.obstacle",
+    "heat.top.obstacle",
+];
+
 /// `f` finite, or the error naming `key`.
 fn finite(v: f64, key: &str) -> Result<f64, RunError> {
     if v.is_finite() {
@@ -202,14 +218,14 @@ impl PlaneHeat {
         let mut start_jump = false;
         for (edge, value) in values.iter().enumerate() {
             let Some(value) = value else { continue };
-            let key = format!("heat.{}.value", EDGE_NAMES[edge]);
+            let key = VALUE_KEYS[edge];
             for node in 0..nodes {
                 if !on_edge(grid, node, edge) || held[node] {
                     continue;
                 }
                 held[node] = true;
                 let s = edge_coordinate(grid, node, edge);
-                let v0 = finite(value.eval(s, 0.0)?, &key)?;
+                let v0 = finite(value.eval(s, 0.0)?, key)?;
                 start_jump |= starts_with_a_jump(old[node], v0);
                 fixed.push(FixedNode { node, edge, s });
             }
@@ -241,9 +257,13 @@ impl PlaneHeat {
             .collect();
         let source_load = vec![0.0; if source.is_some() { nodes } else { 0 }];
         let n_free = free.len();
+        let sides = (grid.xs.windows(2))
+            .chain(grid.ys.windows(2))
+            .map(|p| p[1] - p[0]);
         Ok(Self {
             kappa: diffusivity,
             dt,
+            least_side: sides.fold(f64::INFINITY, f64::min),
             values_full: vec![0.0; pattern.nnz()],
             values_reduced: vec![0.0; reduced.nnz()],
             pattern,
@@ -276,6 +296,12 @@ impl PlaneHeat {
             unknown: vec![0.0; n_free],
             terms: HeatTerms::default(),
         })
+    }
+
+    /// `κΔt/h²`, `h` the least cell side: the heat step's conditioning, part of the identity's
+    /// round-off bound.
+    pub fn diffusion_ratio(&self) -> f64 {
+        self.kappa * self.dt / (self.least_side * self.least_side)
     }
 
     /// The latest temperature at `node`: `θ^{n−1/2}` while the scheme holds `u^n` (`θ^0`
@@ -323,8 +349,7 @@ impl PlaneHeat {
         let t = n as f64 * self.dt;
         for (k, e) in self.exchange_edges.iter().enumerate() {
             if let Some((_, obstacle)) = e {
-                let key = format!("heat.{}.obstacle", EDGE_NAMES[k]);
-                self.theta_obs[k] = finite(obstacle.eval(0.0, t)?, &key)?;
+                self.theta_obs[k] = finite(obstacle.eval(0.0, t)?, OBSTACLE_KEYS[k])?;
             }
         }
         // An exchange switching on or off (on at t = 0: in contact from the start) is a jump
@@ -344,8 +369,7 @@ impl PlaneHeat {
                 if !value.depends_on_t() {
                     continue;
                 }
-                let key = format!("heat.{}.value", EDGE_NAMES[f.edge]);
-                let at = |t: f64| finite(value.eval(f.s, t)?, &key);
+                let at = |t: f64| finite(value.eval(f.s, t)?, VALUE_KEYS[f.edge]);
                 let (a, b) = (at(t_old)?, at(t_new)?);
                 jump |= jumps_within(at, (t_old, t_new), (a, b))?;
                 if jump {
@@ -434,11 +458,10 @@ impl PlaneHeat {
         // θ^{n+1/2} at the held nodes; the others start from θ^{n−1/2}.
         self.new.copy_from_slice(&self.old);
         for f in &self.fixed {
-            let key = format!("heat.{}.value", EDGE_NAMES[f.edge]);
             let value = self.values[f.edge]
                 .as_ref()
                 .expect("a held edge has a value");
-            self.new[f.node] = finite(value.eval(f.s, t_new)?, &key)?;
+            self.new[f.node] = finite(value.eval(f.s, t_new)?, VALUE_KEYS[f.edge])?;
         }
         // The source Q = M q(·, t_n) and the frictional heat q_j = η_j d_j.
         if let Some(source) = &self.source {

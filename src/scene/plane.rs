@@ -6,6 +6,7 @@
 
 use crate::scene::error::invalid;
 use crate::scene::expr::Expression;
+use crate::scene::heat::ThermalCondition;
 use crate::scene::output::{OutputSampling, OutputSpec};
 use crate::scene::schema::{
     GIB, MAX_STEPS, Scene, Time, available_memory_bytes, check_time_grid, number_or_expression,
@@ -41,9 +42,10 @@ pub struct PlaneScene {
     /// The bar's `[output]` table, keys and defaults.
     #[serde(default)]
     pub output: OutputSpec,
-    /// The temperature (`[heat]`, [`crate::scene::plane_heat`]); absent: the body has none.
+    /// The temperature (`[heat]`, checked by `crate::scene::plane_heat`); absent: the body
+    /// has none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub heat: Option<crate::scene::plane_heat::PlaneHeat>,
+    pub heat: Option<PlaneHeat>,
 }
 
 /// The `[plane]` table: geometry and material.
@@ -171,6 +173,66 @@ impl EdgeSpec {
 
 fn optional_expression<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
     number_or_expression(d).map(Some)
+}
+
+/// `[heat]` of a plane scene.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneHeat {
+    /// `γ`: the thermal stress `−γ θ I` and the heating `γ div u_t`; 0 on the plane body.
+    pub coupling: f64,
+    /// `κ > 0`.
+    pub diffusivity: f64,
+    /// `θ(x, y, 0)` (default 0).
+    #[serde(default = "zero_text", deserialize_with = "number_or_expression")]
+    pub temperature: String,
+    /// `q(x, y, t)` (default: no source).
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "optional_expression"
+    )]
+    pub source: Option<String>,
+    #[serde(default)]
+    pub left: ThermalEdge,
+    #[serde(default)]
+    pub right: ThermalEdge,
+    #[serde(default)]
+    pub bottom: ThermalEdge,
+    #[serde(default)]
+    pub top: ThermalEdge,
+}
+
+fn zero_text() -> String {
+    "0".to_string()
+}
+
+/// `heat.<edge>`: its thermal condition and, on a frictional edge, `frictional_heating`.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThermalEdge {
+    #[serde(default)]
+    pub condition: ThermalCondition,
+    /// `θ_edge(s, t)` of a `temperature` edge.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "optional_expression"
+    )]
+    pub value: Option<String>,
+    /// `h >= 0` of an `exchange` edge.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coefficient: Option<f64>,
+    /// `θ_obs(t)` of an `exchange` edge (default 0).
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "optional_expression"
+    )]
+    pub obstacle: Option<String>,
+    /// `η`, the share of the edge's friction dissipation put into the body (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frictional_heating: Option<f64>,
 }
 
 /// The edges in the order `left, right, bottom, top` ([`Edges::all`]).

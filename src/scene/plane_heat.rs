@@ -1,4 +1,4 @@
-//! The `[heat]` table of a plane scene: the temperature deviation `θ` of the plane body,
+//! Checks the `[heat]` table of a plane scene ([`crate::scene::plane::PlaneHeat`]): the temperature
 //! `θ_t − κ Δθ = q` (the coupling `γ` to the displacement must be 0 on the plane), its initial
 //! value (an expression in `x`, `y`), source (in `x`, `y`, `t`), and per edge (`left`, `right`,
 //! `bottom`, `top`) the bar's thermal conditions: insulated (the default), a fixed temperature
@@ -9,74 +9,9 @@
 
 use crate::scene::SceneError;
 use crate::scene::error::invalid;
-use crate::scene::expr::{Expression, number_or_expression};
+use crate::scene::expr::Expression;
 use crate::scene::heat::ThermalCondition;
-use crate::scene::plane::{EDGE_NAMES, EdgeCondition, Edges};
-use serde::{Deserialize, Serialize};
-
-/// `[heat]` of a plane scene.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PlaneHeat {
-    /// `γ`: the thermal stress `−γ θ I` and the heating `γ div u_t`; 0 on the plane body.
-    pub coupling: f64,
-    /// `κ > 0`.
-    pub diffusivity: f64,
-    /// `θ(x, y, 0)` (default 0).
-    #[serde(default = "zero", deserialize_with = "number_or_expression")]
-    pub temperature: String,
-    /// `q(x, y, t)` (default: no source).
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "optional_expression"
-    )]
-    pub source: Option<String>,
-    #[serde(default)]
-    pub left: ThermalEdge,
-    #[serde(default)]
-    pub right: ThermalEdge,
-    #[serde(default)]
-    pub bottom: ThermalEdge,
-    #[serde(default)]
-    pub top: ThermalEdge,
-}
-
-fn zero() -> String {
-    "0".to_string()
-}
-
-fn optional_expression<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
-    number_or_expression(d).map(Some)
-}
-
-/// `heat.<edge>`: its thermal condition and, on a frictional edge, `frictional_heating`.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ThermalEdge {
-    #[serde(default)]
-    pub condition: ThermalCondition,
-    /// `θ_edge(s, t)` of a `temperature` edge.
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "optional_expression"
-    )]
-    pub value: Option<String>,
-    /// `h >= 0` of an `exchange` edge.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub coefficient: Option<f64>,
-    /// `θ_obs(t)` of an `exchange` edge (default 0).
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        deserialize_with = "optional_expression"
-    )]
-    pub obstacle: Option<String>,
-    /// `η`, the share of the edge's friction dissipation put into the body (default 1).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub frictional_heating: Option<f64>,
-}
+use crate::scene::plane::{EDGE_NAMES, EdgeCondition, Edges, PlaneHeat, ThermalEdge};
 
 /// The parsed condition of one edge.
 #[derive(Clone, Debug)]

@@ -151,6 +151,8 @@ pub fn friction_check(name: &str, scene: &PlaneScene) -> Result<FrictionCheck, C
         name: name.to_string(),
         steps: scene.steps(),
         min_dissipation_ratio: f64::INFINITY,
+        // Friction acts from the start-up step: its D_f opens the sum.
+        total_dissipation: sim.first_record().friction_dissipation,
         ..Default::default()
     };
     let (mut acc, mut mass_abs) = (vec![0.0; n], vec![0.0; n]);

@@ -9,6 +9,7 @@
 mod friction;
 mod matrices;
 mod plane;
+mod plane_heat;
 mod random_problems;
 mod scanner;
 mod scenes;
@@ -18,6 +19,7 @@ mod thermal;
 pub use friction::*;
 pub use matrices::*;
 pub use plane::*;
+pub use plane_heat::*;
 pub use random_problems::*;
 pub use scenes::*;
 pub use solvers::*;
@@ -589,6 +591,7 @@ pub fn registry_markdown(
     measured.extend(plane_measured()?);
     measured.extend(friction_measured()?);
     measured.extend(thermal_measured()?);
+    measured.extend(plane_heat_measured()?);
     Ok(registry_markdown_of(
         measured,
         results,
@@ -598,8 +601,8 @@ pub fn registry_markdown(
 }
 
 /// [`registry_markdown`] from the measurements `measured` (those of [`measured`],
-/// [`plane_measured`], [`friction_measured`] and [`thermal_measured`], in that order) taken
-/// apart.
+/// [`plane_measured`], [`friction_measured`], [`thermal_measured`] and
+/// [`plane_heat_measured`], in that order) taken apart.
 pub fn registry_markdown_of(
     mut measured: Vec<Measured>,
     results: &[CaseResult],

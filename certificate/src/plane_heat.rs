@@ -1,0 +1,351 @@
+//! The plane body's temperature (`[heat]`, uncoupled): the heat balance of a frictional launch
+//! at every step, its uniform end temperature, a block on a belt against its closed-form flux
+//! and edge temperature, an exchanging floor's decay rate, a sudden edge temperature's range and
+//! the heat step's orders. `tests/plane_heat.rs` asserts each against its tolerance
+//! ([`crate::tolerances`]); [`markdown`] is VERIFICATION.md's generated table. Derivations:
+//! docs/thermal.md, "The plane body".
+
+use std::fmt::Write;
+use viscobar::output::run_plane_in_memory;
+use viscobar::plane::{PlaneBody, PlaneSimulation};
+use viscobar::scheme::{Body, RunError};
+use viscobar::{PlaneScene, StepRecord};
+
+/// The frictional launch (`scenes/plane-friction-launch.toml`).
+pub const LAUNCH: &str = include_str!("../../scenes/plane-friction-launch.toml");
+
+/// The launch with `[heat]` (`heat` the table's lines) and `overrides`.
+pub fn launch_with_heat(heat: &str, overrides: &[&str]) -> PlaneScene {
+    let text = format!("{LAUNCH}\n[heat]\n{heat}\n");
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    PlaneScene::from_toml(&text, &overrides).expect("a valid scene")
+}
+
+/// The records and the simulation of a certified run of `scene`.
+pub fn run(scene: &PlaneScene) -> Result<(Vec<StepRecord>, PlaneSimulation), RunError> {
+    let (records, _, sim) = run_plane_in_memory("plane-heat", scene)?;
+    Ok((records, sim))
+}
+
+fn theta(sim: &PlaneSimulation, node: usize) -> f64 {
+    let body: &PlaneBody = sim.body();
+    body.temperature(sim.displacement(), node)
+        .expect("a temperature")
+}
+
+/// The heat balance of the launch with `frictional_heating = eta` on its floor: the worst
+/// `|Δ(1ᵀMθ) − Σ q|` over the steps, relative to the largest heat content, and `Σ D_f`.
+pub fn heat_balance(eta: f64) -> Result<(f64, f64), RunError> {
+    let scene = launch_with_heat(
+        &format!("coupling = 0\ndiffusivity = 0.1\nbottom = {{ frictional_heating = {eta:?} }}"),
+        &[],
+    );
+    let (records, _) = run(&scene)?;
+    let heat = |r: &StepRecord| r.heat.expect("a temperature");
+    let largest = (records.iter())
+        .map(|r| heat(r).heat_content.abs())
+        .fold(0.0, f64::max);
+    let (mut before, mut worst, mut total) = (0.0, 0.0f64, 0.0);
+    for r in &records {
+        let h = heat(r);
+        worst = worst.max((h.heat_content - before - h.frictional_heating).abs() / largest);
+        before = h.heat_content;
+        total += r.friction_dissipation;
+    }
+    Ok((worst, total))
+}
+
+/// The launch, insulated (`κ = 1`), run to `t = 8`: the worst relative deviation of θ from the
+/// uniform `Σ D_f / (W H)`, and whether the block has stopped.
+pub fn uniform_end() -> Result<(f64, bool), RunError> {
+    let scene = launch_with_heat("coupling = 0\ndiffusivity = 1.0", &["time.end=8"]);
+    let (records, sim) = run(&scene)?;
+    let work: f64 = records.iter().map(|r| r.friction_dissipation).sum();
+    let expected = work / (scene.plane.width * scene.plane.height);
+    let worst = (0..sim.body().nodes())
+        .map(|node| (theta(&sim, node) - expected).abs() / expected)
+        .fold(0.0, f64::max);
+    let stopped = records.last().is_some_and(|r| r.slip_nodes == 0);
+    Ok((worst, stopped))
+}
+
+/// The belt's friction coefficient, speed and the diffusivity.
+pub const BELT: (f64, f64, f64) = (0.5, 1.0, 1.0);
+
+/// A block (1 × 0.5, `ρ g = 1`) on a belt moving at `−v` under it, dragged against a
+/// frictionless wall at its left edge, its top held at θ = 0.
+pub fn belt_scene() -> PlaneScene {
+    let (mu, v, kappa) = BELT;
+    let text = format!(
+        r#"
+[plane]
+width = 1.0
+height = 0.5
+lambda = 100.0
+mu = 100.0
+viscosity = 0.05
+
+[edges]
+left = {{ condition = "signorini", gap = 0 }}
+bottom = {{ condition = "signorini", gap = 0, friction = {mu}, velocity = "-{v}" }}
+
+[load]
+density = ["0", "-1"]
+
+[mesh]
+nx = 8
+ny = 4
+
+[time]
+step = 0.01
+end = 6.0
+
+[heat]
+coupling = 0
+diffusivity = {kappa}
+top = {{ condition = "temperature", value = 0 }}
+"#
+    );
+    PlaneScene::from_toml(&text, &[]).expect("a valid scene")
+}
+
+/// The belt at its end: `p` (the frictional nodes' mean pressure, `|Σ r_T| / (μ W)`), the
+/// relative deviation of the frictional heat flux from `μ p v`, of the bottom's edge-mean
+/// temperature from `flux H / κ`, and whether a frictional node sticks.
+pub fn belt() -> Result<[f64; 4], RunError> {
+    let (mu, v, kappa) = BELT;
+    let scene = belt_scene();
+    let (records, sim) = run(&scene)?;
+    let last = records.last().expect("a step");
+    let (w, h, dt) = (scene.plane.width, scene.plane.height, scene.time.step);
+    let flux = last.heat.expect("a temperature").frictional_heating / dt / w;
+    let tangential: f64 = last
+        .contact
+        .groups
+        .iter()
+        .map(|g| g.tangential_reaction)
+        .sum();
+    let p = tangential.abs() / (mu * w);
+    let [nx, _] = sim.body().lattice();
+    let hx = w / (nx - 1) as f64;
+    let mean: f64 = (0..nx)
+        .map(|i| {
+            let weight = if i == 0 || i == nx - 1 { hx / 2.0 } else { hx };
+            weight * theta(&sim, i) / w
+        })
+        .sum();
+    let expected = flux * h / kappa;
+    Ok([
+        p,
+        (flux - mu * p * v).abs() / (mu * p * v),
+        (mean - expected).abs() / expected,
+        last.stick_nodes as f64,
+    ])
+}
+
+/// The manufactured solution's levels `(cells per side, Δt)`.
+pub const MANUFACTURED_LEVELS: [(u64, f64); 3] = [(4, 0.04), (8, 0.02), (16, 0.01)];
+
+/// `θ = (1 + t) sin πx sin πy` on the unit square, held at 0 on every edge, with its source:
+/// the nodal error at the last half step, per level of [`MANUFACTURED_LEVELS`].
+pub fn manufactured_errors() -> Result<Vec<f64>, RunError> {
+    let kappa = 0.5;
+    let mut errors = Vec::new();
+    for (n, dt) in MANUFACTURED_LEVELS {
+        let text = format!(
+            r#"
+[plane]
+width = 1.0
+height = 1.0
+lambda = 1.0
+mu = 1.0
+
+[mesh]
+nx = {n}
+ny = {n}
+
+[time]
+step = {dt}
+end = 0.4
+
+[heat]
+coupling = 0
+diffusivity = {kappa}
+temperature = "sin(pi*x)*sin(pi*y)"
+source = "sin(pi*x)*sin(pi*y)*(1 + 2*pi*pi*{kappa}*(1 + t))"
+left = {{ condition = "temperature", value = 0 }}
+right = {{ condition = "temperature", value = 0 }}
+bottom = {{ condition = "temperature", value = 0 }}
+top = {{ condition = "temperature", value = 0 }}
+"#
+        );
+        let scene = PlaneScene::from_toml(&text, &[]).expect("a valid scene");
+        let (_, sim) = run(&scene)?;
+        // The state at t_N holds θ^{N−1/2}.
+        let t = 0.4 - dt / 2.0;
+        let pi = std::f64::consts::PI;
+        let error = (0..sim.body().nodes())
+            .map(|node| {
+                let (x, y) = sim.body().point(node);
+                let exact = (1.0 + t) * (pi * x).sin() * (pi * y.unwrap_or(0.0)).sin();
+                (theta(&sim, node) - exact).abs()
+            })
+            .fold(0.0, f64::max);
+        errors.push(error);
+    }
+    Ok(errors)
+}
+
+/// The observed orders between successive levels.
+pub fn orders(errors: &[f64]) -> Vec<f64> {
+    errors.windows(2).map(|p| (p[0] / p[1]).log2()).collect()
+}
+
+/// A block resting on a floor that takes its heat (`κ = 1`, `h = 2`, `H = 0.5`, `θ^0 = 1`):
+/// the decay rate of its heat content between `t = 0.6` and `t = 1` against `κμ²`,
+/// `μ tan μH = h/κ` (bisection), relative; and whether every step gave heat to the floor.
+pub fn exchange_decay() -> Result<(f64, bool), RunError> {
+    let (kappa, h, height) = (1.0, 2.0, 0.5);
+    let text = format!(
+        r#"
+[plane]
+width = 0.25
+height = {height}
+lambda = 100.0
+mu = 100.0
+viscosity = 0.5
+
+[edges]
+bottom = {{ condition = "signorini", gap = 0 }}
+
+[load]
+density = ["0", "-1"]
+
+[mesh]
+nx = 2
+ny = 32
+
+[time]
+step = 0.005
+end = 1.0
+
+[heat]
+coupling = 0
+diffusivity = {kappa}
+temperature = "1"
+bottom = {{ condition = "exchange", coefficient = {h}, obstacle = "0" }}
+"#
+    );
+    let scene = PlaneScene::from_toml(&text, &[]).expect("a valid scene");
+    let (records, _) = run(&scene)?;
+    let f = |m: f64| m * (m * height).tan() - h / kappa;
+    let (mut a, mut b) = (1e-9, std::f64::consts::PI / (2.0 * height) - 1e-9);
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if f(m) < 0.0 {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    let mu = 0.5 * (a + b);
+    assert!(f(mu).abs() < 1e-9, "the bisection found the root");
+    let rate = kappa * mu * mu;
+    let content = |t: f64| {
+        (records.iter())
+            .find(|r| (r.time - t).abs() < 1e-9)
+            .map_or(f64::NAN, |r| r.heat.expect("a temperature").heat_content)
+    };
+    let observed = (content(0.6) / content(1.0)).ln() / 0.4;
+    let exchanging = (records.iter().skip(1)).all(|r| r.heat.is_some_and(|h| h.exchange > 0.0));
+    Ok(((observed - rate).abs() / rate, exchanging))
+}
+
+/// The diffusivities of the sudden edge temperature: `κΔt/h²` = 0.5, 5 and 100.
+pub const SUDDEN_DIFFUSIVITIES: [f64; 3] = [0.005, 0.05, 1.0];
+
+/// An edge held at 1 from `t = 0` on a body at 0 (square cells, `Δt = 0.04`): the largest
+/// excursion of θ outside [0, 1] over every node and step, for each of
+/// [`SUDDEN_DIFFUSIVITIES`].
+pub fn sudden_edge_excursion() -> Result<f64, RunError> {
+    let mut worst = 0.0f64;
+    for kappa in SUDDEN_DIFFUSIVITIES {
+        let text = format!(
+            r#"
+[plane]
+width = 1.0
+height = 0.1
+lambda = 1.0
+mu = 1.0
+
+[mesh]
+nx = 50
+ny = 5
+
+[time]
+step = 0.04
+end = 1.0
+
+[heat]
+coupling = 0
+diffusivity = {kappa}
+left = {{ condition = "temperature", value = "1" }}
+"#
+        );
+        let scene = PlaneScene::from_toml(&text, &[]).expect("a valid scene");
+        let mut sim = PlaneSimulation::new(&scene)?;
+        for _ in 1..scene.steps() {
+            sim.step()?;
+            for node in 0..sim.body().nodes() {
+                let t = theta(&sim, node);
+                worst = worst.max(-t).max(t - 1.0);
+            }
+        }
+    }
+    Ok(worst)
+}
+
+/// VERIFICATION.md's table of the plane body's temperature.
+pub fn markdown() -> Result<String, RunError> {
+    let (balance_one, work) = heat_balance(1.0)?;
+    let (balance_quarter, _) = heat_balance(0.25)?;
+    let (uniform, stopped) = uniform_end()?;
+    let [p, flux, mean, sticking] = belt()?;
+    let errors = manufactured_errors()?;
+    let orders = orders(&errors);
+    let (decay, _) = exchange_decay()?;
+    let excursion = sudden_edge_excursion()?;
+    let mut s = String::new();
+    let _ = writeln!(s, "| check | measured |\n|---|---|");
+    let _ = writeln!(
+        s,
+        "| launch (`η = 1`, `η = ¼`): worst `|Δ(1ᵀMθ) − Σ q|` per step / largest heat content | {balance_one:.1e}, {balance_quarter:.1e} (Σ D_f = {work:.4e}) |"
+    );
+    let _ = writeln!(
+        s,
+        "| launch to `t = 8`, insulated: worst relative deviation from `Σ D_f / (W H)` (block stopped: {stopped}) | {uniform:.1e} |"
+    );
+    let _ = writeln!(
+        s,
+        "| belt: `p` of the frictional nodes; flux against `μ p v`; edge-mean bottom θ against `flux H / κ` (relative; sticking nodes {sticking}) | p = {p:.6}; {flux:.1e}; {mean:.1e} |"
+    );
+    let levels: Vec<String> = (MANUFACTURED_LEVELS.iter().zip(&errors))
+        .map(|((n, dt), e)| format!("{n} × {n}, Δt = {dt}: {e:.3e}"))
+        .collect();
+    let orders: Vec<String> = orders.iter().map(|o| format!("{o:.2}")).collect();
+    let _ = writeln!(
+        s,
+        "| manufactured θ: nodal error per level; observed orders | {}; {} |",
+        levels.join(", "),
+        orders.join(", ")
+    );
+    let _ = writeln!(
+        s,
+        "| exchanging floor: decay rate against `κμ²`, relative | {decay:.1e} |"
+    );
+    let _ = writeln!(
+        s,
+        "| sudden edge temperature, `κΔt/h²` = 0.5, 5, 100: largest excursion outside [0, 1] | {excursion:.1e} |"
+    );
+    Ok(s)
+}
