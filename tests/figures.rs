@@ -180,6 +180,11 @@ fn expected_files() -> Vec<(String, (u32, u32))> {
             files.push((format!("{scene}.{ext}"), figures::FRICTION_FIGURE_SIZE));
         }
     }
+    for scene in figures::HEAT_FIGURES {
+        for ext in ["png", "svg"] {
+            files.push((format!("{scene}.{ext}"), figures::HEAT_FIGURE_SIZE));
+        }
+    }
     files
 }
 
@@ -233,6 +238,18 @@ fn figures_command_writes_every_talk_figure_reproducibly() {
                 "state (white open, blue stick",
                 "normal pressure",
                 "traction",
+            ] {
+                assert!(svg.contains(needle), "{name}: lacks `{needle}`");
+            }
+            continue;
+        }
+        if figures::HEAT_FIGURES.iter().any(|f| name.starts_with(f)) {
+            // The field at the end, the edge's state and θ over (s, t), one colour bar.
+            for needle in [
+                "temperature θ over the body",
+                "bottom edge: state (white open, blue stick",
+                "bottom edge: temperature θ",
+                "temperature θ (dark: cold)",
             ] {
                 assert!(svg.contains(needle), "{name}: lacks `{needle}`");
             }
@@ -323,7 +340,8 @@ fn docs_figures_are_the_pngs_the_command_writes() {
     let readme =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
     assert!(readme.contains("`cargo run --release -- figures --out docs/figures`"));
-    for scene in figures::talk_scenes().chain(figures::FRICTION_FIGURES.iter().copied()) {
+    let drawn = (figures::FRICTION_FIGURES.iter()).chain(figures::HEAT_FIGURES);
+    for scene in figures::talk_scenes().chain(drawn.copied()) {
         let link = format!("(docs/figures/{scene}.png)");
         assert!(readme.contains(&link), "README does not show {scene}");
     }

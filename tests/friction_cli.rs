@@ -85,6 +85,31 @@ fn run_figure_draws_the_stick_slip_state_and_the_forces() {
         let len = std::fs::metadata(out.join(f)).unwrap().len();
         assert!(len > MIN_FIGURE_BYTES, "{f}: {len} bytes");
     }
+    assert!(!out.join("temperature.png").exists(), "no [heat], no θ");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// With `[heat]`, `--figure` adds the temperature: the field and the edge over `(s, t)`.
+#[test]
+fn run_figure_draws_the_temperature_of_a_scene_with_heat() {
+    let out = fresh_dir("heat-figure");
+    let o = viscobar(&[
+        "run",
+        "plane-brake",
+        "--out",
+        out.to_str().unwrap(),
+        "--figure",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["temperature.png", "temperature.svg", "friction-state.png"] {
+        let len = std::fs::metadata(out.join(f)).unwrap().len();
+        assert!(len > MIN_FIGURE_BYTES, "{f}: {len} bytes");
+    }
+    let svg = std::fs::read_to_string(out.join("temperature.svg")).unwrap();
+    assert!(
+        svg.contains("plane-brake: temperature θ at t = 2.995"),
+        "title"
+    );
     let _ = std::fs::remove_dir_all(&out);
 }
 

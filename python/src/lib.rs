@@ -324,7 +324,7 @@ impl Run {
     }
 
     /// The temperature `θ^{n−1/2}` at the kept steps and written nodes, shape `(kept steps,
-    /// nodes)`, for a bar with `[heat]`; None otherwise.
+    /// nodes)`, for a bar or a plane with `[heat]`; None otherwise.
     #[getter]
     fn theta(&self, py: Python<'_>) -> Option<Py<PyAny>> {
         self.theta.as_ref().map(|t| t.clone_ref(py))

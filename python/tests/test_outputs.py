@@ -1,5 +1,6 @@
 """The arrays and files of `viscobar.run` against the command line's files for the same scene
-and keys, bit for bit, on a bar, a plane, a plane with friction and a thermal bar."""
+and keys, bit for bit, on a bar, a plane, a plane with friction, a thermal bar and a plane with
+a temperature."""
 
 import filecmp
 import threading
@@ -18,7 +19,12 @@ CASES = {
     "plane-tilted-drop": {"time.end": "0.3", "output.every": "3"},
     "plane-friction-tilted-drop": {"time.end": "0.3"},
     "thermal-impact": {"time.end": "0.5", "output.nodes": "21"},
+    "plane-brake": {"time.end": "0.3", "output.every": "3"},
 }
+
+#: The scenes with a temperature, and those with friction.
+HEATED = {"thermal-impact", "plane-brake"}
+FRICTIONAL = {"plane-friction-tilted-drop", "plane-brake"}
 
 
 def cli_run(scene, overrides, folder):
@@ -39,7 +45,7 @@ def test_arrays_hold_the_bits_of_the_cli_files(scene, out):
         assert same_bits(run.history[column], values), column
     assert run.history["step"].dtype == np.float64
     columns = list(run.history)
-    if scene == "plane-friction-tilted-drop":
+    if scene in FRICTIONAL:
         # The frictional floor's tangential total, beside its reaction.
         at = columns.index("reaction_bottom")
         assert columns[at + 1] == "tangential_reaction_bottom"
@@ -61,7 +67,7 @@ def test_arrays_hold_the_bits_of_the_cli_files(scene, out):
     else:
         assert same_bits(table["x"], np.tile(run.positions, kept))
         fields = {"u": run.displacement, "v": run.velocity}
-    if scene == "thermal-impact":
+    if scene in HEATED:
         assert run.theta.shape == (kept, nodes)
         fields["theta"] = run.theta
     else:

@@ -358,6 +358,7 @@ pub const PLANE_BUILTIN: &[(&str, &str)] = &[
         "plane-friction-stick-slip",
         include_str!("../../scenes/plane-friction-stick-slip.toml"),
     ),
+    ("plane-brake", include_str!("../../scenes/plane-brake.toml")),
 ];
 
 /// The TOML text of a built-in plane scene.

@@ -121,12 +121,25 @@ pub(crate) fn colour_bar<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
+    colour_bar_between(area, (0.0, top), label, colour)
+}
+
+/// [`colour_bar`] over `lo … top`.
+pub(crate) fn colour_bar_between<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (lo, top): (f64, f64),
+    label: &str,
+    colour: impl Fn(f64) -> RGBColor,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
     let mut chart = ChartBuilder::on(area)
         .margin_left(40)
         .margin_right(40)
         .margin_bottom(8)
         .x_label_area_size(30)
-        .build_cartesian_2d(0.0..top, 0.0..1.0)?;
+        .build_cartesian_2d(lo..top, 0.0..1.0)?;
     chart
         .configure_mesh()
         .disable_y_axis()
@@ -140,8 +153,8 @@ where
     let cells = 200;
     chart.draw_series((0..cells).map(|k| {
         let (a, b) = (
-            top * k as f64 / cells as f64,
-            top * (k + 1) as f64 / cells as f64,
+            lo + (top - lo) * k as f64 / cells as f64,
+            lo + (top - lo) * (k + 1) as f64 / cells as f64,
         );
         Rectangle::new([(a, 0.0), (b, 1.0)], colour(b).filled())
     }))?;

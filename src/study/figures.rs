@@ -6,7 +6,8 @@
 //! colour bar (for a bar with a temperature, `θ(x, t)` beside it on its own scale), beside the
 //! contact history. Per talk figure (`figure-<k>.png/.svg`): the `l = 0`
 //! scene beside the forced one, as the talk lays them out. Per friction figure
-//! (`<scene>.png/.svg`): the stick/slip state and forces over `(s, t)`.
+//! (`<scene>.png/.svg`): the stick/slip state and forces over `(s, t)`; per temperature
+//! figure, the plane body's `θ` at the end and along its frictional edge over `(s, t)`.
 //!
 //! Only with the `plots` feature (on by default), which brings plotters and the font.
 
@@ -18,6 +19,7 @@ use crate::scheme::RunError;
 use crate::study::figure_writer::{DrawResult, Drawing, FigureError, register_font, write_figure};
 use crate::study::friction_figure::{self, FrictionFigure};
 use crate::study::sampled_run::{ContactHistory, SampledRun, Sampling, sample_run};
+use crate::study::temperature_figure::{self, TemperatureFigure};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::element::Polygon;
@@ -52,6 +54,13 @@ pub const FRICTION_FIGURES: &[&str] = &["plane-friction-stick-slip"];
 
 /// Size of a friction figure of one frictional edge.
 pub const FRICTION_FIGURE_SIZE: (u32, u32) = friction_figure::figure_size(1);
+
+/// The plane scenes with a temperature whose `θ` `viscobar figures` also draws
+/// (`<scene>.png`/`.svg`, the figure of `run SCENE --figure`'s `temperature`).
+pub const HEAT_FIGURES: &[&str] = &["plane-brake"];
+
+/// Size of a temperature figure.
+pub const HEAT_FIGURE_SIZE: (u32, u32) = temperature_figure::FIGURE_SIZE;
 
 /// The talk scenes, figure by figure.
 pub fn talk_scenes() -> impl Iterator<Item = &'static str> {
@@ -123,6 +132,15 @@ pub fn write_talk_figures(out: &Path, overrides: &[String]) -> Result<Vec<PathBu
         let figure = FrictionFigure::run(name, &scene).map_err(run_err(name))?;
         friction.push((name, figure.expect("a frictional scene")));
     }
+    let mut heat = Vec::new();
+    for &name in HEAT_FIGURES {
+        let text = plane_builtin_text(name).expect("a built-in plane scene");
+        let scene = PlaneScene::from_toml(text, &[])
+            .map_err(RunError::from)
+            .map_err(run_err(name))?;
+        let figure = TemperatureFigure::run(name, &scene).map_err(run_err(name))?;
+        heat.push((name, figure.expect("a scene with [heat]")));
+    }
     register_font()?;
     create_folder(out)?;
     let mut written = Vec::new();
@@ -135,6 +153,9 @@ pub fn write_talk_figures(out: &Path, overrides: &[String]) -> Result<Vec<PathBu
         written.extend(write_both(out, stem, &TalkFigure::Pair(&title, pair))?);
     }
     for (name, figure) in &friction {
+        written.extend(figure.write_as(out, name)?);
+    }
+    for (name, figure) in &heat {
         written.extend(figure.write_as(out, name)?);
     }
     Ok(written)

@@ -18,6 +18,7 @@ pub(crate) mod plane_contact_figure;
 pub mod plane_figure;
 pub(crate) mod refine;
 pub(crate) mod sampled_run;
+pub(crate) mod temperature_figure;
 pub mod viscosity_sweep;
 pub mod work_precision;
 

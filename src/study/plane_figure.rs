@@ -270,9 +270,9 @@ impl Drawing for PlaneFigure {
 }
 
 /// Runs `scene` and writes `deformed.png` and `deformed.svg` into `out`, with Signorini
-/// edges `contact-pressure.png`/`.svg` (`crate::study::plane_contact_figure`) and with
-/// friction `friction-state.png`/`.svg` (`crate::study::friction_figure`); returns their
-/// paths.
+/// edges `contact-pressure.png`/`.svg` (`crate::study::plane_contact_figure`), with
+/// friction `friction-state.png`/`.svg` (`crate::study::friction_figure`) and with `[heat]`
+/// `temperature.png`/`.svg` (`crate::study::temperature_figure`); returns their paths.
 pub fn write(name: &str, scene: &PlaneScene, out: &Path) -> Result<Vec<PathBuf>, PlaneFigureError> {
     register_font()?;
     let figure = PlaneFigure::run(name, scene)?;
@@ -293,6 +293,9 @@ pub fn write(name: &str, scene: &PlaneScene, out: &Path) -> Result<Vec<PathBuf>,
     }
     if let Some(friction) = crate::study::friction_figure::FrictionFigure::run(name, scene)? {
         files.extend(friction.write(out)?);
+    }
+    if let Some(heat) = crate::study::temperature_figure::TemperatureFigure::run(name, scene)? {
+        files.extend(heat.write(out)?);
     }
     Ok(files)
 }

@@ -24,20 +24,36 @@ pub const FRICTION_SCENES: [&str; 3] = [
 ];
 
 /// `scene` with the friction key of every Signorini edge set to `friction` (`None`: absent;
-/// without friction an edge's obstacle does not slide).
+/// without friction an edge's obstacle does not slide and its temperature has no frictional
+/// heating).
 pub fn with_friction(scene: &PlaneScene, friction: Option<f64>) -> PlaneScene {
     let mut s = scene.clone();
-    for e in [
+    let frictionless = !friction.is_some_and(|mu| mu > 0.0);
+    let mut heat_edges = s.heat.as_mut().map(|h| {
+        [
+            &mut h.left.frictional_heating,
+            &mut h.right.frictional_heating,
+            &mut h.bottom.frictional_heating,
+            &mut h.top.frictional_heating,
+        ]
+    });
+    for (k, e) in [
         &mut s.edges.left,
         &mut s.edges.right,
         &mut s.edges.bottom,
         &mut s.edges.top,
-    ] {
+    ]
+    .into_iter()
+    .enumerate()
+    {
         if e.condition == EdgeCondition::Signorini {
             e.friction = friction.map(|mu| mu.to_string());
-            // A sliding obstacle belongs to a frictional edge: without friction it is fixed.
-            if !friction.is_some_and(|mu| mu > 0.0) {
+            // A sliding obstacle and frictional heating belong to a frictional edge.
+            if frictionless {
                 e.velocity = None;
+                if let Some(heating) = heat_edges.as_mut() {
+                    *heating[k] = None;
+                }
             }
         }
     }
