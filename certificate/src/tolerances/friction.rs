@@ -34,7 +34,7 @@ pub const STOP_TIME_BOUND: f64 = 1e-8;
 /// `period_two::PeriodTwo::reaction`, measured on the code before friction entered the start-up
 /// step; the reference of [`RESTING_ALTERNATION_BOUND`], not a tolerance).
 const FRICTIONLESS_START_ALTERNATION: f64 = 9e-4;
-/// A hundredth of [`FRICTIONLESS_START_ALTERNATION`]: a start that leaves the period-2 mode
+/// A hundredth of `FRICTIONLESS_START_ALTERNATION` (above): a start that leaves the period-2 mode
 /// shows; friction from the start-up on leaves round-off.
 pub const RESTING_ALTERNATION_BOUND: f64 = FRICTIONLESS_START_ALTERNATION / 100.0;
 
