@@ -165,28 +165,63 @@ impl Heat {
     }
 }
 
+/// The keys of one thermal condition `condition` of a `what` (`end` or `edge`): `value` only on
+/// a `temperature` one, `coefficient` and `obstacle` only on an `exchange` one (`given`: whether
+/// each of the three is set); `key(k)` names a key in an error.
+pub(crate) fn check_condition_keys(
+    condition: ThermalCondition,
+    [value, coefficient, obstacle]: [bool; 3],
+    what: &str,
+    key: &dyn Fn(&str) -> String,
+) -> Result<(), SceneError> {
+    let only = |k: &str, needs: &str| SceneError::Invalid {
+        field: key(k),
+        value: "(set)".into(),
+        allowed: format!(
+            "only a `{needs}` {what} has `{k}` (this {what} is `{}`)",
+            condition.name()
+        ),
+    };
+    if value && condition != ThermalCondition::Temperature {
+        return Err(only("value", "temperature"));
+    }
+    if condition != ThermalCondition::Exchange {
+        if coefficient {
+            return Err(only("coefficient", "exchange"));
+        }
+        if obstacle {
+            return Err(only("obstacle", "exchange"));
+        }
+    }
+    Ok(())
+}
+
+/// An `exchange` condition's coefficient `h >= 0` (required; `key` names it).
+pub(crate) fn exchange_coefficient(
+    h: Option<f64>,
+    what: &str,
+    key: &str,
+) -> Result<f64, SceneError> {
+    let h = h.ok_or_else(|| SceneError::Invalid {
+        field: key.into(),
+        value: "missing".into(),
+        allowed: format!("an `exchange` {what} needs its coefficient h >= 0"),
+    })?;
+    if !(h.is_finite() && h >= 0.0) {
+        return Err(invalid(key, h, "must be a finite number >= 0"));
+    }
+    Ok(h)
+}
+
 impl ThermalEnd {
     fn validate(&self, side: &str, mechanical: (&str, bool)) -> Result<EndHeat, SceneError> {
         let key = |k: &str| format!("heat.{side}.{k}");
-        let only = |k: &str, condition: &str| SceneError::Invalid {
-            field: key(k),
-            value: "(set)".into(),
-            allowed: format!(
-                "only a `{condition}` end has `{k}` (this end is `{}`)",
-                self.condition.name()
-            ),
-        };
-        if self.value.is_some() && self.condition != ThermalCondition::Temperature {
-            return Err(only("value", "temperature"));
-        }
-        if self.condition != ThermalCondition::Exchange {
-            if self.coefficient.is_some() {
-                return Err(only("coefficient", "exchange"));
-            }
-            if self.obstacle.is_some() {
-                return Err(only("obstacle", "exchange"));
-            }
-        }
+        let given = [
+            self.value.is_some(),
+            self.coefficient.is_some(),
+            self.obstacle.is_some(),
+        ];
+        check_condition_keys(self.condition, given, "end", &key)?;
         match self.condition {
             ThermalCondition::Insulated => Ok(EndHeat::Insulated),
             ThermalCondition::Temperature => {
@@ -209,18 +244,7 @@ impl ThermalEnd {
                         ),
                     });
                 }
-                let h = self.coefficient.ok_or_else(|| SceneError::Invalid {
-                    field: key("coefficient"),
-                    value: "missing".into(),
-                    allowed: "an `exchange` end needs its coefficient h >= 0".into(),
-                })?;
-                if !(h.is_finite() && h >= 0.0) {
-                    return Err(invalid(
-                        &key("coefficient"),
-                        h,
-                        "must be a finite number >= 0",
-                    ));
-                }
+                let h = exchange_coefficient(self.coefficient, "end", &key("coefficient"))?;
                 let text = self.obstacle.as_deref().unwrap_or("0");
                 Ok(EndHeat::Exchange {
                     coefficient: h,

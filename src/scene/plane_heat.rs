@@ -10,7 +10,7 @@
 use crate::scene::SceneError;
 use crate::scene::error::invalid;
 use crate::scene::expr::Expression;
-use crate::scene::heat::ThermalCondition;
+use crate::scene::heat::{ThermalCondition, check_condition_keys, exchange_coefficient};
 use crate::scene::plane::{EDGE_NAMES, EdgeCondition, Edges, PlaneHeat, ThermalEdge};
 
 /// The parsed condition of one edge.
@@ -113,25 +113,12 @@ impl PlaneHeat {
 impl ThermalEdge {
     fn validate(&self, edge: usize, mechanical: EdgeCondition) -> Result<EdgeHeat, SceneError> {
         let key = |k: &str| format!("heat.{}.{k}", EDGE_NAMES[edge]);
-        let only = |k: &str, condition: &str| SceneError::Invalid {
-            field: key(k),
-            value: "(set)".into(),
-            allowed: format!(
-                "only a `{condition}` edge has `{k}` (this edge is `{}`)",
-                self.condition.name()
-            ),
-        };
-        if self.value.is_some() && self.condition != ThermalCondition::Temperature {
-            return Err(only("value", "temperature"));
-        }
-        if self.condition != ThermalCondition::Exchange {
-            if self.coefficient.is_some() {
-                return Err(only("coefficient", "exchange"));
-            }
-            if self.obstacle.is_some() {
-                return Err(only("obstacle", "exchange"));
-            }
-        }
+        let given = [
+            self.value.is_some(),
+            self.coefficient.is_some(),
+            self.obstacle.is_some(),
+        ];
+        check_condition_keys(self.condition, given, "edge", &key)?;
         match self.condition {
             ThermalCondition::Insulated => Ok(EdgeHeat::Insulated),
             ThermalCondition::Temperature => {
@@ -159,18 +146,7 @@ impl ThermalEdge {
                         ),
                     });
                 }
-                let h = self.coefficient.ok_or_else(|| SceneError::Invalid {
-                    field: key("coefficient"),
-                    value: "missing".into(),
-                    allowed: "an `exchange` edge needs its coefficient h >= 0".into(),
-                })?;
-                if !(h.is_finite() && h >= 0.0) {
-                    return Err(invalid(
-                        &key("coefficient"),
-                        h,
-                        "must be a finite number >= 0",
-                    ));
-                }
+                let h = exchange_coefficient(self.coefficient, "edge", &key("coefficient"))?;
                 let text = self.obstacle.as_deref().unwrap_or("0");
                 let obstacle = Expression::parse_edge(&key("obstacle"), text)?;
                 if obstacle.depends_on_x() {

@@ -93,21 +93,16 @@ impl ThermalBody {
         } = heat;
         let mut exchange = Vec::new();
         let mut fixed = Vec::new();
-        let mut start_jump = false;
+        // A jump inside the initial temperature is non-smooth data at t = 0 too.
+        let xs: Vec<f64> = (0..nodes).map(|j| j as f64 * dx).collect();
+        let mut start_jump = profile_jumps(|x| temperature.eval(x, 0.0).unwrap_or(f64::NAN), &xs);
         for (side, end) in ends.into_iter().enumerate() {
             let node = if side == 0 { 0 } else { nodes - 1 };
-            let key = if side == 0 { "heat.left" } else { "heat.right" };
             match end {
                 EndHeat::Insulated => {}
                 EndHeat::Temperature(value) => {
+                    // `eval` refuses a value that is not finite, naming the key.
                     let v0 = value.eval(0.0, 0.0)?;
-                    if !v0.is_finite() {
-                        return Err(crate::scene::error::invalid(
-                            &format!("{key}.value"),
-                            v0,
-                            "must be finite",
-                        ));
-                    }
                     let initial = temperature.eval(node as f64 * dx, 0.0)?;
                     start_jump |= starts_with_a_jump(initial, v0);
                     fixed.push(FixedEnd {
@@ -134,9 +129,6 @@ impl ThermalBody {
                 }
             }
         }
-        // A jump inside the initial temperature is non-smooth data at t = 0 too.
-        let xs: Vec<f64> = (0..nodes).map(|j| j as f64 * dx).collect();
-        start_jump |= profile_jumps(|x| temperature.eval(x, 0.0).unwrap_or(f64::NAN), &xs);
         let is_fixed = [0, nodes - 1].map(|n| fixed.iter().any(|f| f.node == n));
         let m = ThermalMatrices::new(
             nodes,
