@@ -261,6 +261,16 @@ bottom = {{ condition = "exchange", coefficient = {h}, obstacle = "0" }}
     Ok(((observed - rate).abs() / rate, exchanging))
 }
 
+/// A strip 1 × 0.1 of 50 × 5 square cells at rest, `Δt = 0.04` to `t = 1`, with `[heat]` of
+/// diffusivity `kappa` and the further lines `heat` (`κΔt/h² = 100 κ`).
+fn strip(kappa: f64, heat: &str) -> PlaneScene {
+    let text = format!(
+        "[plane]\nwidth = 1.0\nheight = 0.1\nlambda = 1.0\nmu = 1.0\n\n[mesh]\nnx = 50\nny = 5\n\n\
+         [time]\nstep = 0.04\nend = 1.0\n\n[heat]\ncoupling = 0\ndiffusivity = {kappa}\n{heat}\n"
+    );
+    PlaneScene::from_toml(&text, &[]).expect("a valid scene")
+}
+
 /// The diffusivities of the sudden edge temperature: `κΔt/h²` = 0.5, 5 and 100.
 pub const SUDDEN_DIFFUSIVITIES: [f64; 3] = [0.005, 0.05, 1.0];
 
@@ -270,29 +280,10 @@ pub const SUDDEN_DIFFUSIVITIES: [f64; 3] = [0.005, 0.05, 1.0];
 pub fn sudden_edge_excursion() -> Result<f64, RunError> {
     let mut worst = 0.0f64;
     for kappa in SUDDEN_DIFFUSIVITIES {
-        let text = format!(
-            r#"
-[plane]
-width = 1.0
-height = 0.1
-lambda = 1.0
-mu = 1.0
-
-[mesh]
-nx = 50
-ny = 5
-
-[time]
-step = 0.04
-end = 1.0
-
-[heat]
-coupling = 0
-diffusivity = {kappa}
-left = {{ condition = "temperature", value = "1" }}
-"#
+        let scene = strip(
+            kappa,
+            "left = { condition = \"temperature\", value = \"1\" }",
         );
-        let scene = PlaneScene::from_toml(&text, &[]).expect("a valid scene");
         let mut sim = PlaneSimulation::new(&scene)?;
         for _ in 1..scene.steps() {
             sim.step()?;
@@ -354,27 +345,7 @@ pub fn markdown() -> Result<String, RunError> {
 /// `κΔt/h² = 100`: the largest decrease of `θ` from a node to the next along `x`, over every
 /// row and step (the exact solution stays nondecreasing in `x`).
 pub fn initial_jump_monotonicity() -> Result<f64, RunError> {
-    let text = r#"
-[plane]
-width = 1.0
-height = 0.1
-lambda = 1.0
-mu = 1.0
-
-[mesh]
-nx = 50
-ny = 5
-
-[time]
-step = 0.04
-end = 1.0
-
-[heat]
-coupling = 0
-diffusivity = 1.0
-temperature = "x > 0.503"
-"#;
-    let scene = PlaneScene::from_toml(text, &[]).expect("a valid scene");
+    let scene = strip(1.0, "temperature = \"x > 0.503\"");
     let mut sim = PlaneSimulation::new(&scene)?;
     let [nx, ny] = sim.body().lattice();
     let mut worst = 0.0f64;
