@@ -154,32 +154,35 @@ fn a_run_in_one_format_removes_the_other_formats_stale_profiles() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// The plane body writes the same format: `t, x, y, ux, uy, vx, vy`, every value the bits of
-/// the CSV of the same run, sampled in both directions by `output.nodes`.
-#[test]
-fn a_plane_run_writes_the_same_rows_as_its_csv() {
-    use viscobar::scene::{AnyScene, load_any};
-    let plane = |extra: &[&str]| {
-        let mut set = vec!["time.end=0.1", "output.every=5", "output.nodes=60"];
+/// `scene` (a plane scene's TOML) run with `extra` settings to CSV and to NPY: every NPY row
+/// the bits of the CSV row, under the header `header` of `N` columns, sampled in both
+/// directions by `output.nodes`.
+fn plane_npy_matches_csv<const N: usize>(scene: &str, extra: &[&str], header: &str)
+where
+    viscobar::internals::output::npy::ProfileRow<N>: npyz::Deserialize,
+{
+    let plane = |format: &[&str]| {
+        let mut set = vec!["output.every=5", "output.nodes=60"];
         set.extend(extra);
+        set.extend(format);
         let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
-        match load_any("plane-tilted-drop", &set).unwrap().1 {
-            AnyScene::Plane(s) => *s,
-            AnyScene::Bar(_) => unreachable!(),
-        }
+        viscobar::PlaneScene::from_toml(scene, &set).unwrap()
     };
     let (csv_scene, npy_scene) = (plane(&[]), plane(&["output.format=npy"]));
     let sampling = npy_scene.output_sampling();
-    let (a, b) = (fresh_dir("plane-csv"), fresh_dir("plane-npy"));
-    viscobar::output::run_plane_to_dir("drop", &csv_scene, &a, false).unwrap();
-    viscobar::output::run_plane_to_dir("drop", &npy_scene, &b, false).unwrap();
+    let (a, b) = (
+        fresh_dir(&format!("plane-csv-{N}")),
+        fresh_dir(&format!("plane-npy-{N}")),
+    );
+    viscobar::output::run_plane_to_dir("plane", &csv_scene, &a, false).unwrap();
+    viscobar::output::run_plane_to_dir("plane", &npy_scene, &b, false).unwrap();
     let bytes = std::fs::read(b.join("displacement.npy")).unwrap();
     let npy = npyz::NpyFile::new(&bytes[..]).unwrap();
     assert_eq!(npy.shape(), &[sampling.rows]);
-    let rows = npy.into_vec::<ProfileRow<7>>().unwrap();
+    let rows = npy.into_vec::<ProfileRow<N>>().unwrap();
     let text = std::fs::read_to_string(a.join("displacement.csv")).unwrap();
     let mut lines = text.lines();
-    assert_eq!(lines.next(), Some("t,x,y,ux,uy,vx,vy"));
+    assert_eq!(lines.next(), Some(header));
     let mut count = 0;
     for (line, r) in lines.zip(&rows) {
         let f: Vec<u64> = line
@@ -195,4 +198,19 @@ fn a_plane_run_writes_the_same_rows_as_its_csv() {
     for d in [a, b] {
         std::fs::remove_dir_all(&d).unwrap();
     }
+}
+
+/// The plane body writes the same format: `t, x, y, ux, uy, vx, vy`, every value the bits of
+/// the CSV of the same run.
+#[test]
+fn a_plane_run_writes_the_same_rows_as_its_csv() {
+    let text = viscobar::scene::plane::plane_builtin_text("plane-tilted-drop").unwrap();
+    plane_npy_matches_csv::<7>(text, &["time.end=0.1"], "t,x,y,ux,uy,vx,vy");
+}
+
+/// With `[heat]` a column `theta` follows, in both formats, to the same bits.
+#[test]
+fn a_plane_run_with_a_temperature_writes_theta_as_its_csv() {
+    let text = viscobar::scene::plane::plane_builtin_text("plane-brake").unwrap();
+    plane_npy_matches_csv::<8>(text, &["time.end=0.2"], "t,x,y,ux,uy,vx,vy,theta");
 }
