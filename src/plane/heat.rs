@@ -12,7 +12,8 @@ use crate::linalg::sparse::Pattern;
 use crate::plane::mesh::Grid;
 use crate::plane::normals::Normal;
 use crate::scene::expr::Expression;
-use crate::scene::plane_heat::{EdgeHeat, PlaneHeatExpressions};
+use crate::scene::heat::EndHeat;
+use crate::scene::plane_heat::PlaneHeatExpressions;
 use crate::scheme::body::{HeatOutputs, HeatTerms};
 use crate::scheme::{RunError, in_contact};
 use crate::step::Friction;
@@ -199,9 +200,9 @@ impl PlaneHeat {
         let mut exchange_edges: [Option<(f64, Expression)>; 4] = Default::default();
         for (k, e) in edges.into_iter().enumerate() {
             match e {
-                EdgeHeat::Insulated => {}
-                EdgeHeat::Temperature(v) => values[k] = Some(v),
-                EdgeHeat::Exchange {
+                EndHeat::Insulated => {}
+                EndHeat::Temperature(v) => values[k] = Some(v),
+                EndHeat::Exchange {
                     coefficient,
                     obstacle,
                 } => exchange_edges[k] = Some((coefficient, obstacle)),

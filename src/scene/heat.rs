@@ -91,11 +91,12 @@ pub struct ThermalEnd {
     pub obstacle: Option<String>,
 }
 
-/// The parsed thermal condition of one end.
-#[derive(Clone, Debug)]
+/// The parsed thermal condition of one end of the bar or one edge of the plane body.
+#[derive(Clone, Debug, Default)]
 pub enum EndHeat {
+    #[default]
     Insulated,
-    /// `θ = value(t)`.
+    /// `θ = value(t)` (on an edge `value(s, t)`).
     Temperature(Expression),
     /// `h` and `θ_obs(t)`.
     Exchange {

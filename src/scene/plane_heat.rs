@@ -10,22 +10,8 @@
 use crate::scene::SceneError;
 use crate::scene::error::invalid;
 use crate::scene::expr::Expression;
-use crate::scene::heat::{ThermalCondition, check_condition_keys, exchange_coefficient};
+use crate::scene::heat::{EndHeat, ThermalCondition, check_condition_keys, exchange_coefficient};
 use crate::scene::plane::{EDGE_NAMES, EdgeCondition, Edges, PlaneHeat, ThermalEdge};
-
-/// The parsed condition of one edge.
-#[derive(Clone, Debug, Default)]
-pub enum EdgeHeat {
-    #[default]
-    Insulated,
-    /// `θ = value(s, t)`.
-    Temperature(Expression),
-    /// `h` and `θ_obs(t)`.
-    Exchange {
-        coefficient: f64,
-        obstacle: Expression,
-    },
-}
 
 /// The parsed `[heat]` of a plane scene.
 #[derive(Clone, Debug)]
@@ -35,7 +21,7 @@ pub struct PlaneHeatExpressions {
     pub temperature: Expression,
     pub source: Option<Expression>,
     /// `left, right, bottom, top`.
-    pub edges: [EdgeHeat; 4],
+    pub edges: [EndHeat; 4],
     /// `η` of each edge (1 where not given; read on frictional edges only).
     pub frictional_heating: [f64; 4],
 }
@@ -76,7 +62,7 @@ impl PlaneHeat {
             None => None,
         };
         let frictions = edges.frictions()?;
-        let mut parsed: [EdgeHeat; 4] = Default::default();
+        let mut parsed: [EndHeat; 4] = Default::default();
         let mut eta = [1.0; 4];
         for (k, spec) in self.edges().into_iter().enumerate() {
             let mechanical = edges.all()[k];
@@ -111,7 +97,7 @@ impl PlaneHeat {
 }
 
 impl ThermalEdge {
-    fn validate(&self, edge: usize, mechanical: EdgeCondition) -> Result<EdgeHeat, SceneError> {
+    fn validate(&self, edge: usize, mechanical: EdgeCondition) -> Result<EndHeat, SceneError> {
         let key = |k: &str| format!("heat.{}.{k}", EDGE_NAMES[edge]);
         let given = [
             self.value.is_some(),
@@ -120,7 +106,7 @@ impl ThermalEdge {
         ];
         check_condition_keys(self.condition, given, "edge", &key)?;
         match self.condition {
-            ThermalCondition::Insulated => Ok(EdgeHeat::Insulated),
+            ThermalCondition::Insulated => Ok(EndHeat::Insulated),
             ThermalCondition::Temperature => {
                 let text = self.value.as_ref().ok_or_else(|| SceneError::Invalid {
                     field: key("value"),
@@ -128,7 +114,7 @@ impl ThermalEdge {
                     allowed: "a `temperature` edge needs its temperature, an expression in s and t"
                         .into(),
                 })?;
-                Ok(EdgeHeat::Temperature(Expression::parse_edge(
+                Ok(EndHeat::Temperature(Expression::parse_edge(
                     &key("value"),
                     text,
                 )?))
@@ -156,7 +142,7 @@ impl ThermalEdge {
                         allowed: "the obstacle's temperature is an expression in t alone".into(),
                     });
                 }
-                Ok(EdgeHeat::Exchange {
+                Ok(EndHeat::Exchange {
                     coefficient: h,
                     obstacle,
                 })
