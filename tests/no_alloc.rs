@@ -81,33 +81,36 @@ fn plane_steps_do_not_allocate() {
     }
 }
 
-/// A plane body with a temperature (a frictional launch heating its floor, with a source and a
-/// top held at a temperature varying in time) allocates nothing once its heat step's factors
-/// are made: the implicit start's, then Crank–Nicolson's at the third step.
+/// The plane body's heat steps (the frictional launch with frictional heating, a source and the
+/// top held at a temperature varying in time; uncoupled, and coupled with `γ = 0.5`) allocate
+/// nothing once each step's factors are made: the implicit start's, then Crank–Nicolson's at
+/// the third step (coupled: with each state's step solver).
 #[test]
 fn plane_heat_steps_do_not_allocate() {
-    let text = format!(
-        "{}\n[heat]\ncoupling = 0\ndiffusivity = 0.2\nsource = \"x*t\"\n\
-         bottom = {{ frictional_heating = 0.5 }}\n\
-         top = {{ condition = \"temperature\", value = \"1 + t\" }}\n",
-        include_str!("../scenes/plane-friction-launch.toml")
-    );
-    let scene = viscobar::PlaneScene::from_toml(&text, &[]).unwrap();
-    let mut sim = viscobar::plane::PlaneSimulation::new(&scene).unwrap();
-    for _ in 0..3 {
-        sim.step().unwrap();
+    for coupling in ["0", "0.5"] {
+        let text = format!(
+            "{}\n[heat]\ncoupling = {coupling}\ndiffusivity = 0.2\nsource = \"x*t\"\n\
+             bottom = {{ frictional_heating = 0.5 }}\n\
+             top = {{ condition = \"temperature\", value = \"1 + t\" }}\n",
+            include_str!("../scenes/plane-friction-launch.toml")
+        );
+        let scene = viscobar::PlaneScene::from_toml(&text, &[]).unwrap();
+        let mut sim = viscobar::plane::PlaneSimulation::new(&scene).unwrap();
+        for _ in 0..3 {
+            sim.step().unwrap();
+        }
+        let before = allocations();
+        let mut heating = 0.0;
+        for _ in 0..100 {
+            heating += sim.step().unwrap().heat.unwrap().frictional_heating;
+        }
+        let allocations = allocations() - before;
+        assert!(heating > 0.0, "the counted steps heat the body");
+        assert_eq!(
+            allocations, 0,
+            "{allocations} allocations in 100 plane heat steps, coupling {coupling}"
+        );
     }
-    let before = allocations();
-    let mut heating = 0.0;
-    for _ in 0..100 {
-        heating += sim.step().unwrap().heat.unwrap().frictional_heating;
-    }
-    let allocations = allocations() - before;
-    assert!(heating > 0.0, "the counted steps heat the body");
-    assert_eq!(
-        allocations, 0,
-        "{allocations} allocations in 100 plane heat steps"
-    );
 }
 
 /// The thermal bar's steps (coupled, with contact and the exchange switching on; uncoupled;

@@ -139,7 +139,12 @@ fn bad_heat_keys_are_refused_naming_the_key() {
     common::assert_each_refused(
         scene.to_str().unwrap(),
         &[
-            ("coupling", &["heat.coupling=0.5"], "heat.coupling"),
+            ("coupling", &["heat.coupling=-0.5"], "heat.coupling"),
+            (
+                "coupled osqp",
+                &["heat.coupling=0.5", "solver.method=\"osqp\""],
+                "solver.method",
+            ),
             ("diffusivity", &["heat.diffusivity=0"], "heat.diffusivity"),
             (
                 "heating out of range",

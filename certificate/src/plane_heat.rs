@@ -1,7 +1,8 @@
-//! The plane body's temperature (`[heat]`, uncoupled): the heat balance of a frictional launch
+//! The plane body's temperature (`[heat]`): uncoupled, the heat balance of a frictional launch
 //! at every step, its uniform end temperature, a block on a belt against its closed-form flux
 //! and edge temperature, an exchanging floor's decay rate, a sudden edge temperature's range and
-//! the heat step's orders. `tests/plane_heat.rs` asserts each against its tolerance
+//! the heat step's orders; coupled, the orders of a manufactured solution in `u` and `θ` and the
+//! identity of a frictional launch. `tests/plane_heat*.rs` assert each against its tolerance
 //! ([`crate::tolerances`]); [`markdown`] is VERIFICATION.md's generated table. Derivations:
 //! docs/thermal.md, "The plane body".
 
@@ -196,6 +197,153 @@ top = {{ condition = "temperature", value = 0 }}
     Ok(errors)
 }
 
+/// The coupled manufactured solution's levels `(cells along x, Δt)` (`nx × nx/2` cells graded
+/// by 1.5, to [`COUPLED_END`]).
+pub const COUPLED_LEVELS: [(u64, f64); 3] = [(32, 0.0125), (64, 0.00625), (128, 0.003125)];
+/// End time of the coupled manufactured runs.
+pub const COUPLED_END: f64 = 0.5;
+
+/// [`viscobar::plane::closed_form::Coupled`] (`γ = 0.8`): the nodal errors of `u` at `t_N`
+/// and of `θ` at `t_N − Δt/2`, per level of [`COUPLED_LEVELS`].
+pub fn coupled_manufactured_errors() -> Result<Vec<(f64, f64)>, RunError> {
+    let c = viscobar::plane::closed_form::Coupled::default();
+    let mut errors = Vec::new();
+    for (nx, dt) in COUPLED_LEVELS {
+        let scene = c.scene(nx, nx / 2, 1.5, dt, COUPLED_END);
+        let (_, sim) = run(&scene)?;
+        let t = sim.time();
+        let d = sim.discretisation();
+        let u_error = (d.free.iter().zip(sim.displacement()))
+            .map(|(&dof, u)| {
+                let (x, y) = d.grid.point(dof / 2);
+                (u - c.mechanics.displacement(x, y, t)[dof % 2]).abs()
+            })
+            .fold(0.0, f64::max);
+        let theta_error = (0..d.grid.nodes())
+            .map(|node| {
+                let (x, y) = d.grid.point(node);
+                (theta(&sim, node) - c.temperature(x, y, t - dt / 2.0)).abs()
+            })
+            .fold(0.0, f64::max);
+        errors.push((u_error, theta_error));
+    }
+    Ok(errors)
+}
+
+/// The launch with a coupled temperature (`γ = coupling`, `κ = 0.2`, `θ^0 = 1 + y`), every step
+/// measured.
+pub fn coupled_launch(coupling: f64) -> PlaneScene {
+    launch_with_heat(
+        &format!("coupling = {coupling:?}\ndiffusivity = 0.2\ntemperature = \"1 + y\""),
+        &["output.diagnostics_every=1"],
+    )
+}
+
+/// The coupled launch's (`γ = 0.5`) worst identity residual over its steps and the bound.
+pub fn coupled_launch_identity() -> Result<(f64, f64), RunError> {
+    let (records, _) = run(&coupled_launch(0.5))?;
+    Ok(records[1..].iter().fold((0.0f64, 0.0f64), |(r, b), rec| {
+        (r.max(rec.identity_residual), b.max(rec.identity_bound))
+    }))
+}
+
+/// The thermal bar of the strip comparison: clamped at both ends, `α = 1`, `θ^0 = 0`, the right
+/// end's temperature ramped to 1 by `t = 0.05` (smooth data: Crank–Nicolson from the start, and
+/// no thermal stress in the Taylor step), `γ = 0.5`.
+pub const STRIP_BAR: &str = r#"
+[bar]
+length = 1.0
+viscosity = 1.0
+
+[left]
+condition = "clamped"
+
+[right]
+condition = "clamped"
+
+[heat]
+coupling = 0.5
+diffusivity = 0.5
+temperature = "0"
+right = { condition = "temperature", value = "min(1, 20*t)" }
+
+[mesh]
+elements = 40
+
+[time]
+step = 0.01
+end = 1.5
+"#;
+
+/// [`STRIP_BAR`] as a plane strip: one row of cells of height `H = 0.1`, `λ = 0`, `μ = ½`,
+/// `ρ = 1`, between frictionless obstacles below and above at gap 0. While `θ >= 0` the thermal
+/// stress `−γθ` presses both edges onto their obstacles, `u_y = 0`, and every plane equation of
+/// `u_x` and `θ`, uniform in `y`, is the bar's times `H` (a thermal stress at the start would
+/// push the Taylor step through the obstacles, and its projection mixes `u_x` and `u_y`).
+pub const STRIP_PLANE: &str = r#"
+[plane]
+width = 1.0
+height = 0.1
+lambda = 0.0
+mu = 0.5
+viscosity = 1.0
+
+[edges]
+left = { condition = "clamped" }
+right = { condition = "clamped" }
+bottom = { condition = "signorini", gap = 0 }
+top = { condition = "signorini", gap = 0 }
+
+[mesh]
+nx = 40
+ny = 1
+
+[time]
+step = 0.01
+end = 1.5
+
+[heat]
+coupling = 0.5
+diffusivity = 0.5
+temperature = "0"
+right = { condition = "temperature", value = "min(1, 20*t)" }
+"#;
+
+/// The coupled strip against the thermal bar, step by step: the largest difference of `u_x`
+/// (bottom and top nodes) from the bar's `u` and of `θ` from the bar's, each relative to its
+/// field's largest value over the run; and the least `θ` seen (it must stay positive for the
+/// strip's edges to stay in contact).
+pub fn coupled_strip_against_bar() -> Result<(f64, f64, f64), RunError> {
+    use viscobar::thermal::ThermalSimulation;
+    let bar_scene = viscobar::Scene::from_toml(STRIP_BAR, &[])?;
+    let plane_scene = PlaneScene::from_toml(STRIP_PLANE, &[])?;
+    let mut bar = ThermalSimulation::new(&bar_scene)?;
+    let mut plane = PlaneSimulation::new(&plane_scene)?;
+    let (mut du, mut dt, mut u_scale, mut t_scale) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let mut least = f64::INFINITY;
+    for step in 1..bar_scene.steps() {
+        if step > 1 {
+            bar.step()?;
+            plane.step()?;
+        }
+        let (b, p) = (bar.body(), plane.body());
+        let [nx, _] = p.lattice();
+        for i in 0..nx {
+            let ub = b.unknown_of(i).map_or(0.0, |k| bar.displacement()[k]);
+            let tb = b.temperature(bar.displacement(), i).expect("a temperature");
+            u_scale = u_scale.max(ub.abs());
+            t_scale = t_scale.max(tb.abs());
+            least = least.min(tb);
+            for node in [i, i + nx] {
+                let up = p.unknown_of(2 * node).map_or(0.0, |k| plane.displacement()[k]);
+                du = du.max((up - ub).abs());
+                dt = dt.max((theta(&plane, node) - tb).abs());
+            }
+        }
+    }
+    Ok((du / u_scale, dt / t_scale, least))
+}
+
 /// The observed orders between successive levels.
 pub fn orders(errors: &[f64]) -> Vec<f64> {
     errors.windows(2).map(|p| (p[0] / p[1]).log2()).collect()
@@ -303,9 +451,13 @@ pub fn markdown() -> Result<String, RunError> {
     let (uniform, stopped) = uniform_end()?;
     let [p, flux, mean, sticking] = belt()?;
     let errors = manufactured_errors()?;
-    let orders = orders(&errors);
+    let heat_orders = orders(&errors);
     let (decay, _) = exchange_decay()?;
     let excursion = sudden_edge_excursion()?;
+    let coupled = coupled_manufactured_errors()?;
+    let (coupled_u, coupled_theta): (Vec<f64>, Vec<f64>) = coupled.iter().copied().unzip();
+    let (residual, bound) = coupled_launch_identity()?;
+    let (strip_u, strip_theta, _) = coupled_strip_against_bar()?;
     let mut s = String::new();
     let _ = writeln!(s, "| check | measured |\n|---|---|");
     let _ = writeln!(
@@ -323,12 +475,12 @@ pub fn markdown() -> Result<String, RunError> {
     let levels: Vec<String> = (MANUFACTURED_LEVELS.iter().zip(&errors))
         .map(|((n, dt), e)| format!("{n} × {n}, Δt = {dt}: {e:.3e}"))
         .collect();
-    let orders: Vec<String> = orders.iter().map(|o| format!("{o:.2}")).collect();
+    let heat_orders: Vec<String> = heat_orders.iter().map(|o| format!("{o:.2}")).collect();
     let _ = writeln!(
         s,
         "| manufactured θ: nodal error per level; observed orders | {}; {} |",
         levels.join(", "),
-        orders.join(", ")
+        heat_orders.join(", ")
     );
     let _ = writeln!(
         s,
@@ -337,6 +489,25 @@ pub fn markdown() -> Result<String, RunError> {
     let _ = writeln!(
         s,
         "| sudden edge temperature, `κΔt/h²` = 0.5, 5, 100: largest excursion outside [0, 1] | {excursion:.1e} |"
+    );
+    let levels: Vec<String> = (COUPLED_LEVELS.iter().zip(&coupled))
+        .map(|((n, dt), (u, t))| format!("{n} × {}, Δt = {dt}: {u:.3e}, {t:.3e}", n / 2))
+        .collect();
+    let show = |o: Vec<f64>| o.iter().map(|o| format!("{o:.2}")).collect::<Vec<_>>().join(", ");
+    let _ = writeln!(
+        s,
+        "| coupled manufactured (`γ = 0.8`): nodal errors of `u` and `θ` per level; observed orders in `u`; in `θ` | {}; {}; {} |",
+        levels.join("; "),
+        show(orders(&coupled_u)),
+        show(orders(&coupled_theta))
+    );
+    let _ = writeln!(
+        s,
+        "| coupled launch (`γ = 0.5`, Lemke through the coupled system): worst identity residual per step (bound) | {residual:.1e} ({bound:.1e}) |"
+    );
+    let _ = writeln!(
+        s,
+        "| coupled strip (one row of cells, `λ = 0`, `μ = ½`, held in `y` by its obstacles) against the thermal bar: largest difference of `u`, of `θ`, over every node and step, relative | {strip_u:.1e}, {strip_theta:.1e} |"
     );
     Ok(s)
 }

@@ -172,8 +172,9 @@ impl Body for BarBody {
         self.disc.stiffness.mul_into(x, y);
     }
 
-    fn step_matrix_mul(&self, x: &[f64], y: &mut [f64]) {
+    fn step_matrix_mul(&mut self, x: &[f64], y: &mut [f64]) -> Result<(), RunError> {
         self.disc.step_matrix.mul_into(x, y);
+        Ok(())
     }
 
     /// On the unknowns that carry mass (a contiguous block: the massless ones are end nodes,

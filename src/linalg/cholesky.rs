@@ -1,14 +1,17 @@
 //! The sparse Cholesky factorisation `A = LLᵀ` of the plane body's symmetric positive definite
-//! matrices (faer 0.24, supernodal, AMD fill-reducing ordering), through faer's low-level
+//! matrices (faer 0.24, supernodal, AMD fill-reducing ordering), and `A = LDLᵀ` of its
+//! symmetric quasi-definite ones (`[[P, G], [Gᵀ, −N]]`, `P`, `N` positive definite: an `LDLᵀ`
+//! exists for every ordering, Vanderbei 1995), through faer's low-level
 //! API: the symbolic analysis once per pattern, the numeric factorisation once per matrix, and
 //! solves with a work space kept for the run, so that a solve allocates nothing (faer's
 //! high-level `Llt` allocates on every solve: `docs/sparse-cholesky.md`).
 
 use crate::linalg::sparse::Pattern;
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
+    CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky, SymmetricOrdering,
     factorize_symbolic_cholesky,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
@@ -19,6 +22,8 @@ use faer::{Conj, MatMut, Par, Side};
 pub enum FactorError {
     #[error("the matrix {matrix} is not positive definite (pivot {index} of the ordered matrix)")]
     NotPositiveDefinite { matrix: &'static str, index: usize },
+    #[error("the matrix {matrix} has a zero pivot ({index} of the ordered matrix)")]
+    ZeroPivot { matrix: &'static str, index: usize },
     #[error("the symbolic analysis of {matrix} failed: {reason}")]
     Symbolic {
         matrix: &'static str,
@@ -28,8 +33,11 @@ pub enum FactorError {
 
 /// `A = LLᵀ` for matrices on one [`Pattern`]: [`SparseCholesky::factor`] replaces the numeric
 /// factor (same pattern, no new analysis), [`SparseCholesky::solve_in_place`] solves.
+/// [`SparseCholesky::quasi_definite`] factorises `A = LDLᵀ` instead, without pivoting.
 pub struct SparseCholesky {
     symbolic: SymbolicCholesky<usize>,
+    /// `LDLᵀ` (a quasi-definite matrix) rather than `LLᵀ`.
+    ldlt: bool,
     values: Vec<f64>,
     /// Work space of a solve, kept for the run.
     solve_buffer: MemBuffer,
@@ -42,6 +50,25 @@ impl SparseCholesky {
     /// The symbolic analysis of `pattern` (AMD ordering) and the factorisation of the matrix
     /// with values `a` on it; `matrix` names it in errors.
     pub fn new(pattern: &Pattern, a: &[f64], matrix: &'static str) -> Result<Self, FactorError> {
+        Self::with_kind(pattern, a, matrix, false)
+    }
+
+    /// `A = LDLᵀ` of the symmetric quasi-definite matrix with values `a` on `pattern` (AMD
+    /// ordering, no pivoting: `D` holds the signs of `A`'s two blocks).
+    pub fn quasi_definite(
+        pattern: &Pattern,
+        a: &[f64],
+        matrix: &'static str,
+    ) -> Result<Self, FactorError> {
+        Self::with_kind(pattern, a, matrix, true)
+    }
+
+    fn with_kind(
+        pattern: &Pattern,
+        a: &[f64],
+        matrix: &'static str,
+        ldlt: bool,
+    ) -> Result<Self, FactorError> {
         let symbolic = factorize_symbolic_cholesky(
             Self::structure(pattern),
             Side::Lower,
@@ -56,6 +83,7 @@ impl SparseCholesky {
         let values = vec![0.0; symbolic.len_val()];
         let mut this = Self {
             symbolic,
+            ldlt,
             values,
             solve_buffer,
             factor_buffer: None,
@@ -107,8 +135,13 @@ impl SparseCholesky {
     }
 
     fn factor_scratch(&self) -> faer::dyn_stack::StackReq {
-        self.symbolic
-            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+        if self.ldlt {
+            self.symbolic
+                .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default())
+        } else {
+            self.symbolic
+                .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+        }
     }
 
     fn factor_with(
@@ -119,6 +152,20 @@ impl SparseCholesky {
         buffer: &mut MemBuffer,
     ) -> Result<(), FactorError> {
         let a = SparseColMatRef::new(Self::structure(pattern), a);
+        if self.ldlt {
+            self.symbolic
+                .factorize_numeric_ldlt(
+                    &mut self.values,
+                    a,
+                    Side::Lower,
+                    LdltRegularization::default(),
+                    Par::Seq,
+                    MemStack::new(buffer),
+                    Default::default(),
+                )
+                .map_err(|LdltError::ZeroPivot { index }| FactorError::ZeroPivot { matrix, index })?;
+            return Ok(());
+        }
         self.symbolic
             .factorize_numeric_llt(
                 &mut self.values,
@@ -140,14 +187,9 @@ impl SparseCholesky {
     /// `x ← A⁻¹ x`; allocates nothing.
     pub fn solve_in_place(&mut self, x: &mut [f64]) {
         assert_eq!(x.len(), self.n, "right-hand side of the wrong length");
-        let llt = LltRef::new(&self.symbolic, &self.values);
         let rhs = MatMut::from_column_major_slice_mut(x, self.n, 1);
-        llt.solve_in_place_with_conj(
-            Conj::No,
-            rhs,
-            Par::Seq,
-            MemStack::new(&mut self.solve_buffer),
-        );
+        let stack = MemStack::new(&mut self.solve_buffer);
+        solve_factored((&self.symbolic, &self.values, self.ldlt), rhs, stack);
     }
 
     /// `X ← A⁻¹ X` for `ncols` right-hand sides stored column after column in `x` (one pass
@@ -160,9 +202,9 @@ impl SparseCholesky {
         );
         let mut buffer =
             MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(ncols, Par::Seq));
-        let llt = LltRef::new(&self.symbolic, &self.values);
         let rhs = MatMut::from_column_major_slice_mut(x, self.n, ncols);
-        llt.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut buffer));
+        let stack = MemStack::new(&mut buffer);
+        solve_factored((&self.symbolic, &self.values, self.ldlt), rhs, stack);
     }
 
     /// Stored values of the factor (`≈ nnz(L)`, supernodal blocks included).
@@ -173,6 +215,19 @@ impl SparseCholesky {
     /// Unknowns.
     pub fn dim(&self) -> usize {
         self.n
+    }
+}
+
+/// `X ← A⁻¹ X` by the factor `(symbolic, values)`, `LDLᵀ` when `ldlt`, else `LLᵀ`.
+fn solve_factored(
+    (symbolic, values, ldlt): (&SymbolicCholesky<usize>, &[f64], bool),
+    rhs: MatMut<'_, f64>,
+    stack: &mut MemStack,
+) {
+    if ldlt {
+        LdltRef::new(symbolic, values).solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+    } else {
+        LltRef::new(symbolic, values).solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
     }
 }
 

@@ -59,7 +59,12 @@ pub struct Csc {
 /// of `‖C⁻¹‖_1`, which equals `‖C⁻¹‖_∞` for symmetric `C`: a lower bound, exact or within a
 /// small factor in practice; at most five pairs of solves, once per run.
 pub fn inverse_norm_estimate(system: &mut impl SpdSystem) -> f64 {
-    let n = system.dim();
+    hager_norm_estimate(system.dim(), |x| system.solve_in_place(x))
+}
+
+/// Hager's estimate of `‖A‖_1` for a symmetric `A` of order `n` given as `apply: x ← A x`
+/// ([`inverse_norm_estimate`] with `A = C⁻¹`); at most five pairs of applications.
+pub fn hager_norm_estimate(n: usize, mut apply: impl FnMut(&mut [f64])) -> f64 {
     if n == 0 {
         return 0.0;
     }
@@ -69,12 +74,12 @@ pub fn inverse_norm_estimate(system: &mut impl SpdSystem) -> f64 {
     let mut estimate = 0.0;
     for _ in 0..5 {
         y.copy_from_slice(&x);
-        system.solve_in_place(&mut y);
+        apply(&mut y);
         estimate = y.iter().map(|v| v.abs()).sum::<f64>();
         for (wi, yi) in w.iter_mut().zip(&y) {
             *wi = if *yi >= 0.0 { 1.0 } else { -1.0 };
         }
-        system.solve_in_place(&mut w);
+        apply(&mut w);
         let (j, wmax) = w.iter().enumerate().fold((0, 0.0f64), |(jm, m), (i, v)| {
             if v.abs() > m { (i, v.abs()) } else { (jm, m) }
         });

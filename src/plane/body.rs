@@ -9,6 +9,7 @@ use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::sparse::Pattern;
 use crate::linalg::system::SparseSystem;
 use crate::plane::energy::{StrainForms, measure};
+use crate::plane::coupling::CoupledSolver;
 use crate::plane::heat::PlaneHeat;
 use crate::plane::matrices::{Material, assemble, assemble_with};
 use crate::plane::mesh::Grid;
@@ -221,6 +222,12 @@ impl Body for PlaneBody {
             }
             *br = force.map_or(0.0, |f| f[r]) + mw * self.inv_dt2 + ky;
         }
+        // A coupled temperature's load, `ζ` eliminated (crate::plane::coupling).
+        if let Some(load) = self.heat.as_ref().and_then(|h| h.thermal_load()) {
+            for (br, l) in b.iter_mut().zip(load) {
+                *br += l;
+            }
+        }
     }
 
     fn energy_sums(&self, u: &[f64], z: &[f64], w: &[f64], force: Option<&[f64]>) -> EnergySums {
@@ -248,8 +255,14 @@ impl Body for PlaneBody {
         self.disc.pattern.mul_into(&self.disc.stiffness, x, y);
     }
 
-    fn step_matrix_mul(&self, x: &[f64], y: &mut [f64]) {
+    /// `C x`; with a coupled temperature `S x` of the start-up's state
+    /// (`src/plane/coupling.rs`), the matrix its step solver projects with.
+    fn step_matrix_mul(&mut self, x: &[f64], y: &mut [f64]) -> Result<(), RunError> {
         self.disc.pattern.mul_into(&self.c, x, y);
+        match &mut self.heat {
+            Some(heat) => heat.add_schur_product(x, y),
+            None => Ok(()),
+        }
     }
 
     fn solve_mass(&self, a: &mut [f64]) -> Result<(), RunError> {
@@ -317,16 +330,42 @@ impl Body for PlaneBody {
             .map_or_else(HeatOutputs::default, |h| h.outputs())
     }
 
-    fn prepare_step(&mut self, n: usize, lower: &[f64]) -> Result<(), RunError> {
+    fn prepare_step(&mut self, n: usize, lower: &[f64], w_old: &[f64]) -> Result<(), RunError> {
         match &mut self.heat {
-            Some(heat) => heat.prepare(n, lower),
+            Some(heat) => heat.prepare(n, lower, w_old),
             None => Ok(()),
         }
     }
 
-    fn heat_step(&mut self, n: usize, friction_work: &[f64]) -> Result<(), RunError> {
+    /// With a coupled temperature, the Taylor step's acceleration gains `M⁻¹ γ G θ^0`.
+    fn complete_start_up(
+        &self,
+        _u0: &[f64],
+        _v0: &[f64],
+        increment: &mut [f64],
+    ) -> Result<(), RunError> {
+        let Some(heat) = &self.heat else {
+            return Ok(());
+        };
+        let mut a = vec![0.0; increment.len()];
+        if heat.initial_thermal_force(&mut a) {
+            self.solve_mass(&mut a)?;
+            let half_dt2 = 0.5 * self.disc.dt * self.disc.dt;
+            for (z, ai) in increment.iter_mut().zip(&a) {
+                *z += half_dt2 * ai;
+            }
+        }
+        Ok(())
+    }
+
+    fn heat_step(
+        &mut self,
+        n: usize,
+        increments: (&[f64], Option<&[f64]>),
+        friction_work: &[f64],
+    ) -> Result<(), RunError> {
         match &mut self.heat {
-            Some(heat) => heat.step(n, friction_work),
+            Some(heat) => heat.step(n, increments, friction_work),
             None => Ok(()),
         }
     }
@@ -426,9 +465,31 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
     } else {
         Shape::ManyPlaneNormals
     };
+    let heat = match &scene.heat {
+        Some(table) => {
+            let parsed = table.validate(&scene.edges)?;
+            Some(Box::new(PlaneHeat::new(
+                grid,
+                (&normals, &friction_nodes),
+                &disc.free,
+                parsed,
+                disc.dt,
+            )?))
+        }
+        None => None,
+    };
     let method = scene.solver.method;
     let epsilon = || scene.solver.penalty_settings().epsilon;
+    let coupled = heat.as_ref().and_then(|h| {
+        h.coupled_solver_parts((&disc.pattern, &c), &constraints, &friction_nodes)
+    });
     let solver: Box<dyn StepSolver> = match algorithm_for(method, shape) {
+        // A coupled temperature: the exact solver of each state's `S` (the scene's
+        // validation admits the exact method only).
+        _ if coupled.is_some() => {
+            let (parts, exchange, implicit) = coupled.expect("matched");
+            Box::new(CoupledSolver::new(parts, exchange, implicit))
+        }
         Some(Algorithm::CondensedLcp) => Box::new(CondensedLcp::new(system()?, constraints, 0.0)?),
         Some(Algorithm::CondensedPenalty) => {
             Box::new(CondensedLcp::new(system()?, constraints, epsilon())?)
@@ -475,19 +536,6 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
         }
         .into());
     }
-    let heat = match &scene.heat {
-        Some(table) => {
-            let parsed = table.validate(&scene.edges)?;
-            Some(Box::new(PlaneHeat::new(
-                grid,
-                &normals,
-                &friction_nodes,
-                parsed,
-                dt,
-            )?))
-        }
-        None => None,
-    };
     if let Some(h) = &heat {
         let bound = conditioned_bound(
             PLANE_IDENTITY_TOL,

@@ -3,10 +3,14 @@
 //! `Φ = (a₁ sin(πx/W) sin(πy/H), a₂ sin(2πx/W) sin(2πy/H))`, and its load
 //! `l = ρ u_tt − div σ`, `σ = A ε(u + α u_t)` (derivation: `docs/plane-manufactured.md`).
 //! `Φ` vanishes on the boundary, so the clamped conditions hold; the unit test checks `l`
-//! against finite differences of `u` and the scene's load text against `l`.
+//! against finite differences of `u` and the scene's load text against `l`. [`Coupled`] adds a
+//! temperature `θ = b (1 + t) sin(πx/W) sin(πy/H)` coupled by `γ` (held at 0 on the edges),
+//! the load gaining `γ ∇θ` and the heat source `θ_t − κΔθ + γ div u_t`.
 
+use crate::scene::heat::ThermalCondition;
 use crate::scene::plane::{
-    Body, EdgeCondition, EdgeSpec, Edges, PlaneInitial, PlaneLoad, PlaneMesh, PlaneScene, Vector,
+    Body, EdgeCondition, EdgeSpec, Edges, PlaneHeat, PlaneInitial, PlaneLoad, PlaneMesh,
+    PlaneScene, ThermalEdge, Vector,
 };
 use crate::scene::schema::Time;
 use std::f64::consts::PI;
@@ -208,6 +212,86 @@ impl Manufactured {
     }
 }
 
+/// The manufactured solution with a coupled temperature: [`Manufactured`]'s `u` and
+/// `θ = b (1 + t) sin(k₁ₓx) sin(k₁ᵧy)`, `γ`, `κ`.
+#[derive(Clone, Copy, Debug)]
+pub struct Coupled {
+    pub mechanics: Manufactured,
+    /// `γ`, `κ`, `b`.
+    pub coupling: f64,
+    pub diffusivity: f64,
+    pub amplitude: f64,
+}
+
+impl Default for Coupled {
+    /// `γ = 0.8`, `κ = 0.3`, `b = 0.5` on [`Manufactured::default`].
+    fn default() -> Self {
+        Self {
+            mechanics: Manufactured::default(),
+            coupling: 0.8,
+            diffusivity: 0.3,
+            amplitude: 0.5,
+        }
+    }
+}
+
+impl Coupled {
+    /// `θ(x, y, t)`.
+    pub fn temperature(&self, x: f64, y: f64, t: f64) -> f64 {
+        let [k1x, k1y, _, _] = self.mechanics.k();
+        self.amplitude * (1.0 + t) * (k1x * x).sin() * (k1y * y).sin()
+    }
+
+    /// `l + γ ∇θ` and `q = θ_t − κ Δθ + γ div u_t` as scene expressions.
+    pub fn texts(&self) -> ([String; 2], String) {
+        let m = &self.mechanics;
+        let [k1x, k1y, k2x, k2y] = m.k();
+        let [a1, a2] = m.amplitude;
+        let (g, b, kappa) = (self.coupling, self.amplitude, self.diffusivity);
+        let (w, beta) = (m.omega, m.beta);
+        let [lx, ly] = m.load_text();
+        let load = [
+            format!("{lx} + {:?}*(1 + t)*cos({k1x:?}*x)*sin({k1y:?}*y)", g * b * k1x),
+            format!("{ly} + {:?}*(1 + t)*sin({k1x:?}*x)*cos({k1y:?}*y)", g * b * k1y),
+        ];
+        let gp = format!("({w:?}*({beta:?}*cos({w:?}*t) - sin({w:?}*t)))");
+        let laplacian = kappa * (k1x * k1x + k1y * k1y);
+        let source = format!(
+            "{b:?}*sin({k1x:?}*x)*sin({k1y:?}*y)*(1 + {laplacian:?}*(1 + t)) + {g:?}*{gp}*\
+             ({:?}*cos({k1x:?}*x)*sin({k1y:?}*y) + {:?}*sin({k2x:?}*x)*cos({k2y:?}*y))",
+            a1 * k1x,
+            a2 * k2y
+        );
+        (load, source)
+    }
+
+    /// [`Manufactured::scene`] with the coupled load and `[heat]`: `θ^0`, the source, every
+    /// edge held at 0.
+    pub fn scene(&self, nx: u64, ny: u64, y_grading: f64, dt: f64, end: f64) -> PlaneScene {
+        let mut scene = self.mechanics.scene(nx, ny, y_grading, dt, end);
+        let [k1x, k1y, _, _] = self.mechanics.k();
+        let (load, source) = self.texts();
+        scene.description = Some("Coupled manufactured solution (plane::closed_form).".into());
+        scene.load.density = Some(Vector(load));
+        let held = ThermalEdge {
+            condition: ThermalCondition::Temperature,
+            value: Some("0".into()),
+            ..Default::default()
+        };
+        scene.heat = Some(PlaneHeat {
+            coupling: self.coupling,
+            diffusivity: self.diffusivity,
+            temperature: format!("{:?}*sin({k1x:?}*x)*sin({k1y:?}*y)", self.amplitude),
+            source: Some(source),
+            left: held.clone(),
+            right: held.clone(),
+            bottom: held.clone(),
+            top: held,
+        });
+        scene
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -303,5 +387,44 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// `θ_t − κΔθ + γ div u_t` and `γ ∇θ` by central differences of [`Coupled`]'s fields
+    /// against its texts (less the mechanical load, checked above): truncation `O(h²)` of
+    /// third and fourth derivatives of size up to (2π)⁴ ≈ 1.6e3 and round-off ε/h², as above.
+    #[test]
+    fn coupled_source_and_load_match_finite_differences() {
+        let c = Coupled::default();
+        let (load, source) = c.texts();
+        let parse = |t: &str| Expression::parse_plane("heat.source", t, true).unwrap();
+        let (q, l) = (parse(&source), load.map(|t| parse(&t)));
+        let mechanical = c.mechanics.load_text().map(|t| parse(&t));
+        let h = FD_STEP;
+        let (mut worst, mut scale) = (0.0f64, 0.0f64);
+        for (x, y, t) in [(0.3, 0.2, 0.1), (1.1, 0.7, 0.45), (1.7, 0.55, 1.3)] {
+            let th = |x: f64, y: f64, t: f64| c.temperature(x, y, t);
+            let u = |x: f64, y: f64, t: f64| c.mechanics.displacement(x, y, t);
+            let theta_t = (th(x, y, t + h) - th(x, y, t - h)) / (2.0 * h);
+            let lap = (th(x + h, y, t) + th(x - h, y, t) + th(x, y + h, t) + th(x, y - h, t)
+                - 4.0 * th(x, y, t))
+                / (h * h);
+            let div = |t: f64| {
+                (u(x + h, y, t)[0] - u(x - h, y, t)[0] + u(x, y + h, t)[1] - u(x, y - h, t)[1])
+                    / (2.0 * h)
+            };
+            let div_t = (div(t + h) - div(t - h)) / (2.0 * h);
+            let expected = theta_t - c.diffusivity * lap + c.coupling * div_t;
+            let grad = [
+                (th(x + h, y, t) - th(x - h, y, t)) / (2.0 * h),
+                (th(x, y + h, t) - th(x, y - h, t)) / (2.0 * h),
+            ];
+            worst = worst.max((q.eval_xy(x, y, t).unwrap() - expected).abs());
+            scale = scale.max(expected.abs());
+            for k in 0..2 {
+                let thermal = l[k].eval_xy(x, y, t).unwrap() - mechanical[k].eval_xy(x, y, t).unwrap();
+                worst = worst.max((thermal - c.coupling * grad[k]).abs());
+            }
+        }
+        assert!(worst <= FD_TOL * scale, "{worst:e} vs {scale:e}");
     }
 }

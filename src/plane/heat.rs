@@ -1,14 +1,19 @@
-//! The plane body's temperature: `θ_t − κ Δθ = q`, Q1 on the body's mesh at the half steps,
-//! stepped after each mechanical step (the coupling `γ` is 0 on the plane, so the step of `θ`
-//! follows from `u^{n+1}`): Crank–Nicolson, or implicit Euler where the data are not smooth
+//! The plane body's temperature: `θ_t − κ Δθ + γ div u_t = q`, Q1 on the body's mesh at the
+//! half steps, stepped after each mechanical step (with `γ > 0` the step's displacement
+//! problem has `θ` eliminated, [`crate::plane::coupling`], and the heat step follows from its
+//! answer): Crank–Nicolson, or implicit Euler where the data are not smooth
 //! (the thermal bar's Rannacher start, [`crate::thermal::smoothing`]). Edges are insulated,
 //! held at a temperature, or exchange heat with their obstacle where in contact (lumped on the
 //! edge's nodes); the friction work of each frictional node enters it as nodal heat, the
 //! share `η` of its edge. Each contact state's matrix is factorised once, when first met.
 //! Derivation and the thermal terms of the energy identity: docs/thermal.md, "The plane body".
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::sparse::Pattern;
+use crate::plane::coupling::{CoupledParts, CouplingMatrix, HeatStepMatrix};
 use crate::plane::mesh::Grid;
 use crate::plane::normals::Normal;
 use crate::scene::expr::Expression;
@@ -16,7 +21,8 @@ use crate::scene::heat::EndHeat;
 use crate::scene::plane_heat::PlaneHeatExpressions;
 use crate::scheme::body::{HeatOutputs, HeatTerms};
 use crate::scheme::{RunError, in_contact};
-use crate::step::Friction;
+use crate::step::{Constraints, Friction};
+use crate::thermal::solver::ImplicitFlag;
 use crate::thermal::smoothing::{Smoothing, jumps_within, profile_jumps, starts_with_a_jump};
 
 /// A node held at its edge's temperature: the node, its edge and coordinate `s`.
@@ -38,11 +44,32 @@ struct ExchangeNode {
 }
 
 /// The factor of one step matrix `(M + c A_χ)` on the unknown temperatures: its exchange
-/// state `χ` and whether `c = Δt` (an implicit Euler step) or `Δt/2`.
+/// state `χ` and `c = wτ` (`Δt` an implicit Euler step, `Δt/2` a Crank–Nicolson one or the
+/// start-up's implicit half step, `Δt/4` the start-up's Crank–Nicolson half step).
 struct StepFactor {
     chi: Vec<bool>,
-    implicit: bool,
+    c: f64,
     factor: SparseCholesky,
+}
+
+/// The coupling `γ > 0`: `G`, the step's thermal load on the displacement and the heat the
+/// displacement's divergence takes, and the frictional heat lagged by one step (docs/thermal.md,
+/// "The plane body").
+struct Coupled {
+    gamma: f64,
+    g: CouplingMatrix,
+    /// Whether the step is an implicit Euler step, for the step solver.
+    implicit: ImplicitFlag,
+    /// `γ G θ̂ + γ w G_F B⁻¹ (r_F − γ/2 G_Fᵀ w)` on the displacement unknowns.
+    load: Vec<f64>,
+    /// `γ/2 Gᵀ δ` on every node.
+    heating: Vec<f64>,
+    /// Each frictional node's share of the previous step's `D_f`.
+    lagged: Vec<f64>,
+    /// Scratch on the displacement unknowns, on every node and on the unknown temperatures.
+    delta: Vec<f64>,
+    nodal: Vec<f64>,
+    unknown: Vec<f64>,
 }
 
 /// The plane body's temperature and its step.
@@ -55,11 +82,11 @@ pub struct PlaneHeat {
     pattern: Pattern,
     mass: Vec<f64>,
     stiffness: Vec<f64>,
-    /// The unknown temperatures (nodes not held): their pattern and each entry's position in
-    /// `pattern`; `free[i]` the node of unknown `i`.
-    reduced: Pattern,
-    from: Vec<usize>,
+    /// The step's matrix on the unknown temperatures (nodes not held); `free[i]` the node of
+    /// unknown `i`, `keep` the reverse.
+    step_matrix: HeatStepMatrix,
     free: Vec<usize>,
+    keep: Vec<Option<usize>>,
     fixed: Vec<FixedNode>,
     values: [Option<Expression>; 4],
     exchange: Vec<ExchangeNode>,
@@ -74,6 +101,8 @@ pub struct PlaneHeat {
     chi: Vec<bool>,
     theta_obs: [f64; 4],
     implicit: bool,
+    /// Whether the start-up's half step is implicit Euler (the data jump at `t = 0`).
+    start_implicit: bool,
     smoothing: Smoothing,
     start_jump: bool,
     /// `θ^{n−1/2}` and `θ^{n+1/2}` on every node.
@@ -88,13 +117,15 @@ pub struct PlaneHeat {
     a_weighted: Vec<f64>,
     rhs: Vec<f64>,
     unknown: Vec<f64>,
-    values_full: Vec<f64>,
     values_reduced: Vec<f64>,
+    /// `Σ q` and `Σ (1 − η) d` of the step.
+    inputs: (f64, f64),
+    coupled: Option<Coupled>,
     terms: HeatTerms,
 }
 
 /// The 3 × 3 node stencil of every node: the pattern of the scalar Q1 matrices.
-fn node_stencil(grid: &Grid) -> Pattern {
+pub(crate) fn node_stencil(grid: &Grid) -> Pattern {
     let n = grid.nodes();
     let mut row_ptr = Vec::with_capacity(n + 1);
     let mut cols = Vec::with_capacity(9 * n);
@@ -113,7 +144,7 @@ fn node_stencil(grid: &Grid) -> Pattern {
 
 /// The scalar Q1 mass and stiffness on the grid, cell by cell as tensor products of the P1
 /// element matrices in `x` and in `y` (exact on rectangles).
-fn assemble(grid: &Grid, pattern: &Pattern) -> (Vec<f64>, Vec<f64>) {
+pub(crate) fn assemble(grid: &Grid, pattern: &Pattern) -> (Vec<f64>, Vec<f64>) {
     let (mut mass, mut stiffness) = (vec![0.0; pattern.nnz()], vec![0.0; pattern.nnz()]);
     let m1 = |h: f64| [[h / 3.0, h / 6.0], [h / 6.0, h / 3.0]];
     let k1 = |h: f64| [[1.0 / h, -1.0 / h], [-1.0 / h, 1.0 / h]];
@@ -179,10 +210,11 @@ fn on_edge(grid: &Grid, node: usize, edge: usize) -> bool {
 impl PlaneHeat {
     /// The temperature of a plane body on `grid` with the contact `normals`, the frictional
     /// nodes `friction` and the parsed `[heat]`; `θ^0` evaluated at every node.
+    /// `mechanical` are the displacement unknowns' degrees of freedom (for `G`).
     pub fn new(
         grid: &Grid,
-        normals: &[Normal],
-        friction: &Friction,
+        (normals, friction): (&[Normal], &Friction),
+        mechanical: &[usize],
         heat: PlaneHeatExpressions,
         dt: f64,
     ) -> Result<Self, RunError> {
@@ -190,6 +222,7 @@ impl PlaneHeat {
         let (mass, stiffness) = assemble(grid, &pattern);
         let nodes = grid.nodes();
         let PlaneHeatExpressions {
+            coupling,
             diffusivity,
             temperature,
             source,
@@ -228,6 +261,8 @@ impl PlaneHeat {
                 let s = edge_coordinate(grid, node, edge);
                 let v0 = finite(value.eval(s, 0.0)?, key)?;
                 start_jump |= starts_with_a_jump(old[node], v0);
+                // A held node starts at its edge's value, as the bar's fixed end does.
+                old[node] = v0;
                 fixed.push(FixedNode { node, edge, s });
             }
         }
@@ -249,6 +284,7 @@ impl PlaneHeat {
         };
         let free: Vec<usize> = (0..nodes).filter(|&n| !held[n]).collect();
         let (reduced, from) = pattern.restrict(&keep);
+        let coefficient = |edge: usize| exchange_edges[edge].as_ref().map_or(0.0, |e| e.0);
         let exchange: Vec<ExchangeNode> = (normals.iter().enumerate())
             .filter(|(_, nk)| exchange_edges[nk.edge].is_some())
             .map(|(k, nk)| ExchangeNode {
@@ -258,11 +294,34 @@ impl PlaneHeat {
                 edge: nk.edge,
             })
             .collect();
-        let heated = (friction.normals.iter())
+        let step_matrix = HeatStepMatrix {
+            mass: from.iter().map(|&k| mass[k]).collect(),
+            stiffness: from.iter().map(|&k| stiffness[k]).collect(),
+            exchange: (exchange.iter())
+                .map(|x| {
+                    let position = keep[x.node].map(|i| reduced.position(i, i));
+                    (position, coefficient(x.edge), x.weight)
+                })
+                .collect(),
+            kappa: diffusivity,
+            pattern: reduced,
+        };
+        let heated: Vec<(usize, f64)> = (friction.normals.iter())
             .map(|&k| (normals[k].node, frictional_heating[normals[k].edge]))
             .collect();
         let source_load = vec![0.0; if source.is_some() { nodes } else { 0 }];
         let n_free = free.len();
+        let coupled = (coupling > 0.0).then(|| Coupled {
+            gamma: coupling,
+            g: CouplingMatrix::new(grid, &pattern, mechanical),
+            implicit: Arc::new(AtomicBool::new(false)),
+            load: vec![0.0; mechanical.len()],
+            heating: vec![0.0; nodes],
+            lagged: vec![0.0; heated.len()],
+            delta: vec![0.0; mechanical.len()],
+            nodal: vec![0.0; nodes],
+            unknown: vec![0.0; n_free],
+        });
         let sides = (grid.xs.windows(2))
             .chain(grid.ys.windows(2))
             .map(|p| p[1] - p[0]);
@@ -270,14 +329,13 @@ impl PlaneHeat {
             kappa: diffusivity,
             dt,
             least_side: sides.fold(f64::INFINITY, f64::min),
-            values_full: vec![0.0; pattern.nnz()],
-            values_reduced: vec![0.0; reduced.nnz()],
+            values_reduced: vec![0.0; step_matrix.pattern.nnz()],
+            step_matrix,
             pattern,
             mass,
             stiffness,
-            reduced,
-            from,
             free,
+            keep,
             fixed,
             values,
             chi: vec![false; exchange.len()],
@@ -289,6 +347,7 @@ impl PlaneHeat {
             factors: Vec::new(),
             theta_obs: [0.0; 4],
             implicit: false,
+            start_implicit: false,
             smoothing: Smoothing::default(),
             start_jump,
             new: old.clone(),
@@ -300,6 +359,8 @@ impl PlaneHeat {
             a_weighted: vec![0.0; nodes],
             rhs: vec![0.0; nodes],
             unknown: vec![0.0; n_free],
+            inputs: (0.0, 0.0),
+            coupled,
             terms: HeatTerms::default(),
         })
     }
@@ -351,7 +412,9 @@ impl PlaneHeat {
 
     /// The step from `t_n` (`n = 0` the start-up): the exchange state read off the step's
     /// bounds `lower`, `θ_obs(t_n)`, and whether the heat step is implicit Euler.
-    pub fn prepare(&mut self, n: usize, lower: &[f64]) -> Result<(), RunError> {
+    /// With `γ > 0` also the step's data and the displacement's thermal load ([`PlaneHeat::thermal_load`];
+    /// `w_old = u^n − u^{n−1}`).
+    pub fn prepare(&mut self, n: usize, lower: &[f64], w_old: &[f64]) -> Result<(), RunError> {
         let t = n as f64 * self.dt;
         for (k, e) in self.exchange_edges.iter().enumerate() {
             if let Some((_, obstacle)) = e {
@@ -383,8 +446,119 @@ impl PlaneHeat {
                 }
             }
         }
-        self.implicit = self.smoothing.schedule(n, jump) && n > 0;
+        let implicit = self.smoothing.schedule(n, jump);
+        // The start-up's half step is its own; its projection takes Crank–Nicolson's `S`.
+        (self.implicit, self.start_implicit) = match n {
+            0 => (false, implicit),
+            _ => (implicit, self.start_implicit),
+        };
+        let Some(mut coupled) = self.coupled.take() else {
+            return Ok(());
+        };
+        coupled.implicit.store(self.implicit, Ordering::Relaxed);
+        let lagged = std::mem::take(&mut coupled.lagged);
+        self.heat_inputs(&lagged);
+        coupled.lagged = lagged;
+        let result = self.begin(n).and_then(|()| match n {
+            0 => Ok(()),
+            _ => self.coupled_load(n, &mut coupled, w_old),
+        });
+        self.coupled = Some(coupled);
+        result
+    }
+
+    /// `γ G θ̂ + γ w G_F B⁻¹ (r_F − γ/2 G_Fᵀ w_old)`, `θ̂` the step's `θ^{n−1/2}` with the held
+    /// nodes at `θ_w`: the displacement's thermal load once `ζ_F` is eliminated.
+    fn coupled_load(&mut self, n: usize, c: &mut Coupled, w_old: &[f64]) -> Result<(), RunError> {
+        let (_, w) = self.weights(n);
+        c.nodal.copy_from_slice(&self.old);
+        for f in &self.fixed {
+            let (a, b) = (self.old[f.node], self.new[f.node]);
+            c.nodal[f.node] = a + w * (b - a);
+        }
+        c.g.mul_into(&c.nodal, c.gamma, &mut c.load);
+        c.g.transpose_mul_into(w_old, 0.5 * c.gamma, &mut c.nodal);
+        for (u, &node) in c.unknown.iter_mut().zip(&self.free) {
+            *u = self.rhs[node] - c.nodal[node];
+        }
+        let index = self.factor_index(w * self.dt)?;
+        self.factors[index].factor.solve_in_place(&mut c.unknown);
+        c.nodal.fill(0.0);
+        for (u, &node) in c.unknown.iter().zip(&self.free) {
+            c.nodal[node] = *u;
+        }
+        c.g.mul_into(&c.nodal, c.gamma * w, &mut c.delta);
+        for (l, d) in c.load.iter_mut().zip(&c.delta) {
+            *l += d;
+        }
         Ok(())
+    }
+
+    /// The displacement's thermal load of the step being taken (`γ > 0`; `None` uncoupled).
+    pub fn thermal_load(&self) -> Option<&[f64]> {
+        self.coupled.as_ref().map(|c| &c.load[..])
+    }
+
+    /// `γ G θ^0` (`γ > 0`; after the start-up's `prepare`): the thermal stress in the start-up's
+    /// Taylor step.
+    pub fn initial_thermal_force(&self, out: &mut [f64]) -> bool {
+        match &self.coupled {
+            Some(c) => {
+                c.g.mul_into(&self.old, c.gamma, out);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// `y += (γ²/4) G_F B⁻¹ G_Fᵀ x` with the start-up's Crank–Nicolson `B`: `S x − C x` of the
+    /// step solver's start-up state (`γ > 0`; nothing uncoupled).
+    pub fn add_schur_product(&mut self, x: &[f64], y: &mut [f64]) -> Result<(), RunError> {
+        let Some(mut c) = self.coupled.take() else {
+            return Ok(());
+        };
+        c.g.transpose_mul_into(x, 1.0, &mut c.nodal);
+        for (u, &node) in c.unknown.iter_mut().zip(&self.free) {
+            *u = c.nodal[node];
+        }
+        let result = self.factor_index(0.5 * self.dt);
+        if let Ok(index) = result {
+            self.factors[index].factor.solve_in_place(&mut c.unknown);
+            c.nodal.fill(0.0);
+            for (u, &node) in c.unknown.iter().zip(&self.free) {
+                c.nodal[node] = *u;
+            }
+            c.g.mul_into(&c.nodal, 0.25 * c.gamma * c.gamma, &mut c.delta);
+            for (yi, d) in y.iter_mut().zip(&c.delta) {
+                *yi += d;
+            }
+        }
+        self.coupled = Some(c);
+        result.map(|_| ())
+    }
+
+    /// The parts of the coupled step solver (`γ > 0`): `C` on `c_pattern`, `G_F`, `B`'s parts,
+    /// the constraints and frictional nodes; the exchange nodes' constraints, in the order of a
+    /// state's entries, and the flag of the implicit steps.
+    pub fn coupled_solver_parts(
+        &self,
+        (c_pattern, c): (&Pattern, &[f64]),
+        constraints: &Constraints,
+        friction: &Friction,
+    ) -> Option<(CoupledParts, Vec<usize>, ImplicitFlag)> {
+        let coupled = self.coupled.as_ref()?;
+        let parts = CoupledParts {
+            c_pattern: c_pattern.clone(),
+            c: c.to_vec(),
+            g: coupled.g.restrict_columns(&self.keep),
+            heat: self.step_matrix.clone(),
+            gamma: coupled.gamma,
+            dt: self.dt,
+            constraints: constraints.clone(),
+            friction: friction.clone(),
+        };
+        let exchange = self.exchange.iter().map(|x| x.constraint).collect();
+        Some((parts, exchange, coupled.implicit.clone()))
     }
 
     /// `t_{n−1/2}` and `t_{n+1/2}` of step `n` (`0` and `Δt/2` for the start-up).
@@ -411,54 +585,88 @@ impl PlaneHeat {
         }
     }
 
-    /// The factor of `(M + c A_χ)` on the unknown temperatures, `c = Δt` when `implicit`, else
-    /// `Δt/2` (Crank–Nicolson, and the start-up's half step); made when the state is first met.
-    fn factor_index(&mut self, implicit: bool) -> Result<usize, RunError> {
+    /// The factor of `(M + c A_χ)` on the unknown temperatures (`c = wτ`) in the step's exchange
+    /// state, made when first met.
+    fn factor_index(&mut self, c: f64) -> Result<usize, RunError> {
         if let Some(i) =
-            (self.factors.iter()).position(|f| f.implicit == implicit && f.chi == self.chi)
+            (self.factors.iter()).position(|f| f.c == c && f.chi == self.chi)
         {
             return Ok(i);
         }
-        let c = if implicit { self.dt } else { 0.5 * self.dt };
-        for ((v, m), k) in self
-            .values_full
-            .iter_mut()
-            .zip(&self.mass)
-            .zip(&self.stiffness)
-        {
-            *v = m + c * self.kappa * k;
-        }
-        for (x_e, &chi) in self.exchange.iter().zip(&self.chi) {
-            if chi {
-                let h = self.exchange_edges[x_e.edge].as_ref().map_or(0.0, |e| e.0);
-                let p = self.pattern.position(x_e.node, x_e.node);
-                self.values_full[p] += c * h * x_e.weight;
-            }
-        }
-        for (v, &p) in self.values_reduced.iter_mut().zip(&self.from) {
-            *v = self.values_full[p];
-        }
-        let factor = SparseCholesky::new(&self.reduced, &self.values_reduced, "the heat step")?;
+        (self.step_matrix).values(&self.chi, c, &mut self.values_reduced);
+        let factor = SparseCholesky::new(
+            &self.step_matrix.pattern,
+            &self.values_reduced,
+            "the heat step",
+        )?;
         self.factors.push(StepFactor {
             chi: self.chi.clone(),
-            implicit,
+            c,
             factor,
         });
         Ok(self.factors.len() - 1)
     }
 
     /// The heat step `θ^{n−1/2} → θ^{n+1/2}` after the mechanical step from `t_n`
-    /// (`n = 0`: `θ^0 → θ^{1/2}`, an implicit Euler half step), with frictional node `j`'s
-    /// share `friction_work[j]` of `D_f`; records the step's thermal terms.
-    pub fn step(&mut self, n: usize, friction_work: &[f64]) -> Result<(), RunError> {
-        std::mem::swap(&mut self.old, &mut self.new);
-        let (tau, w) = if n == 0 {
-            (0.5 * self.dt, 1.0)
+    /// (`n = 0`: `θ^0 → θ^{1/2}`, a Crank–Nicolson half step, implicit Euler where the data
+    /// jump at `t = 0`), with frictional node `j`'s
+    /// share `friction_work[j]` of `D_f` and the step's displacement increments
+    /// `(z, w)` (`w = None` at the start-up); records the step's thermal terms. With `γ > 0`
+    /// the step's data were set by [`PlaneHeat::prepare`], the frictional heat is the previous
+    /// step's, and the heat rows take `γ/2 Gᵀ (z + w)`.
+    pub fn step(
+        &mut self,
+        n: usize,
+        (z, w_old): (&[f64], Option<&[f64]>),
+        friction_work: &[f64],
+    ) -> Result<(), RunError> {
+        let Some(mut coupled) = self.coupled.take() else {
+            self.heat_inputs(friction_work);
+            self.begin(n)?;
+            return self.finish(n);
+        };
+        // γ/2 Gᵀ δ, δ = z + w (z at the start-up), leaves the unknown rows' right-hand side.
+        for (d, (i, zi)) in coupled.delta.iter_mut().zip(z.iter().enumerate()) {
+            *d = zi + w_old.map_or(0.0, |w| w[i]);
+        }
+        let half = 0.5 * coupled.gamma;
+        (coupled.g).transpose_mul_into(&coupled.delta, half, &mut coupled.heating);
+        for (r, h) in self.rhs.iter_mut().zip(&coupled.heating) {
+            *r -= h;
+        }
+        coupled.lagged.copy_from_slice(friction_work);
+        self.coupled = Some(coupled);
+        self.finish(n)
+    }
+
+    /// `q_j = η_j d_j` at each frictional node from its share `d_j` of `D_f`, and their sums.
+    fn heat_inputs(&mut self, friction_work: &[f64]) {
+        self.heat.fill(0.0);
+        let (mut heating, mut obstacle) = (0.0, 0.0);
+        for (&(node, eta), &d) in self.heated.iter().zip(friction_work) {
+            self.heat[node] += eta * d;
+            heating += eta * d;
+            obstacle += (1.0 - eta) * d;
+        }
+        self.inputs = (heating, obstacle);
+    }
+
+    /// `τ` and `w` of step `n`'s heat step.
+    fn weights(&self, n: usize) -> (f64, f64) {
+        if n == 0 {
+            (0.5 * self.dt, if self.start_implicit { 1.0 } else { 0.5 })
         } else if self.implicit {
             (self.dt, 1.0)
         } else {
             (self.dt, 0.5)
-        };
+        }
+    }
+
+    /// The step's data: `θ^{n−1/2}` moved to `old`, the held nodes' `θ^{n+1/2}`, and the right-
+    /// hand side `τ (Q + h X χ θ_obs − A θ^{n−1/2}) + q − (M + wτ A) ζ_held` on every node.
+    fn begin(&mut self, n: usize) -> Result<(), RunError> {
+        std::mem::swap(&mut self.old, &mut self.new);
+        let (tau, w) = self.weights(n);
         let t_n = n as f64 * self.dt;
         let (_, t_new) = self.half_steps(n);
         // θ^{n+1/2} at the held nodes; the others start from θ^{n−1/2}.
@@ -469,7 +677,7 @@ impl PlaneHeat {
                 .expect("a held edge has a value");
             self.new[f.node] = finite(value.eval(f.s, t_new)?, VALUE_KEYS[f.edge])?;
         }
-        // The source Q = M q(·, t_n) and the frictional heat q_j = η_j d_j.
+        // The source Q = M q(·, t_n).
         if let Some(source) = &self.source {
             for (node, &(x, y)) in self.points.iter().enumerate() {
                 self.weighted[node] = finite(source.eval_xy(x, y, t_n)?, "heat.source")?;
@@ -477,14 +685,6 @@ impl PlaneHeat {
             self.pattern
                 .mul_into(&self.mass, &self.weighted, &mut self.source_load);
         }
-        self.heat.fill(0.0);
-        let (mut heating, mut obstacle) = (0.0, 0.0);
-        for (&(node, eta), &d) in self.heated.iter().zip(friction_work) {
-            self.heat[node] += eta * d;
-            heating += eta * d;
-            obstacle += (1.0 - eta) * d;
-        }
-        // rhs = τ (Q + h X χ θ_obs − A θ^{n−1/2}) + q − (M + wτ A) ζ_held.
         let mut product = std::mem::take(&mut self.product);
         self.apply_a(&self.old, &mut product);
         self.product = product;
@@ -519,7 +719,14 @@ impl PlaneHeat {
             }
             (self.weighted, self.product) = (zeta, product);
         }
-        let index = self.factor_index(n > 0 && self.implicit)?;
+        Ok(())
+    }
+
+    /// Solves the unknown rows of the right-hand side `begin` made, checks `θ^{n+1/2}` finite and
+    /// records the step's thermal terms.
+    fn finish(&mut self, n: usize) -> Result<(), RunError> {
+        let (tau, w) = self.weights(n);
+        let index = self.factor_index(w * tau)?;
         for (u, &node) in self.unknown.iter_mut().zip(&self.free) {
             *u = self.rhs[node];
         }
@@ -535,7 +742,7 @@ impl PlaneHeat {
                 failure: crate::step::StepFailure::NonFinite,
             });
         }
-        self.measure(tau, w, (heating, obstacle));
+        self.measure(tau, w, self.inputs);
         Ok(())
     }
 
@@ -576,6 +783,9 @@ impl PlaneHeat {
                 }
             }
             rho -= tau * self.source_load.get(node).copied().unwrap_or(0.0) + self.heat[node];
+            if let Some(c) = &self.coupled {
+                rho += c.heating[node];
+            }
             supply += self.weighted[node] * rho;
         }
         let mut frictional_supply = 0.0;

@@ -13,6 +13,7 @@
 
 pub(crate) mod body;
 pub mod closed_form;
+pub(crate) mod coupling;
 pub(crate) mod energy;
 pub(crate) mod friction;
 pub(crate) mod heat;

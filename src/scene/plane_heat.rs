@@ -1,5 +1,5 @@
 //! Checks the `[heat]` table of a plane scene ([`crate::scene::plane::PlaneHeat`]): the temperature
-//! `θ_t − κ Δθ = q` (the coupling `γ` to the displacement must be 0 on the plane), its initial
+//! `θ_t − κ Δθ + γ div u_t = q` (the stress gains `−γθI`), its initial
 //! value (an expression in `x`, `y`), source (in `x`, `y`, `t`), and per edge (`left`, `right`,
 //! `bottom`, `top`) the bar's thermal conditions: insulated (the default), a fixed temperature
 //! `value` (in the edge's coordinate `s` and `t`) or, on a Signorini edge, an exchange with
@@ -16,6 +16,8 @@ use crate::scene::plane::{EDGE_NAMES, EdgeCondition, Edges, PlaneHeat, ThermalEd
 /// The parsed `[heat]` of a plane scene.
 #[derive(Clone, Debug)]
 pub struct PlaneHeatExpressions {
+    /// `γ`.
+    pub coupling: f64,
     pub diffusivity: f64,
     /// `θ(x, y, 0)`.
     pub temperature: Expression,
@@ -40,13 +42,6 @@ impl PlaneHeat {
                 "heat.coupling",
                 self.coupling,
                 "must be a finite number >= 0",
-            ));
-        }
-        if self.coupling != 0.0 {
-            return Err(invalid(
-                "heat.coupling",
-                self.coupling,
-                "must be 0 on the plane body: its temperature is not coupled to the displacement",
             ));
         }
         if !(self.diffusivity.is_finite() && self.diffusivity > 0.0) {
@@ -87,6 +82,7 @@ impl PlaneHeat {
             }
         }
         Ok(PlaneHeatExpressions {
+            coupling: self.coupling,
             diffusivity: self.diffusivity,
             temperature,
             source,

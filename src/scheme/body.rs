@@ -89,8 +89,9 @@ pub trait Body {
     fn mass_mul(&self, x: &[f64], y: &mut [f64]);
     /// `y = K x`.
     fn stiffness_mul(&self, x: &[f64], y: &mut [f64]);
-    /// `y = C x`.
-    fn step_matrix_mul(&self, x: &[f64], y: &mut [f64]);
+    /// `y = C x`: the norm the start-up's Taylor step is projected in (a body whose step
+    /// matrix depends on the step's state, the coupled plane, takes the start-up's).
+    fn step_matrix_mul(&mut self, x: &[f64], y: &mut [f64]) -> Result<(), RunError>;
     /// `a ← M⁻¹ a` on the unknowns that carry mass, `0` on the others (start-up only).
     fn solve_mass(&self, a: &mut [f64]) -> Result<(), RunError>;
     /// The rows of the full-mesh mass matrix at the unknowns (`FullMassRows`).
@@ -130,8 +131,9 @@ pub trait Body {
     /// which ends exchange heat), before the step's right-hand side; `n = 0` before the
     /// start-up step. `lower` are the step's bounds `lo_k = −g_k − s_k u^n_{i_k}`, the
     /// obstacles already moved to `t_{n+1}` ([`crate::scheme::ContactSet::lower_bounds_into`]):
-    /// a body reads contact off them, never off gaps of its own. Allocates nothing.
-    fn prepare_step(&mut self, _n: usize, _lower: &[f64]) -> Result<(), RunError> {
+    /// a body reads contact off them, never off gaps of its own. `w_old = u^n − u^{n−1}` (0
+    /// before the start-up). Allocates nothing.
+    fn prepare_step(&mut self, _n: usize, _lower: &[f64], _w_old: &[f64]) -> Result<(), RunError> {
         Ok(())
     }
     /// Completes the start-up increment `u^1 − u^0` that the scheme has put in `increment`
@@ -148,12 +150,18 @@ pub trait Body {
     fn heat_outputs(&self) -> HeatOutputs {
         HeatOutputs::default()
     }
-    /// The heat step of a body whose temperature follows its mechanics (the plane body's,
-    /// not coupled to its displacement), after the solve of the step from `t_n`:
-    /// `θ^{n−1/2} → θ^{n+1/2}` (`n = 0`: the start-up's half step `θ^0 → θ^{1/2}`), with
-    /// `friction_work[j]` frictional node `j`'s share of the step's `D_f` (empty without
-    /// friction). Allocates nothing once each contact state's matrix is factorised.
-    fn heat_step(&mut self, _n: usize, _friction_work: &[f64]) -> Result<(), RunError> {
+    /// The heat step of a body whose temperature follows its mechanics (the plane body's),
+    /// after the solve of the step from `t_n`: `θ^{n−1/2} → θ^{n+1/2}` (`n = 0`: the
+    /// start-up's half step `θ^0 → θ^{1/2}`), with the step's increments `(z, w_old)`
+    /// (`w_old = None` at the start-up) and `friction_work[j]` frictional node `j`'s share of
+    /// the step's `D_f` (empty without friction). Allocates nothing once each contact state's
+    /// matrix is factorised.
+    fn heat_step(
+        &mut self,
+        _n: usize,
+        _increments: (&[f64], Option<&[f64]>),
+        _friction_work: &[f64],
+    ) -> Result<(), RunError> {
         Ok(())
     }
     /// The thermal terms of the start-up's record: `E^{1/2}`'s thermal part and, for a body

@@ -181,7 +181,7 @@ impl<B: Body> Scheme<B> {
             self.solver.set_obstacle_slide(slide.displacement());
         }
         self.contact.lower_bounds_into(&self.u, &mut self.lower);
-        self.body.prepare_step(0, &self.lower)?;
+        self.body.prepare_step(0, &self.lower, &self.w)?;
         // a = M⁻¹ (F^0 − K u^0 − α K u_1), in z.
         let (acc, kv) = (&mut self.z, &mut self.b);
         self.body.stiffness_mul(&self.u, acc);
@@ -198,7 +198,7 @@ impl<B: Body> Scheme<B> {
             self.w[i] = dt * v0[i] + 0.5 * dt * dt * acc[i];
         }
         self.body.complete_start_up(&self.u, v0, &mut self.w)?;
-        self.body.step_matrix_mul(&self.w, &mut self.b);
+        self.body.step_matrix_mul(&self.w, &mut self.b)?;
         // The start-up's slip is u^1 − u^0: a frictional solver's previous increment is 0.
         self.z.fill(0.0);
         self.solver.set_previous_increment(&self.z);
@@ -208,7 +208,7 @@ impl<B: Body> Scheme<B> {
         // The friction work over the start-up, `−r_T,j (u^1 − u^0)_{t_j}`, and the heat step.
         let work = &mut self.friction_work;
         (self.contact).friction_work_into(&self.reactions, (&self.z, None), 1.0, work);
-        self.body.heat_step(0, &self.friction_work)?;
+        self.body.heat_step(0, (&self.z, None), &self.friction_work)?;
         let potential0 = self.body.stiffness_form(&self.u);
         add_in_place(&mut self.u, &self.z);
         self.body.mass_mul(&self.z, &mut self.b);
@@ -306,7 +306,7 @@ impl<B: Body> Scheme<B> {
         self.contact.advance_gaps((n + 1) as f64 * self.body.dt())?;
         self.contact.lower_bounds_into(&self.u, &mut self.lower);
         // 2. F^n and b.
-        self.body.prepare_step(n, &self.lower)?;
+        self.body.prepare_step(n, &self.lower, &self.w)?;
         self.load.update(&self.body, n)?;
         let force = self.load.force();
         self.body.rhs_into(&self.u, &self.w, force, &mut self.b);
@@ -328,7 +328,8 @@ impl<B: Body> Scheme<B> {
         // A temperature that follows the mechanics takes its step, heated by friction.
         let work = &mut self.friction_work;
         (self.contact).friction_work_into(&self.reactions, (&self.z, Some(&self.w)), 0.5, work);
-        self.body.heat_step(n, &self.friction_work)?;
+        let increments = (&self.z[..], Some(&self.w[..]));
+        self.body.heat_step(n, increments, &self.friction_work)?;
         let clock = clock.lap(&mut self.timing.solve_ns);
         // 4. The contact state and the energy identity.
         let mut record = StepRecord {

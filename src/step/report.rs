@@ -85,6 +85,9 @@ pub enum StepFailure {
     /// finite termination proof makes unreachable; kept as a guard).
     #[error("solver status: active-set iteration did not terminate in {iterations} iterations")]
     IterationLimit { iterations: u32 },
+    /// The step's matrix, made when the run first met its state, could not be set up.
+    #[error("setting up the step's matrix failed: {0}")]
+    Setup(String),
     /// The solver reported success but its answer fails an optimality condition checked
     /// independently by [`crate::step::audit::KktAudit`].
     #[error("audit failed: {what} = {value:e} exceeds its tolerance {tolerance:e}")]

@@ -592,14 +592,14 @@ impl Body for ThermalBody {
 
     /// `[[C, −γ/2 G], [−γ/2 Gᵀ, −H_χ]] x` with the step's exchange state, or on an implicit
     /// Euler step `[[C, −γ G], [−γ Gᵀ, −2(M_θ + Δt κ K_θ + Δt h χ)]] x`.
-    fn step_matrix_mul(&self, x: &[f64], y: &mut [f64]) {
+    fn step_matrix_mul(&mut self, x: &[f64], y: &mut [f64]) -> Result<(), RunError> {
         let m = &self.m;
         let weight = heat_weight(self.implicit);
         let (n_u, gamma, s, scale) = (m.n_u, m.gamma, weight * self.dt(), 2.0 * weight);
         let (xu, xt) = x.split_at(n_u);
         let theta = |k: usize| m.theta_unknown(k).map_or(0.0, |j| x[j]);
         let (yu, yt) = y.split_at_mut(n_u);
-        self.bar.step_matrix_mul(xu, yu);
+        self.bar.step_matrix_mul(xu, yu)?;
         for (i, yi) in yu.iter_mut().enumerate() {
             *yi -= weight * gamma * self.g_row(m.u_first + i, theta);
         }
@@ -612,6 +612,7 @@ impl Body for ThermalBody {
             }
             *yj = -(scale * h) - weight * gamma * self.gt_row(j, |k| self.disp(xu, k));
         }
+        Ok(())
     }
 
     fn solve_mass(&self, a: &mut [f64]) -> Result<(), RunError> {
@@ -659,7 +660,7 @@ impl Body for ThermalBody {
     /// reads it (the gaps of `u^n` against the obstacles where the step puts them),
     /// `θ_obs(t_n)`, the fixed ends' `θ_end(t_{n∓1/2})` and the source's `Q^n`. Allocates
     /// nothing.
-    fn prepare_step(&mut self, n: usize, lower: &[f64]) -> Result<(), RunError> {
+    fn prepare_step(&mut self, n: usize, lower: &[f64], _w_old: &[f64]) -> Result<(), RunError> {
         let dt = self.dt();
         let t = n as f64 * dt;
         for (e, x) in self.exchange.iter().enumerate() {

@@ -3,8 +3,8 @@
 
 use super::Measured;
 use crate::plane_heat::{
-    belt, exchange_decay, heat_balance, initial_jump_monotonicity, sudden_edge_excursion,
-    uniform_end,
+    belt, coupled_strip_against_bar, exchange_decay, heat_balance, initial_jump_monotonicity,
+    sudden_edge_excursion, uniform_end,
 };
 use viscobar::scheme::RunError;
 
@@ -30,6 +30,12 @@ pub const PLANE_MONOTONE_TOL: f64 = 1e-12;
 /// start-up leave the stiff modes' remainder, measured 2.0e-9, the bound five times that; a
 /// Crank–Nicolson start leaves a decrease of 0.78.
 pub const BAR_MONOTONE_TOL: f64 = 1e-8;
+
+/// The coupled strip against the thermal bar, relative to each field's largest value: two
+/// independent solvers of the same equations (the bar's block-tridiagonal `LDLᵀ` and end
+/// enumeration, the plane's sparse quasi-definite `LDLᵀ` and condensed LCP), whose round-off
+/// differs at each of the 150 steps.
+pub const COUPLED_STRIP_TOL: f64 = 1e-12;
 
 /// The registry's entries for the plane body's temperature.
 pub fn plane_heat_measured() -> Result<Vec<Measured>, RunError> {
@@ -72,6 +78,16 @@ pub fn plane_heat_measured() -> Result<Vec<Measured>, RunError> {
             worst: initial_jump_monotonicity()?,
             note: "an initial jump inside a cell, κΔt/h² = 100, every row and step; no decrease \
                    measured",
+        },
+        Measured {
+            name: "COUPLED_STRIP_TOL".into(),
+            used_in: "tests/plane_heat_coupled.rs",
+            tolerance: COUPLED_STRIP_TOL,
+            worst: {
+                let (u, theta, _) = coupled_strip_against_bar()?;
+                u.max(theta)
+            },
+            note: "u and θ at every node and step of the heated strip against the thermal bar",
         },
         Measured {
             name: "BAR_MONOTONE_TOL".into(),
