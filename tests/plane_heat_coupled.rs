@@ -4,10 +4,8 @@
 //! coupling acting on the mechanics; an exchanging floor switches the step's coupled matrix
 //! with its contact, and keeps the identity.
 
-use viscobar::StepRecord;
-use viscobar_certificate::plane_heat::{
-    self, coupled_launch, coupled_manufactured_errors, orders,
-};
+use viscobar::{Body, StepRecord};
+use viscobar_certificate::plane_heat::{self, coupled_launch, coupled_manufactured_errors, orders};
 use viscobar_certificate::tolerances::COUPLED_STRIP_TOL;
 
 /// The observed orders of the coupled manufactured solution's nodal errors in `u` and `θ`
@@ -53,7 +51,9 @@ fn a_coupled_frictional_launch_keeps_the_identity_at_every_step() {
     let last = records.last().unwrap();
     assert!(last.slip_nodes == 0, "still slipping at the end: {last:?}");
     assert!(records.iter().any(|r| r.slip_nodes > 0));
-    let report = sim.solver_report().expect("the exact solver keeps an audit");
+    let report = sim
+        .solver_report()
+        .expect("the exact solver keeps an audit");
     assert!(report.audit.steps as usize >= records.len() - 1);
 }
 
@@ -94,7 +94,11 @@ diagnostics_every = 1
     let scene = viscobar::PlaneScene::from_toml(text, &[]).unwrap();
     let (records, _) = plane_heat::run(&scene).unwrap();
     assert_identity_every_step(&records);
-    let exchanged: Vec<f64> = records.iter().filter_map(|r| r.heat).map(|h| h.exchange).collect();
+    let exchanged: Vec<f64> = records
+        .iter()
+        .filter_map(|r| r.heat)
+        .map(|h| h.exchange)
+        .collect();
     assert!(exchanged.iter().any(|&e| e > 0.0), "the floor took no heat");
     assert!(exchanged.contains(&0.0), "never out of contact");
 }
@@ -109,4 +113,27 @@ fn a_coupled_strip_runs_the_thermal_bar() {
     assert!(least > 0.0, "θ fell to {least}: the strip's edges may open");
     assert!(du <= COUPLED_STRIP_TOL, "u: {du:e}");
     assert!(dtheta <= COUPLED_STRIP_TOL, "θ: {dtheta:e}");
+}
+
+/// A coupled body at rest at a uniform temperature has the stress `−γθ` on the diagonal (the
+/// outputs' nodal stress, `σ_zz` included) and no shear; uncoupled, none.
+#[test]
+fn the_output_stress_carries_the_thermal_stress() {
+    for (gamma, expected) in [(0.5, -0.75), (0.0, 0.0)] {
+        let text = format!(
+            "[plane]\nwidth = 1.0\nheight = 0.5\nlambda = 1.0\nmu = 1.0\n[mesh]\nnx = 4\nny = 2\n\
+             [time]\nstep = 0.01\nend = 0.1\n[heat]\ncoupling = {gamma:?}\ndiffusivity = 0.1\n\
+             temperature = \"1.5\"\n"
+        );
+        let scene = viscobar::PlaneScene::from_toml(&text, &[]).unwrap();
+        let unstarted = viscobar::PlaneSimulation::prepare(&scene).unwrap();
+        let state = unstarted.state();
+        let stress = unstarted.body().nodal_stress(state.u, state.w).unwrap();
+        for s in stress {
+            assert_eq!(
+                [s[0], s[1], s[2], s[3]],
+                [expected, expected, 0.0, expected]
+            );
+        }
+    }
 }

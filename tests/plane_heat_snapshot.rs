@@ -14,6 +14,7 @@ use serde::Serialize;
 use viscobar::Body;
 use viscobar::plane::{PlaneBody, PlaneSimulation};
 use viscobar_certificate::plane::contact::plane_scene;
+use viscobar_certificate::tolerances::SUM_TOL;
 
 mod common;
 
@@ -21,9 +22,6 @@ mod common;
 const SIGNIFICANT_DIGITS: i32 = 7;
 /// Rows of the snapshot (10 intervals).
 const T_POINTS: usize = 11;
-/// The heat sums against each other, relative to the largest: sums of a few hundred steps'
-/// heat (each `η d_j` and `(1 − η) d_j` of one `d_j`, the content a backward-stable solve).
-const SUM_TOL: f64 = 1e-13;
 
 /// [`common::round_to_digits`] with this file's [`SIGNIFICANT_DIGITS`].
 fn round_sig(x: f64, scale: f64) -> f64 {

@@ -335,13 +335,39 @@ pub fn coupled_strip_against_bar() -> Result<(f64, f64, f64), RunError> {
             t_scale = t_scale.max(tb.abs());
             least = least.min(tb);
             for node in [i, i + nx] {
-                let up = p.unknown_of(2 * node).map_or(0.0, |k| plane.displacement()[k]);
+                let up = p
+                    .unknown_of(2 * node)
+                    .map_or(0.0, |k| plane.displacement()[k]);
                 du = du.max((up - ub).abs());
                 dt = dt.max((theta(&plane, node) - tb).abs());
             }
         }
     }
     Ok((du / u_scale, dt / t_scale, least))
+}
+
+/// The built-in `plane-brake` (`η < 1` at its floor) over every step: the largest
+/// `|Σ (1 − η) d − (1 − η)/η Σ η d|` (heat to the belt against the body's share) and the
+/// largest excess of the heat content over the frictional heating so far (the top, held at 0,
+/// only lets heat out), each relative to the largest frictional heating so far.
+pub fn brake_heat_sums() -> Result<(f64, f64), RunError> {
+    let text = viscobar::scene::plane_builtin_text("plane-brake").expect("a built-in scene");
+    let scene = PlaneScene::from_toml(text, &[])?;
+    let eta = (scene.heat.as_ref())
+        .and_then(|h| h.bottom.frictional_heating)
+        .expect("the brake's floor has its share η");
+    let (records, _) = run(&scene)?;
+    let (mut heating, mut to_obstacle) = (0.0, 0.0);
+    let (mut share, mut excess, mut largest) = (0.0f64, 0.0f64, 0.0f64);
+    for r in &records {
+        let h = r.heat.expect("a temperature");
+        heating += h.frictional_heating;
+        to_obstacle += h.obstacle_heating;
+        largest = largest.max(heating);
+        share = share.max((to_obstacle - (1.0 - eta) / eta * heating).abs());
+        excess = excess.max(h.heat_content - heating);
+    }
+    Ok((share / largest, excess / largest))
 }
 
 /// The observed orders between successive levels.
@@ -493,7 +519,12 @@ pub fn markdown() -> Result<String, RunError> {
     let levels: Vec<String> = (COUPLED_LEVELS.iter().zip(&coupled))
         .map(|((n, dt), (u, t))| format!("{n} × {}, Δt = {dt}: {u:.3e}, {t:.3e}", n / 2))
         .collect();
-    let show = |o: Vec<f64>| o.iter().map(|o| format!("{o:.2}")).collect::<Vec<_>>().join(", ");
+    let show = |o: Vec<f64>| {
+        o.iter()
+            .map(|o| format!("{o:.2}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     let _ = writeln!(
         s,
         "| coupled manufactured (`γ = 0.8`): nodal errors of `u` and `θ` per level; observed orders in `u`; in `θ` | {}; {}; {} |",

@@ -1,6 +1,6 @@
 """The arrays and files of `viscobar.run` against the command line's files for the same scene
 and keys, bit for bit, on a bar, a plane, a plane with friction, a thermal bar and a plane with
-a temperature."""
+a temperature, uncoupled and coupled."""
 
 import filecmp
 import threading
@@ -20,11 +20,17 @@ CASES = {
     "plane-friction-tilted-drop": {"time.end": "0.3"},
     "thermal-impact": {"time.end": "0.5", "output.nodes": "21"},
     "plane-brake": {"time.end": "0.3", "output.every": "3"},
+    "plane-brake coupled": {"time.end": "0.3", "output.every": "3", "heat.coupling": "0.5"},
 }
 
-#: The scenes with a temperature, and those with friction.
-HEATED = {"thermal-impact", "plane-brake"}
-FRICTIONAL = {"plane-friction-tilted-drop", "plane-brake"}
+#: The cases with a temperature, and those with friction.
+HEATED = {"thermal-impact", "plane-brake", "plane-brake coupled"}
+FRICTIONAL = {"plane-friction-tilted-drop", "plane-brake", "plane-brake coupled"}
+
+
+def scene_of(case):
+    """The built-in scene a case runs (its name's first word)."""
+    return case.split()[0]
 
 
 def cli_run(scene, overrides, folder):
@@ -33,9 +39,9 @@ def cli_run(scene, overrides, folder):
     return folder
 
 
-@pytest.mark.parametrize("scene", CASES)
-def test_arrays_hold_the_bits_of_the_cli_files(scene, out):
-    overrides = CASES[scene]
+@pytest.mark.parametrize("case", CASES)
+def test_arrays_hold_the_bits_of_the_cli_files(case, out):
+    overrides, scene = CASES[case], scene_of(case)
     files = cli_run(scene, overrides, out / "cli")
     run = viscobar.run(scene, set=overrides)
 
@@ -45,7 +51,7 @@ def test_arrays_hold_the_bits_of_the_cli_files(scene, out):
         assert same_bits(run.history[column], values), column
     assert run.history["step"].dtype == np.float64
     columns = list(run.history)
-    if scene in FRICTIONAL:
+    if case in FRICTIONAL:
         # The frictional floor's tangential total, beside its reaction.
         at = columns.index("reaction_bottom")
         assert columns[at + 1] == "tangential_reaction_bottom"
@@ -67,7 +73,7 @@ def test_arrays_hold_the_bits_of_the_cli_files(scene, out):
     else:
         assert same_bits(table["x"], np.tile(run.positions, kept))
         fields = {"u": run.displacement, "v": run.velocity}
-    if scene in HEATED:
+    if case in HEATED:
         assert run.theta.shape == (kept, nodes)
         fields["theta"] = run.theta
     else:
@@ -81,9 +87,9 @@ def test_arrays_hold_the_bits_of_the_cli_files(scene, out):
     assert run.summary["output"]["kept_steps"] == kept
 
 
-@pytest.mark.parametrize("scene", CASES)
-def test_write_gives_the_cli_files(scene, out):
-    overrides = CASES[scene]
+@pytest.mark.parametrize("case", CASES)
+def test_write_gives_the_cli_files(case, out):
+    overrides, scene = CASES[case], scene_of(case)
     files = cli_run(scene, overrides, out / "cli")
     run = viscobar.run(scene, set=overrides)
     run.write(out / "python")

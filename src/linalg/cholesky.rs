@@ -163,7 +163,10 @@ impl SparseCholesky {
                     MemStack::new(buffer),
                     Default::default(),
                 )
-                .map_err(|LdltError::ZeroPivot { index }| FactorError::ZeroPivot { matrix, index })?;
+                .map_err(|LdltError::ZeroPivot { index }| FactorError::ZeroPivot {
+                    matrix,
+                    index,
+                })?;
             return Ok(());
         }
         self.symbolic

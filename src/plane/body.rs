@@ -8,8 +8,8 @@
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::sparse::Pattern;
 use crate::linalg::system::SparseSystem;
-use crate::plane::energy::{StrainForms, measure};
 use crate::plane::coupling::CoupledSolver;
+use crate::plane::energy::{StrainForms, measure};
 use crate::plane::heat::PlaneHeat;
 use crate::plane::matrices::{Material, assemble, assemble_with};
 use crate::plane::mesh::Grid;
@@ -310,14 +310,26 @@ impl Body for PlaneBody {
         self.disc.index[dof]
     }
 
-    /// `crate::plane::stress`: the cell-centre stresses, averaged at the nodes.
+    /// `crate::plane::stress`: the cell-centre stresses, averaged at the nodes; a coupled
+    /// temperature adds its `−γθ` to the diagonal at each node (`σ_zz` too: plane strain's
+    /// thermal stress is isotropic), so the von Mises stress keeps its value.
     fn nodal_stress(&self, u: &[f64], v: &[f64]) -> Option<Vec<[f64; 4]>> {
         let d = &self.disc;
         let (mut uf, mut vf) = (vec![0.0; d.grid.dofs()], vec![0.0; d.grid.dofs()]);
         self.scatter_into(u, 1.0, &mut uf);
         self.scatter_into(v, 1.0, &mut vf);
         let cells = stress::cell_stress(&d.grid, d.material, d.alpha, &uf, &vf);
-        Some(stress::nodal_stress(&d.grid, &cells))
+        let mut nodal = stress::nodal_stress(&d.grid, &cells);
+        if let Some(heat) = &self.heat {
+            for (node, s) in nodal.iter_mut().enumerate() {
+                if let Some(thermal) = heat.thermal_stress(node) {
+                    for k in [0, 1, 3] {
+                        s[k] -= thermal;
+                    }
+                }
+            }
+        }
+        Some(nodal)
     }
 
     fn has_temperature(&self) -> bool {
@@ -480,9 +492,9 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
     };
     let method = scene.solver.method;
     let epsilon = || scene.solver.penalty_settings().epsilon;
-    let coupled = heat.as_ref().and_then(|h| {
-        h.coupled_solver_parts((&disc.pattern, &c), &constraints, &friction_nodes)
-    });
+    let coupled = heat
+        .as_ref()
+        .and_then(|h| h.coupled_solver_parts((&disc.pattern, &c), &constraints, &friction_nodes));
     let solver: Box<dyn StepSolver> = match algorithm_for(method, shape) {
         // A coupled temperature: the exact solver of each state's `S` (the scene's
         // validation admits the exact method only).

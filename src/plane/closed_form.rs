@@ -251,8 +251,14 @@ impl Coupled {
         let (w, beta) = (m.omega, m.beta);
         let [lx, ly] = m.load_text();
         let load = [
-            format!("{lx} + {:?}*(1 + t)*cos({k1x:?}*x)*sin({k1y:?}*y)", g * b * k1x),
-            format!("{ly} + {:?}*(1 + t)*sin({k1x:?}*x)*cos({k1y:?}*y)", g * b * k1y),
+            format!(
+                "{lx} + {:?}*(1 + t)*cos({k1x:?}*x)*sin({k1y:?}*y)",
+                g * b * k1x
+            ),
+            format!(
+                "{ly} + {:?}*(1 + t)*sin({k1x:?}*x)*cos({k1y:?}*y)",
+                g * b * k1y
+            ),
         ];
         let gp = format!("({w:?}*({beta:?}*cos({w:?}*t) - sin({w:?}*t)))");
         let laplacian = kappa * (k1x * k1x + k1y * k1y);
@@ -421,7 +427,8 @@ mod tests {
             worst = worst.max((q.eval_xy(x, y, t).unwrap() - expected).abs());
             scale = scale.max(expected.abs());
             for k in 0..2 {
-                let thermal = l[k].eval_xy(x, y, t).unwrap() - mechanical[k].eval_xy(x, y, t).unwrap();
+                let thermal =
+                    l[k].eval_xy(x, y, t).unwrap() - mechanical[k].eval_xy(x, y, t).unwrap();
                 worst = worst.max((thermal - c.coupling * grad[k]).abs());
             }
         }

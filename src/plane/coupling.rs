@@ -482,7 +482,11 @@ mod tests {
             let u: Vec<f64> = (0..grid.dofs())
                 .map(|d| {
                     let (x, y) = grid.point(d / 2);
-                    if d % 2 == c { if c == 0 { x } else { y } } else { 0.0 }
+                    if d % 2 == c {
+                        if c == 0 { x } else { y }
+                    } else {
+                        0.0
+                    }
                 })
                 .collect();
             let mut t = vec![0.0; grid.nodes()];
@@ -522,21 +526,21 @@ mod tests {
         heat.values(&[], 0.5 * dt, &mut b_values);
         let free: Vec<usize> = (0..grid.dofs()).collect();
         let g = CouplingMatrix::new(&grid, &stencil, &free);
-        let mut s = CoupledSystem::new(
-            (&m.pattern, &c),
-            g,
-            (&stencil, &b_values),
-            gamma,
-            0.5,
-        )
-        .unwrap();
-        let b: Vec<f64> = (0..grid.dofs()).map(|i| ((i * 7919) % 13) as f64 - 6.0).collect();
+        let mut s =
+            CoupledSystem::new((&m.pattern, &c), g, (&stencil, &b_values), gamma, 0.5).unwrap();
+        let b: Vec<f64> = (0..grid.dofs())
+            .map(|i| ((i * 7919) % 13) as f64 - 6.0)
+            .collect();
         let mut x = b.clone();
         s.solve_in_place(&mut x);
         let mut sx = vec![0.0; x.len()];
         s.mul_into(&x, &mut sx);
         let max = |v: &[f64]| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-        let residual = sx.iter().zip(&b).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+        let residual = sx
+            .iter()
+            .zip(&b)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max);
         let scale = s.inf_norm() * max(&x) + max(&b);
         assert!(
             residual <= s.roundoff_ulps() * f64::EPSILON * scale,
@@ -545,7 +549,11 @@ mod tests {
         // The coupling acts: `S x` differs from `C x` by more than round-off.
         let mut cx = vec![0.0; x.len()];
         m.pattern.mul_into(&c, &x, &mut cx);
-        let coupling = cx.iter().zip(&sx).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+        let coupling = cx
+            .iter()
+            .zip(&sx)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max);
         assert!(coupling > 1e6 * residual, "{coupling:e}");
     }
 }

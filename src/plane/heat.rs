@@ -22,8 +22,8 @@ use crate::scene::plane_heat::PlaneHeatExpressions;
 use crate::scheme::body::{HeatOutputs, HeatTerms};
 use crate::scheme::{RunError, in_contact};
 use crate::step::{Constraints, Friction};
-use crate::thermal::solver::ImplicitFlag;
 use crate::thermal::smoothing::{Smoothing, jumps_within, profile_jumps, starts_with_a_jump};
+use crate::thermal::solver::ImplicitFlag;
 
 /// A node held at its edge's temperature: the node, its edge and coordinate `s`.
 #[derive(Clone, Copy, Debug)]
@@ -377,6 +377,11 @@ impl PlaneHeat {
         self.new[node]
     }
 
+    /// `γ θ` at `node` (the latest temperature), the thermal stress's size; `None` uncoupled.
+    pub fn thermal_stress(&self, node: usize) -> Option<f64> {
+        self.coupled.as_ref().map(|c| c.gamma * self.new[node])
+    }
+
     /// `½ |θ^{n+1/2}|²_M`.
     pub fn energy(&self) -> f64 {
         0.5 * self.pattern.quad(&self.mass, &self.new)
@@ -411,9 +416,9 @@ impl PlaneHeat {
     }
 
     /// The step from `t_n` (`n = 0` the start-up): the exchange state read off the step's
-    /// bounds `lower`, `θ_obs(t_n)`, and whether the heat step is implicit Euler.
-    /// With `γ > 0` also the step's data and the displacement's thermal load ([`PlaneHeat::thermal_load`];
-    /// `w_old = u^n − u^{n−1}`).
+    /// bounds `lower`, `θ_obs(t_n)`, and whether the heat step is implicit Euler. With `γ > 0`
+    /// also the step's data and the displacement's thermal load
+    /// ([`PlaneHeat::thermal_load`]; `w_old = u^n − u^{n−1}`).
     pub fn prepare(&mut self, n: usize, lower: &[f64], w_old: &[f64]) -> Result<(), RunError> {
         let t = n as f64 * self.dt;
         for (k, e) in self.exchange_edges.iter().enumerate() {
@@ -588,9 +593,7 @@ impl PlaneHeat {
     /// The factor of `(M + c A_χ)` on the unknown temperatures (`c = wτ`) in the step's exchange
     /// state, made when first met.
     fn factor_index(&mut self, c: f64) -> Result<usize, RunError> {
-        if let Some(i) =
-            (self.factors.iter()).position(|f| f.c == c && f.chi == self.chi)
-        {
+        if let Some(i) = (self.factors.iter()).position(|f| f.c == c && f.chi == self.chi) {
             return Ok(i);
         }
         (self.step_matrix).values(&self.chi, c, &mut self.values_reduced);

@@ -208,7 +208,8 @@ impl<B: Body> Scheme<B> {
         // The friction work over the start-up, `−r_T,j (u^1 − u^0)_{t_j}`, and the heat step.
         let work = &mut self.friction_work;
         (self.contact).friction_work_into(&self.reactions, (&self.z, None), 1.0, work);
-        self.body.heat_step(0, (&self.z, None), &self.friction_work)?;
+        self.body
+            .heat_step(0, (&self.z, None), &self.friction_work)?;
         let potential0 = self.body.stiffness_form(&self.u);
         add_in_place(&mut self.u, &self.z);
         self.body.mass_mul(&self.z, &mut self.b);

@@ -3,8 +3,8 @@
 
 use super::Measured;
 use crate::plane_heat::{
-    belt, coupled_strip_against_bar, exchange_decay, heat_balance, initial_jump_monotonicity,
-    sudden_edge_excursion, uniform_end,
+    belt, brake_heat_sums, coupled_strip_against_bar, exchange_decay, heat_balance,
+    initial_jump_monotonicity, sudden_edge_excursion, uniform_end,
 };
 use viscobar::scheme::RunError;
 
@@ -30,6 +30,11 @@ pub const PLANE_MONOTONE_TOL: f64 = 1e-12;
 /// start-up leave the stiff modes' remainder, measured 2.0e-9, the bound five times that; a
 /// Crank–Nicolson start leaves a decrease of 0.78.
 pub const BAR_MONOTONE_TOL: f64 = 1e-8;
+
+/// The brake's heat sums against each other, relative to the largest frictional heating: sums
+/// of a few hundred steps' heat (each `η d_j` and `(1 − η) d_j` of one `d_j`, the content a
+/// backward-stable solve's).
+pub const SUM_TOL: f64 = 1e-13;
 
 /// The coupled strip against the thermal bar, relative to each field's largest value: two
 /// independent solvers of the same equations (the bar's block-tridiagonal `LDLᵀ` and end
@@ -78,6 +83,17 @@ pub fn plane_heat_measured() -> Result<Vec<Measured>, RunError> {
             worst: initial_jump_monotonicity()?,
             note: "an initial jump inside a cell, κΔt/h² = 100, every row and step; no decrease \
                    measured",
+        },
+        Measured {
+            name: "SUM_TOL".into(),
+            used_in: "tests/plane_heat_snapshot.rs",
+            tolerance: SUM_TOL,
+            worst: {
+                let (share, excess) = brake_heat_sums()?;
+                share.max(excess)
+            },
+            note: "plane-brake, every step: the belt's heat against the body's share, and the \
+                   heat content's excess over the frictional heating",
         },
         Measured {
             name: "COUPLED_STRIP_TOL".into(),
