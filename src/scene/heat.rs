@@ -128,20 +128,7 @@ impl Heat {
         mechanical: [(&str, bool); 2],
         obstacle: bool,
     ) -> Result<HeatExpressions, SceneError> {
-        if !(self.coupling.is_finite() && self.coupling >= 0.0) {
-            return Err(invalid(
-                "heat.coupling",
-                self.coupling,
-                "must be a finite number >= 0",
-            ));
-        }
-        if !(self.diffusivity.is_finite() && self.diffusivity > 0.0) {
-            return Err(invalid(
-                "heat.diffusivity",
-                self.diffusivity,
-                "must be a finite number > 0",
-            ));
-        }
+        check_material(self.coupling, self.diffusivity)?;
         if obstacle {
             return Err(SceneError::Invalid {
                 field: "obstacle.gap".into(),
@@ -164,6 +151,26 @@ impl Heat {
             ends: [left, right],
         })
     }
+}
+
+/// `heat.coupling` `γ >= 0` and `heat.diffusivity` `κ > 0`, both finite (the bar's and the
+/// plane's `[heat]`).
+pub(crate) fn check_material(coupling: f64, diffusivity: f64) -> Result<(), SceneError> {
+    if !(coupling.is_finite() && coupling >= 0.0) {
+        return Err(invalid(
+            "heat.coupling",
+            coupling,
+            "must be a finite number >= 0",
+        ));
+    }
+    if !(diffusivity.is_finite() && diffusivity > 0.0) {
+        return Err(invalid(
+            "heat.diffusivity",
+            diffusivity,
+            "must be a finite number > 0",
+        ));
+    }
+    Ok(())
 }
 
 /// The keys of one thermal condition `condition` of a `what` (`end` or `edge`): `value` only on

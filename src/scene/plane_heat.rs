@@ -10,7 +10,9 @@
 use crate::scene::SceneError;
 use crate::scene::error::invalid;
 use crate::scene::expr::Expression;
-use crate::scene::heat::{EndHeat, ThermalCondition, check_condition_keys, exchange_coefficient};
+use crate::scene::heat::{
+    EndHeat, ThermalCondition, check_condition_keys, check_material, exchange_coefficient,
+};
 use crate::scene::plane::{EDGE_NAMES, EdgeCondition, Edges, PlaneHeat, ThermalEdge};
 
 /// The parsed `[heat]` of a plane scene.
@@ -37,20 +39,7 @@ impl PlaneHeat {
     /// Checks every key against its range and against the mechanical edges; the error names
     /// the key.
     pub fn validate(&self, edges: &Edges) -> Result<PlaneHeatExpressions, SceneError> {
-        if !(self.coupling.is_finite() && self.coupling >= 0.0) {
-            return Err(invalid(
-                "heat.coupling",
-                self.coupling,
-                "must be a finite number >= 0",
-            ));
-        }
-        if !(self.diffusivity.is_finite() && self.diffusivity > 0.0) {
-            return Err(invalid(
-                "heat.diffusivity",
-                self.diffusivity,
-                "must be a finite number > 0",
-            ));
-        }
+        check_material(self.coupling, self.diffusivity)?;
         let temperature = Expression::parse_plane("heat.temperature", &self.temperature, false)?;
         let source = match &self.source {
             Some(text) => Some(Expression::parse_plane("heat.source", text, true)?),
