@@ -495,36 +495,37 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
     let coupled = heat
         .as_ref()
         .and_then(|h| h.coupled_solver_parts((&disc.pattern, &c), &constraints, &friction_nodes));
-    let solver: Box<dyn StepSolver> = match algorithm_for(method, shape) {
+    let solver: Box<dyn StepSolver> = match (coupled, algorithm_for(method, shape)) {
         // A coupled temperature: the exact solver of each state's `S` (the scene's
         // validation admits the exact method only).
-        _ if coupled.is_some() => {
-            let (parts, exchange, implicit) = coupled.expect("matched");
+        (Some((parts, exchange, implicit)), _) => {
             Box::new(CoupledSolver::new(parts, exchange, implicit))
         }
-        Some(Algorithm::CondensedLcp) => Box::new(CondensedLcp::new(system()?, constraints, 0.0)?),
-        Some(Algorithm::CondensedPenalty) => {
+        (None, Some(Algorithm::CondensedLcp)) => {
+            Box::new(CondensedLcp::new(system()?, constraints, 0.0)?)
+        }
+        (None, Some(Algorithm::CondensedPenalty)) => {
             Box::new(CondensedLcp::new(system()?, constraints, epsilon())?)
         }
-        Some(Algorithm::SemismoothPenalty) => {
+        (None, Some(Algorithm::SemismoothPenalty)) => {
             Box::new(SemismoothPenalty::new(system()?, constraints, epsilon())?)
         }
-        Some(Algorithm::Osqp) => Box::new(Osqp::with_system(
+        (None, Some(Algorithm::Osqp)) => Box::new(Osqp::with_system(
             system()?,
             constraints,
             scene.solver.osqp_settings(),
         )?),
-        Some(Algorithm::CondensedLemke) => {
+        (None, Some(Algorithm::CondensedLemke)) => {
             Box::new(CondensedLemke::new(system()?, constraints, friction)?)
         }
-        Some(Algorithm::OsqpTresca) => Box::new(OsqpTresca::new(
+        (None, Some(Algorithm::OsqpTresca)) => Box::new(OsqpTresca::new(
             system()?,
             constraints,
             friction,
             scene.solver.osqp_settings(),
         )?),
         // The scene's validation refuses a method the table has not (penalty with friction).
-        None => {
+        (None, None) => {
             return Err(SceneError::Invalid {
                 field: "solver.method".into(),
                 value: method.name().into(),
@@ -532,7 +533,7 @@ fn setup(scene: &PlaneScene) -> Result<Setup<PlaneBody>, RunError> {
             }
             .into());
         }
-        Some(other) => unreachable!("the table gives the plane {other:?}"),
+        (None, Some(other)) => unreachable!("the table gives the plane {other:?}"),
     };
     let (dt, alpha) = (disc.dt, disc.alpha);
     let condition = condition_bound(&disc.pattern, &c, &disc.mass, dt);

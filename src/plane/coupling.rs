@@ -159,14 +159,16 @@ pub struct CoupledSystem {
     norm: f64,
 }
 
-/// The symmetric pattern of `[[C, G], [Gᵀ, B]]` (`G` with `m` columns) and, for each of its
-/// entries, where its value comes from.
+/// Where an entry of the quasi-definite matrix takes its value from: an entry of `C`, of `G`
+/// (in either triangle) or of `B`.
 enum Source {
     C(usize),
     G(usize),
     B(usize),
 }
 
+/// The symmetric pattern of `[[C, G], [Gᵀ, B]]` (`G` with `B`'s order of columns), each row's
+/// columns ascending, and the source of each entry.
 fn augmented_pattern(c: &Pattern, g: &CouplingMatrix, b: &Pattern) -> (Pattern, Vec<Source>) {
     let (n, m) = (c.n, b.n);
     let mut transpose: Vec<Vec<(usize, usize)>> = vec![Vec::new(); m];
