@@ -106,11 +106,14 @@ diagnostics_every = 1
 /// The bar is the plane's special case with a coupled temperature too: a strip of one row of
 /// cells held in `y` by its edges' obstacles runs the thermal bar (clamped, one end heated by a
 /// ramp; the bar's block-tridiagonal solver against the plane's sparse `S`), step by step; `θ`
-/// stays positive, so the obstacles keep pressing.
+/// stays at or above 0, so the obstacles keep pressing (or touch without force).
 #[test]
 fn a_coupled_strip_runs_the_thermal_bar() {
     let (du, dtheta, least) = plane_heat::coupled_strip_against_bar().unwrap();
-    assert!(least > 0.0, "θ fell to {least}: the strip's edges may open");
+    assert!(
+        least >= 0.0,
+        "θ fell to {least}: the strip's edges may open"
+    );
     assert!(du <= COUPLED_STRIP_TOL, "u: {du:e}");
     assert!(dtheta <= COUPLED_STRIP_TOL, "θ: {dtheta:e}");
 }

@@ -292,26 +292,14 @@ impl SpdSystem for CoupledSystem {
         self.norm
     }
 
-    fn diagonal(&self, i: usize) -> f64 {
-        let mut e = vec![0.0; self.dim()];
-        e[i] = 1.0;
-        let mut y = vec![0.0; self.dim()];
-        self.mul_into(&e, &mut y);
-        y[i]
+    // The penalty law's audit alone reads `S_ii` and `(|S||x|)_i` (`S − C` is dense); the
+    // coupled plane admits the exact solver only (`solver.method`).
+    fn diagonal(&self, _i: usize) -> f64 {
+        unreachable!("the penalty method is refused on a plane body with a coupled temperature")
     }
 
-    /// `(|C||x|)_i + |(S − C) x|_i`, a lower bound of `(|S||x|)_i`: `S − C` is dense; only
-    /// the penalty law reads this, and the coupled plane refuses it.
-    fn abs_row_product(&self, i: usize, x: &[f64]) -> f64 {
-        let mut y = vec![0.0; self.dim()];
-        self.mul_into(x, &mut y);
-        let p = &self.c_pattern;
-        let (mut abs, mut cx) = (0.0, 0.0);
-        for k in p.row_ptr[i]..p.row_ptr[i + 1] {
-            abs += (self.c[k] * x[p.cols[k]]).abs();
-            cx += self.c[k] * x[p.cols[k]];
-        }
-        abs + (y[i] - cx).abs()
+    fn abs_row_product(&self, _i: usize, _x: &[f64]) -> f64 {
+        unreachable!("the penalty method is refused on a plane body with a coupled temperature")
     }
 
     /// `C x`'s row (18 products) and `G_F B⁻¹ G_Fᵀ x` (two rows of 18 and 9 products and a
